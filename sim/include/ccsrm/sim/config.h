@@ -1,0 +1,139 @@
+#pragma once
+// Typed, validated configuration of an arm, its solver and its protocol.
+// configs/paper.yaml is the complete default; LoadConfig() is the one way to
+// get a Config, and every value is range-checked there (one source of truth).
+// Units are SI unless a name says otherwise; angles are radians in C++ and
+// degrees in YAML.
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace ccsrm::sim {
+
+// Kind of cable-constrained synchronous rotating mechanism between two
+// adjacent joints of a segment.
+enum class ConnectingKind { kSmallS, kLargeS };
+
+// Small "S": a linear torsional spring-damper (eqs. 38-43).
+struct SmallSGeometry {
+  double cable_length_m = 0.0;   // l_sc
+  double pulley_radius_m = 0.0;  // r_sc
+};
+
+// Large "S": spring with conduit friction (eqs. 44-53).
+struct LargeSGeometry {
+  double cable_length_m = 0.0;   // l_lc
+  double pulley_radius_m = 0.0;  // r_lc
+  double wrap_angle_rad = 0.0;   // Theta_lc
+};
+
+struct SegmentConfig {
+  std::string name;
+  int links = 0;
+  double link_length_m = 0.0;
+  double link_mass_kg = 0.0;
+  Eigen::Vector3d link_inertia_kgm2 = Eigen::Vector3d::Zero();  // diagonal, link frame
+  double hole_circle_radius_m = 0.0;
+  std::vector<ConnectingKind> connecting_pattern;  // links - 1 entries
+  SmallSGeometry small_s;
+  LargeSGeometry large_s;
+};
+
+struct DrivingCableRoute {
+  int segment = 0;              // 1-based segment the cable drives
+  double hole_angle_rad = 0.0;  // from x' toward y'
+};
+
+struct DrivingCableConfig {
+  double youngs_modulus_pa = 0.0;
+  double cross_section_m2 = 0.0;
+  double density_kgpm3 = 0.0;
+  double rayleigh_beta_s = 0.0;
+  double pretension_n = 0.0;      // T_d0
+  double friction_kinetic = 0.0;  // mu
+  double friction_static = 0.0;   // mu'
+  double input_offset_m = 0.0;
+  std::vector<DrivingCableRoute> cables;
+};
+
+struct ConnectingCableConfig {
+  double youngs_modulus_pa = 0.0;
+  double cross_section_m2 = 0.0;
+  double pretension_n = 0.0;           // T_p
+  double friction_kinetic = 0.0;       // mu_c
+  double friction_static = 0.0;        // mu'_c
+  double damping_small_nmsprad = 0.0;  // c_sc [N m s/rad]
+  double damping_large_nmsprad = 0.0;  // c_lc [N m s/rad]
+};
+
+struct ArmConfig {
+  double joint_disk_gap_m = 0.0;  // d
+  Eigen::Vector3d gravity_mps2 = Eigen::Vector3d::Zero();
+  std::vector<SegmentConfig> segments;
+  DrivingCableConfig driving;
+  ConnectingCableConfig connecting;
+
+  int total_links() const;
+  // Index (0-based) of the segment that holds link `link` (1-based).
+  int segment_of_link(int link) const;
+};
+
+struct SolverConfig {
+  double baumgarte_alpha_per_s = 100.0;
+  double baumgarte_beta_per_s2 = 100.0;
+  double smoothing_step_s = 0.01;
+  double stick_velocity_tolerance_mps = 1e-6;
+  double stick_force_tolerance_n = 1e-3;
+  double large_s_static_velocity_mps = 1e-4;
+  double large_s_dynamic_velocity_mps = 2e-4;
+  double relative_tolerance = 1e-6;
+  double absolute_tolerance = 1e-8;
+  double initial_step_s = 1e-5;
+  double max_step_s = 2e-3;
+  double min_step_s = 1e-12;
+  double switch_time_tolerance_s = 1e-6;
+  double max_constraint_violation = 1e-3;
+  double output_rate_hz = 100.0;
+};
+
+// The paper's protocol (SPEC 3).
+struct ProtocolConfig {
+  double amplitude_rad = 0.0;
+  double ramp_s = 20.0;
+  double hold_s = 4.0;
+  double return_s = 20.0;
+  double rest_s = 4.0;
+  double duration_s() const { return ramp_s + hold_s + return_s + rest_s; }
+};
+
+struct Config {
+  ArmConfig arm;
+  SolverConfig solver;
+  ProtocolConfig protocol;
+  std::string source_name;  // file name used in error messages
+  std::string source_yaml;  // the text it was parsed from
+};
+
+// Parses and validates YAML text. `source_name` names the file in errors.
+// Throws InputError "<file>: line N, key 'a.b.c': <problem>" on an unknown
+// key, a missing key or section, a wrong type or a value out of range.
+Config ParseConfig(const std::string& yaml_text, const std::string& source_name);
+
+// Reads and parses a configuration file. Throws InputError.
+Config LoadConfig(const std::string& path);
+
+// Writes the configuration back as YAML in the schema of configs/paper.yaml
+// (so a run file's config_yaml reflects any overrides applied in C++).
+std::string ToYaml(const Config& config);
+
+// The friction switches of the paper's four cases (section 6), applied on
+// top of any configuration: 1 no friction; 2 friction on all cables (the
+// configured values); 3 driving cables only; 4 connecting cables only.
+// Throws InputError for a case outside 1..4.
+void ApplyPaperCase(int case_number, Config* config);
+
+// Checks cross-field consistency of a Config built or modified in C++.
+// Throws InputError naming the offending key.
+void Validate(const Config& config);
+
+}  // namespace ccsrm::sim

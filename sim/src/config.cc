@@ -1,0 +1,566 @@
+#include "ccsrm/sim/config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/common/error.h"
+
+namespace ccsrm::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegToRad = kPi / 180.0;
+constexpr const char* kSchema = "ccsrm-config/1";
+
+// Line (1-based) of every key path seen while parsing, so that Validate can
+// name the line of a value that is out of range.
+using LineMap = std::map<std::string, int>;
+
+std::string Where(const LineMap* lines, const std::string& key) {
+  if (lines != nullptr) {
+    const auto it = lines->find(key);
+    if (it != lines->end()) return "line " + std::to_string(it->second) + ", key '" + key + "'";
+  }
+  return "key '" + key + "'";
+}
+
+// Levenshtein distance, to suggest the key a typo meant.
+int EditDistance(const std::string& a, const std::string& b) {
+  std::vector<int> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = static_cast<int>(j);
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    int diagonal = row[0];
+    row[0] = static_cast<int>(i);
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const int above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// Walks one YAML mapping: every read records the key as known; Finish()
+// rejects the keys nobody read (typos).
+class MapReader {
+ public:
+  MapReader(const YAML::Node& node, std::string path, const std::string& file, LineMap* lines)
+      : node_(node), path_(std::move(path)), file_(file), lines_(lines) {
+    if (!node_.IsMap()) Fail(path_, node_, "expected a mapping of keys");
+  }
+
+  MapReader Section(const std::string& key) {
+    return MapReader(Require(key), Join(key), file_, lines_);
+  }
+
+  double Number(const std::string& key) { return AsNumber(Require(key), Join(key)); }
+
+  int Integer(const std::string& key) {
+    const YAML::Node node = Require(key);
+    const double value = AsNumber(node, Join(key));
+    if (value != std::floor(value) || std::abs(value) > 1e9) {
+      Fail(Join(key), node, "expected a whole number, found '" + node.Scalar() + "'");
+    }
+    return static_cast<int>(value);
+  }
+
+  std::string String(const std::string& key) {
+    const YAML::Node node = Require(key);
+    if (!node.IsScalar()) Fail(Join(key), node, "expected a string");
+    return node.Scalar();
+  }
+
+  Eigen::Vector3d Vector3(const std::string& key) {
+    const YAML::Node node = Require(key);
+    if (!node.IsSequence() || node.size() != 3)
+      Fail(Join(key), node, "expected a list of 3 numbers");
+    Eigen::Vector3d v;
+    for (int i = 0; i < 3; ++i) v[i] = AsNumber(node[i], Join(key) + "[" + std::to_string(i) + "]");
+    return v;
+  }
+
+  // A sequence of mappings; `item` is called with a reader for each.
+  template <typename Fn>
+  void ForEach(const std::string& key, Fn&& item) {
+    const YAML::Node node = Require(key);
+    if (!node.IsSequence()) Fail(Join(key), node, "expected a list");
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      const std::string path = Join(key) + "[" + std::to_string(i) + "]";
+      Record(path, node[i]);
+      MapReader reader(node[i], path, file_, lines_);
+      item(reader, static_cast<int>(i));
+      reader.Finish();
+    }
+  }
+
+  // A list of words, each one of `choices`; returns the index of each word.
+  std::vector<int> WordList(const std::string& key, const std::vector<std::string>& choices) {
+    const YAML::Node node = Require(key);
+    if (!node.IsSequence()) Fail(Join(key), node, "expected a list");
+    std::vector<int> out;
+    for (const auto& item : node) {
+      const std::string word = item.IsScalar() ? item.Scalar() : std::string();
+      int index = -1;
+      for (std::size_t i = 0; i < choices.size(); ++i) {
+        if (word == choices[i]) index = static_cast<int>(i);
+      }
+      if (index < 0) {
+        std::string list;
+        for (const auto& c : choices) list += (list.empty() ? "'" : ", '") + c + "'";
+        Fail(Join(key), item, "expected one of " + list + ", found '" + word + "'");
+      }
+      out.push_back(index);
+    }
+    return out;
+  }
+
+  void Finish() const {
+    for (const auto& entry : node_) {
+      const std::string key = entry.first.Scalar();
+      if (read_.count(key) == 0) {
+        Fail(Join(key), entry.first, "unknown key (allowed here: " + Allowed() + ")");
+      }
+    }
+  }
+
+  [[noreturn]] void Fail(const std::string& key, const YAML::Node& at,
+                         const std::string& what) const {
+    ThrowInputError(file_, "line " + std::to_string(at.Mark().line + 1) + ", key '" + key + "'",
+                    what);
+  }
+
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string Join(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+  YAML::Node Require(const std::string& key) {
+    read_.insert(key);
+    allowed_.push_back(key);
+    const YAML::Node child = node_[key];
+    if (!child.IsDefined() || child.IsNull()) {
+      // A missing key next to an unknown one is most often a typo: name the typo.
+      for (const auto& entry : node_) {
+        const std::string other = entry.first.Scalar();
+        if (read_.count(other) == 0 && EditDistance(other, key) <= 3) {
+          Fail(Join(other), entry.first, "unknown key (did you mean '" + key + "'?)");
+        }
+      }
+      const std::string where = path_.empty() ? "top level" : "'" + path_ + "'";
+      ThrowInputError(file_,
+                      "line " + std::to_string(node_.Mark().line + 1) + ", key '" + Join(key) + "'",
+                      "missing (required in " + where + ")");
+    }
+    Record(Join(key), child);
+    return child;
+  }
+
+  void Record(const std::string& key, const YAML::Node& node) const {
+    if (lines_ != nullptr) (*lines_)[key] = node.Mark().line + 1;
+  }
+
+  double AsNumber(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsScalar()) Fail(key, node, "expected a number");
+    double value = 0.0;
+    std::istringstream in(node.Scalar());
+    in.imbue(std::locale::classic());
+    in >> value;
+    if (in.fail() || !in.eof()) Fail(key, node, "expected a number, found '" + node.Scalar() + "'");
+    if (!std::isfinite(value)) Fail(key, node, "must be finite");
+    return value;
+  }
+
+  std::string Allowed() const {
+    std::string out;
+    for (const auto& key : allowed_) out += (out.empty() ? "" : ", ") + key;
+    return out;
+  }
+
+  YAML::Node node_;
+  std::string path_;
+  const std::string& file_;
+  LineMap* lines_;
+  std::set<std::string> read_;
+  std::vector<std::string> allowed_;
+};
+
+class Checker {
+ public:
+  Checker(const std::string& file, const LineMap* lines) : file_(file), lines_(lines) {}
+
+  void Positive(const std::string& key, double value) const {
+    if (!(value > 0.0)) Fail(key, "must be > 0, found " + Format(value));
+  }
+  void NonNegative(const std::string& key, double value) const {
+    if (!(value >= 0.0)) Fail(key, "must be >= 0, found " + Format(value));
+  }
+  void InRange(const std::string& key, double value, double lo, double hi) const {
+    if (!(value >= lo && value <= hi)) {
+      Fail(key, "must be in [" + Format(lo) + ", " + Format(hi) + "], found " + Format(value));
+    }
+  }
+  [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
+    ThrowInputError(file_, Where(lines_, key), what);
+  }
+
+ private:
+  static std::string Format(double v) {
+    std::ostringstream out;
+    out << v;
+    return out.str();
+  }
+  const std::string& file_;
+  const LineMap* lines_;
+};
+
+void ValidateWithLines(const Config& c, const LineMap* lines) {
+  const Checker check(c.source_name, lines);
+  const ArmConfig& arm = c.arm;
+  check.Positive("arm.joint_disk_gap_m", arm.joint_disk_gap_m);
+  if (arm.segments.empty()) check.Fail("arm.segments", "at least one segment is required");
+  for (std::size_t i = 0; i < arm.segments.size(); ++i) {
+    const SegmentConfig& s = arm.segments[i];
+    const std::string p = "arm.segments[" + std::to_string(i) + "].";
+    if (s.links < 1 || s.links > 100)
+      check.Fail(p + "links", "must be in [1, 100], found " + std::to_string(s.links));
+    check.Positive(p + "link_length_m", s.link_length_m);
+    if (s.link_length_m <= arm.joint_disk_gap_m) {
+      check.Fail(p + "link_length_m",
+                 "must exceed arm.joint_disk_gap_m so that both disks fit on the link");
+    }
+    check.Positive(p + "link_mass_kg", s.link_mass_kg);
+    for (int k = 0; k < 3; ++k) check.Positive(p + "link_inertia_kgm2", s.link_inertia_kgm2[k]);
+    check.Positive(p + "hole_circle_radius_m", s.hole_circle_radius_m);
+    if (static_cast<int>(s.connecting_pattern.size()) != s.links - 1) {
+      check.Fail(p + "connecting_pattern", "needs links - 1 = " + std::to_string(s.links - 1) +
+                                               " entries, found " +
+                                               std::to_string(s.connecting_pattern.size()));
+    }
+    check.Positive(p + "small_s.cable_length_m", s.small_s.cable_length_m);
+    check.Positive(p + "small_s.pulley_radius_m", s.small_s.pulley_radius_m);
+    check.Positive(p + "large_s.cable_length_m", s.large_s.cable_length_m);
+    check.Positive(p + "large_s.pulley_radius_m", s.large_s.pulley_radius_m);
+    check.InRange(p + "large_s.wrap_angle_deg", s.large_s.wrap_angle_rad / kDegToRad, 0.0, 720.0);
+  }
+  const DrivingCableConfig& d = arm.driving;
+  check.Positive("driving_cables.youngs_modulus_pa", d.youngs_modulus_pa);
+  check.Positive("driving_cables.cross_section_m2", d.cross_section_m2);
+  check.Positive("driving_cables.density_kgpm3", d.density_kgpm3);
+  check.NonNegative("driving_cables.rayleigh_beta_s", d.rayleigh_beta_s);
+  check.Positive("driving_cables.pretension_n", d.pretension_n);
+  check.InRange("driving_cables.friction_kinetic", d.friction_kinetic, 0.0, 2.0);
+  check.InRange("driving_cables.friction_static", d.friction_static, 0.0, 2.0);
+  check.Positive("driving_cables.input_offset_m", d.input_offset_m);
+  if (d.cables.empty())
+    check.Fail("driving_cables.cables", "at least one driving cable is required");
+  for (std::size_t i = 0; i < d.cables.size(); ++i) {
+    const std::string p = "driving_cables.cables[" + std::to_string(i) + "].";
+    const int seg = d.cables[i].segment;
+    if (seg < 1 || seg > static_cast<int>(arm.segments.size())) {
+      check.Fail(p + "segment", "must name a segment 1.." + std::to_string(arm.segments.size()) +
+                                    ", found " + std::to_string(seg));
+    }
+    check.InRange(p + "hole_angle_deg", d.cables[i].hole_angle_rad / kDegToRad, -360.0, 360.0);
+  }
+  const ConnectingCableConfig& cc = arm.connecting;
+  check.Positive("connecting_cables.youngs_modulus_pa", cc.youngs_modulus_pa);
+  check.Positive("connecting_cables.cross_section_m2", cc.cross_section_m2);
+  check.Positive("connecting_cables.pretension_n", cc.pretension_n);
+  check.InRange("connecting_cables.friction_kinetic", cc.friction_kinetic, 0.0, 2.0);
+  check.InRange("connecting_cables.friction_static", cc.friction_static, 0.0, 2.0);
+  check.NonNegative("connecting_cables.damping_small_nmsprad", cc.damping_small_nmsprad);
+  check.NonNegative("connecting_cables.damping_large_nmsprad", cc.damping_large_nmsprad);
+
+  const SolverConfig& s = c.solver;
+  check.NonNegative("solver.baumgarte_alpha_per_s", s.baumgarte_alpha_per_s);
+  check.NonNegative("solver.baumgarte_beta_per_s2", s.baumgarte_beta_per_s2);
+  check.NonNegative("solver.smoothing_step_s", s.smoothing_step_s);
+  check.Positive("solver.stick_velocity_tolerance_mps", s.stick_velocity_tolerance_mps);
+  check.Positive("solver.stick_force_tolerance_n", s.stick_force_tolerance_n);
+  check.Positive("solver.large_s_static_velocity_mps", s.large_s_static_velocity_mps);
+  if (!(s.large_s_dynamic_velocity_mps > s.large_s_static_velocity_mps)) {
+    check.Fail("solver.large_s_dynamic_velocity_mps",
+               "must exceed solver.large_s_static_velocity_mps");
+  }
+  check.InRange("solver.relative_tolerance", s.relative_tolerance, 1e-14, 1e-1);
+  check.InRange("solver.absolute_tolerance", s.absolute_tolerance, 1e-16, 1e-1);
+  check.Positive("solver.initial_step_s", s.initial_step_s);
+  check.Positive("solver.max_step_s", s.max_step_s);
+  check.Positive("solver.min_step_s", s.min_step_s);
+  if (!(s.min_step_s < s.initial_step_s && s.initial_step_s <= s.max_step_s)) {
+    check.Fail("solver.initial_step_s", "must satisfy min_step_s < initial_step_s <= max_step_s");
+  }
+  check.Positive("solver.switch_time_tolerance_s", s.switch_time_tolerance_s);
+  check.Positive("solver.max_constraint_violation", s.max_constraint_violation);
+  check.InRange("solver.output_rate_hz", s.output_rate_hz, 1e-3, 1e5);
+
+  const ProtocolConfig& pr = c.protocol;
+  check.InRange("protocol.amplitude_deg", pr.amplitude_rad / kDegToRad, -60.0, 60.0);
+  check.Positive("protocol.ramp_s", pr.ramp_s);
+  check.NonNegative("protocol.hold_s", pr.hold_s);
+  check.Positive("protocol.return_s", pr.return_s);
+  check.NonNegative("protocol.rest_s", pr.rest_s);
+}
+
+}  // namespace
+
+int ArmConfig::total_links() const {
+  int n = 0;
+  for (const auto& s : segments) n += s.links;
+  return n;
+}
+
+int ArmConfig::segment_of_link(int link) const {
+  int last = 0;
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    last += segments[i].links;
+    if (link <= last) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+Config ParseConfig(const std::string& yaml_text, const std::string& source_name) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    ThrowInputError(source_name, "line " + std::to_string(e.mark.line + 1),
+                    "YAML syntax error: " + e.msg);
+  }
+  if (!root.IsMap()) ThrowInputError(source_name, "", "expected a YAML mapping at the top level");
+
+  LineMap lines;
+  Config c;
+  c.source_name = source_name;
+  c.source_yaml = yaml_text;
+  MapReader top(root, "", source_name, &lines);
+
+  const std::string schema = top.String("schema");
+  if (schema != kSchema) {
+    top.Fail("schema", root["schema"],
+             "expected '" + std::string(kSchema) + "', found '" + schema + "'");
+  }
+
+  {
+    MapReader arm = top.Section("arm");
+    c.arm.joint_disk_gap_m = arm.Number("joint_disk_gap_m");
+    c.arm.gravity_mps2 = arm.Vector3("gravity_mps2");
+    arm.ForEach("segments", [&](MapReader& s, int) {
+      SegmentConfig seg;
+      seg.name = s.String("name");
+      seg.links = s.Integer("links");
+      seg.link_length_m = s.Number("link_length_m");
+      seg.link_mass_kg = s.Number("link_mass_kg");
+      seg.link_inertia_kgm2 = s.Vector3("link_inertia_kgm2");
+      seg.hole_circle_radius_m = s.Number("hole_circle_radius_m");
+      for (int kind : s.WordList("connecting_pattern", {"small", "large"})) {
+        seg.connecting_pattern.push_back(kind == 0 ? ConnectingKind::kSmallS
+                                                   : ConnectingKind::kLargeS);
+      }
+      MapReader small = s.Section("small_s");
+      seg.small_s.cable_length_m = small.Number("cable_length_m");
+      seg.small_s.pulley_radius_m = small.Number("pulley_radius_m");
+      small.Finish();
+      MapReader large = s.Section("large_s");
+      seg.large_s.cable_length_m = large.Number("cable_length_m");
+      seg.large_s.pulley_radius_m = large.Number("pulley_radius_m");
+      seg.large_s.wrap_angle_rad = large.Number("wrap_angle_deg") * kDegToRad;
+      large.Finish();
+      c.arm.segments.push_back(seg);
+    });
+    arm.Finish();
+  }
+  {
+    MapReader d = top.Section("driving_cables");
+    DrivingCableConfig& dc = c.arm.driving;
+    dc.youngs_modulus_pa = d.Number("youngs_modulus_pa");
+    dc.cross_section_m2 = d.Number("cross_section_m2");
+    dc.density_kgpm3 = d.Number("density_kgpm3");
+    dc.rayleigh_beta_s = d.Number("rayleigh_beta_s");
+    dc.pretension_n = d.Number("pretension_n");
+    dc.friction_kinetic = d.Number("friction_kinetic");
+    dc.friction_static = d.Number("friction_static");
+    dc.input_offset_m = d.Number("input_offset_m");
+    d.ForEach("cables", [&](MapReader& cable, int) {
+      DrivingCableRoute route;
+      route.segment = cable.Integer("segment");
+      route.hole_angle_rad = cable.Number("hole_angle_deg") * kDegToRad;
+      dc.cables.push_back(route);
+    });
+    d.Finish();
+  }
+  {
+    MapReader k = top.Section("connecting_cables");
+    ConnectingCableConfig& cc = c.arm.connecting;
+    cc.youngs_modulus_pa = k.Number("youngs_modulus_pa");
+    cc.cross_section_m2 = k.Number("cross_section_m2");
+    cc.pretension_n = k.Number("pretension_n");
+    cc.friction_kinetic = k.Number("friction_kinetic");
+    cc.friction_static = k.Number("friction_static");
+    cc.damping_small_nmsprad = k.Number("damping_small_nmsprad");
+    cc.damping_large_nmsprad = k.Number("damping_large_nmsprad");
+    k.Finish();
+  }
+  {
+    MapReader s = top.Section("solver");
+    SolverConfig& sc = c.solver;
+    sc.baumgarte_alpha_per_s = s.Number("baumgarte_alpha_per_s");
+    sc.baumgarte_beta_per_s2 = s.Number("baumgarte_beta_per_s2");
+    sc.smoothing_step_s = s.Number("smoothing_step_s");
+    sc.stick_velocity_tolerance_mps = s.Number("stick_velocity_tolerance_mps");
+    sc.stick_force_tolerance_n = s.Number("stick_force_tolerance_n");
+    sc.large_s_static_velocity_mps = s.Number("large_s_static_velocity_mps");
+    sc.large_s_dynamic_velocity_mps = s.Number("large_s_dynamic_velocity_mps");
+    sc.relative_tolerance = s.Number("relative_tolerance");
+    sc.absolute_tolerance = s.Number("absolute_tolerance");
+    sc.initial_step_s = s.Number("initial_step_s");
+    sc.max_step_s = s.Number("max_step_s");
+    sc.min_step_s = s.Number("min_step_s");
+    sc.switch_time_tolerance_s = s.Number("switch_time_tolerance_s");
+    sc.max_constraint_violation = s.Number("max_constraint_violation");
+    sc.output_rate_hz = s.Number("output_rate_hz");
+    s.Finish();
+  }
+  {
+    MapReader p = top.Section("protocol");
+    ProtocolConfig& pc = c.protocol;
+    pc.amplitude_rad = p.Number("amplitude_deg") * kDegToRad;
+    pc.ramp_s = p.Number("ramp_s");
+    pc.hold_s = p.Number("hold_s");
+    pc.return_s = p.Number("return_s");
+    pc.rest_s = p.Number("rest_s");
+    p.Finish();
+  }
+  top.Finish();
+  ValidateWithLines(c, &lines);
+  return c;
+}
+
+Config LoadConfig(const std::string& path) { return ParseConfig(ReadTextFile(path), path); }
+
+void Validate(const Config& config) { ValidateWithLines(config, nullptr); }
+
+void ApplyPaperCase(int case_number, Config* config) {
+  if (case_number < 1 || case_number > 4) {
+    ThrowInputError("--case", "", "must be 1, 2, 3 or 4, found " + std::to_string(case_number));
+  }
+  const bool driving = case_number == 2 || case_number == 3;
+  const bool connecting = case_number == 2 || case_number == 4;
+  if (!driving) {
+    config->arm.driving.friction_kinetic = 0.0;
+    config->arm.driving.friction_static = 0.0;
+  }
+  if (!connecting) {
+    config->arm.connecting.friction_kinetic = 0.0;
+    config->arm.connecting.friction_static = 0.0;
+  }
+}
+
+std::string ToYaml(const Config& c) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  auto vec3 = [&](const Eigen::Vector3d& v) {
+    out << YAML::Flow << YAML::BeginSeq << v[0] << v[1] << v[2] << YAML::EndSeq;
+  };
+  out << YAML::BeginMap;
+  out << YAML::Key << "schema" << YAML::Value << kSchema;
+  out << YAML::Key << "arm" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "joint_disk_gap_m" << YAML::Value << c.arm.joint_disk_gap_m;
+  out << YAML::Key << "gravity_mps2" << YAML::Value;
+  vec3(c.arm.gravity_mps2);
+  out << YAML::Key << "segments" << YAML::Value << YAML::BeginSeq;
+  for (const SegmentConfig& s : c.arm.segments) {
+    out << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << s.name;
+    out << YAML::Key << "links" << YAML::Value << s.links;
+    out << YAML::Key << "link_length_m" << YAML::Value << s.link_length_m;
+    out << YAML::Key << "link_mass_kg" << YAML::Value << s.link_mass_kg;
+    out << YAML::Key << "link_inertia_kgm2" << YAML::Value;
+    vec3(s.link_inertia_kgm2);
+    out << YAML::Key << "hole_circle_radius_m" << YAML::Value << s.hole_circle_radius_m;
+    out << YAML::Key << "connecting_pattern" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (ConnectingKind k : s.connecting_pattern)
+      out << (k == ConnectingKind::kSmallS ? "small" : "large");
+    out << YAML::EndSeq;
+    out << YAML::Key << "small_s" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "cable_length_m" << YAML::Value << s.small_s.cable_length_m;
+    out << YAML::Key << "pulley_radius_m" << YAML::Value << s.small_s.pulley_radius_m;
+    out << YAML::EndMap;
+    out << YAML::Key << "large_s" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "cable_length_m" << YAML::Value << s.large_s.cable_length_m;
+    out << YAML::Key << "pulley_radius_m" << YAML::Value << s.large_s.pulley_radius_m;
+    out << YAML::Key << "wrap_angle_deg" << YAML::Value << s.large_s.wrap_angle_rad / kDegToRad;
+    out << YAML::EndMap;
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq << YAML::EndMap;
+
+  const DrivingCableConfig& d = c.arm.driving;
+  out << YAML::Key << "driving_cables" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "youngs_modulus_pa" << YAML::Value << d.youngs_modulus_pa;
+  out << YAML::Key << "cross_section_m2" << YAML::Value << d.cross_section_m2;
+  out << YAML::Key << "density_kgpm3" << YAML::Value << d.density_kgpm3;
+  out << YAML::Key << "rayleigh_beta_s" << YAML::Value << d.rayleigh_beta_s;
+  out << YAML::Key << "pretension_n" << YAML::Value << d.pretension_n;
+  out << YAML::Key << "friction_kinetic" << YAML::Value << d.friction_kinetic;
+  out << YAML::Key << "friction_static" << YAML::Value << d.friction_static;
+  out << YAML::Key << "input_offset_m" << YAML::Value << d.input_offset_m;
+  out << YAML::Key << "cables" << YAML::Value << YAML::BeginSeq;
+  for (const DrivingCableRoute& r : d.cables) {
+    out << YAML::Flow << YAML::BeginMap << YAML::Key << "segment" << YAML::Value << r.segment
+        << YAML::Key << "hole_angle_deg" << YAML::Value << r.hole_angle_rad / kDegToRad
+        << YAML::EndMap;
+  }
+  out << YAML::EndSeq << YAML::EndMap;
+
+  const ConnectingCableConfig& cc = c.arm.connecting;
+  out << YAML::Key << "connecting_cables" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "youngs_modulus_pa" << YAML::Value << cc.youngs_modulus_pa;
+  out << YAML::Key << "cross_section_m2" << YAML::Value << cc.cross_section_m2;
+  out << YAML::Key << "pretension_n" << YAML::Value << cc.pretension_n;
+  out << YAML::Key << "friction_kinetic" << YAML::Value << cc.friction_kinetic;
+  out << YAML::Key << "friction_static" << YAML::Value << cc.friction_static;
+  out << YAML::Key << "damping_small_nmsprad" << YAML::Value << cc.damping_small_nmsprad;
+  out << YAML::Key << "damping_large_nmsprad" << YAML::Value << cc.damping_large_nmsprad;
+  out << YAML::EndMap;
+
+  const SolverConfig& s = c.solver;
+  out << YAML::Key << "solver" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "baumgarte_alpha_per_s" << YAML::Value << s.baumgarte_alpha_per_s;
+  out << YAML::Key << "baumgarte_beta_per_s2" << YAML::Value << s.baumgarte_beta_per_s2;
+  out << YAML::Key << "smoothing_step_s" << YAML::Value << s.smoothing_step_s;
+  out << YAML::Key << "stick_velocity_tolerance_mps" << YAML::Value
+      << s.stick_velocity_tolerance_mps;
+  out << YAML::Key << "stick_force_tolerance_n" << YAML::Value << s.stick_force_tolerance_n;
+  out << YAML::Key << "large_s_static_velocity_mps" << YAML::Value << s.large_s_static_velocity_mps;
+  out << YAML::Key << "large_s_dynamic_velocity_mps" << YAML::Value
+      << s.large_s_dynamic_velocity_mps;
+  out << YAML::Key << "relative_tolerance" << YAML::Value << s.relative_tolerance;
+  out << YAML::Key << "absolute_tolerance" << YAML::Value << s.absolute_tolerance;
+  out << YAML::Key << "initial_step_s" << YAML::Value << s.initial_step_s;
+  out << YAML::Key << "max_step_s" << YAML::Value << s.max_step_s;
+  out << YAML::Key << "min_step_s" << YAML::Value << s.min_step_s;
+  out << YAML::Key << "switch_time_tolerance_s" << YAML::Value << s.switch_time_tolerance_s;
+  out << YAML::Key << "max_constraint_violation" << YAML::Value << s.max_constraint_violation;
+  out << YAML::Key << "output_rate_hz" << YAML::Value << s.output_rate_hz;
+  out << YAML::EndMap;
+
+  const ProtocolConfig& p = c.protocol;
+  out << YAML::Key << "protocol" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "amplitude_deg" << YAML::Value << p.amplitude_rad / kDegToRad;
+  out << YAML::Key << "ramp_s" << YAML::Value << p.ramp_s;
+  out << YAML::Key << "hold_s" << YAML::Value << p.hold_s;
+  out << YAML::Key << "return_s" << YAML::Value << p.return_s;
+  out << YAML::Key << "rest_s" << YAML::Value << p.rest_s;
+  out << YAML::EndMap;
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace ccsrm::sim

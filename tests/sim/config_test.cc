@@ -1,0 +1,127 @@
+#include "ccsrm/sim/config.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/common/error.h"
+
+namespace ccsrm::sim {
+namespace {
+using ::testing::HasSubstr;
+
+const std::string kPaperConfig = std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml";
+
+std::string PaperText() { return ReadTextFile(kPaperConfig); }
+
+// Replaces the first occurrence of `from` in the paper configuration.
+std::string Edited(const std::string& from, const std::string& to) {
+  std::string text = PaperText();
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
+  return text;
+}
+
+std::string ErrorOf(const std::string& text) {
+  try {
+    ParseConfig(text, "bad.yaml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// Line (1-based) of the first occurrence of `needle` in `text`.
+int LineOf(const std::string& text, const std::string& needle) {
+  const auto at = text.find(needle);
+  int line = 1;
+  for (std::size_t i = 0; i < at; ++i) line += text[i] == '\n';
+  return line;
+}
+
+TEST(Config, PaperConfigurationHoldsTable1) {
+  const Config c = LoadConfig(kPaperConfig);
+  ASSERT_EQ(c.arm.segments.size(), 2u);
+  EXPECT_EQ(c.arm.total_links(), 12);
+  EXPECT_DOUBLE_EQ(c.arm.segments[0].link_length_m, 0.085);
+  EXPECT_DOUBLE_EQ(c.arm.segments[1].link_length_m, 0.100);
+  EXPECT_DOUBLE_EQ(c.arm.segments[0].link_inertia_kgm2[0], 66e-6);
+  EXPECT_DOUBLE_EQ(c.arm.segments[1].hole_circle_radius_m, 0.016);
+  EXPECT_NEAR(c.arm.segments[0].large_s.wrap_angle_rad, 184.0 * M_PI / 180.0, 1e-15);
+  EXPECT_EQ(c.arm.segments[0].connecting_pattern[1], ConnectingKind::kLargeS);
+  EXPECT_EQ(c.arm.driving.cables.size(), 6u);
+  EXPECT_EQ(c.arm.driving.cables[3].segment, 2);
+  EXPECT_NEAR(c.arm.driving.cables[3].hole_angle_rad, M_PI / 3.0, 1e-15);
+  EXPECT_DOUBLE_EQ(c.arm.driving.youngs_modulus_pa, 2.6e10);
+  EXPECT_DOUBLE_EQ(c.arm.connecting.pretension_n, 50.0);
+  EXPECT_DOUBLE_EQ(c.solver.smoothing_step_s, 0.01);
+  EXPECT_DOUBLE_EQ(c.protocol.duration_s(), 48.0);
+  EXPECT_EQ(c.arm.segment_of_link(6), 0);
+  EXPECT_EQ(c.arm.segment_of_link(7), 1);
+}
+
+TEST(Config, TypoInKeyNamesFileLineAndKey) {
+  const std::string text = Edited("      link_mass_kg: 0.095", "      link_mas_kg: 0.095");
+  const std::string error = ErrorOf(text);
+  EXPECT_THAT(error, HasSubstr("bad.yaml: line " + std::to_string(LineOf(text, "link_mas_kg"))));
+  EXPECT_THAT(error, HasSubstr("arm.segments[0].link_mas_kg"));
+  EXPECT_THAT(error, HasSubstr("unknown key"));
+  EXPECT_EQ(error.find('\n'), std::string::npos);
+}
+
+TEST(Config, NegativeLengthNamesFileLineAndKey) {
+  const std::string text = Edited("link_length_m: 0.100", "link_length_m: -0.1");
+  const std::string error = ErrorOf(text);
+  EXPECT_THAT(error, HasSubstr("bad.yaml: line " + std::to_string(LineOf(text, "-0.1"))));
+  EXPECT_THAT(error, HasSubstr("arm.segments[1].link_length_m"));
+  EXPECT_THAT(error, HasSubstr("must be > 0"));
+}
+
+TEST(Config, MissingSectionNamesIt) {
+  std::string text = PaperText();
+  text = text.substr(0, text.find("protocol:"));
+  const std::string error = ErrorOf(text);
+  EXPECT_THAT(error, HasSubstr("bad.yaml: line "));
+  EXPECT_THAT(error, HasSubstr("key 'protocol'"));
+  EXPECT_THAT(error, HasSubstr("missing"));
+}
+
+TEST(Config, RejectsBadValues) {
+  EXPECT_THAT(ErrorOf(Edited("links: 6", "links: 0")), HasSubstr("arm.segments[0].links"));
+  EXPECT_THAT(ErrorOf(Edited("youngs_modulus_pa: 2.6e10", "youngs_modulus_pa: -1")),
+              HasSubstr("driving_cables.youngs_modulus_pa"));
+  EXPECT_THAT(
+      ErrorOf(Edited("{segment: 1, hole_angle_deg: 0.0}", "{segment: 3, hole_angle_deg: 0.0}")),
+      HasSubstr("driving_cables.cables[0].segment"));
+  EXPECT_THAT(ErrorOf(Edited("[small, large, small, large, small]", "[small, large]")),
+              HasSubstr("connecting_pattern"));
+  EXPECT_THAT(
+      ErrorOf(Edited("[small, large, small, large, small]", "[small, larg, small, large, small]")),
+      HasSubstr("found 'larg'"));
+  EXPECT_THAT(ErrorOf(Edited("link_mass_kg: 0.095", "link_mass_kg: heavy")),
+              HasSubstr("expected a number, found 'heavy'"));
+  EXPECT_THAT(ErrorOf(Edited("schema: ccsrm-config/1", "schema: ccsrm-config/2")),
+              HasSubstr("schema"));
+  EXPECT_THAT(ErrorOf("arm: [1, 2"), HasSubstr("YAML syntax error"));
+}
+
+TEST(Config, YamlRoundTripKeepsEveryValue) {
+  const Config a = LoadConfig(kPaperConfig);
+  const Config b = ParseConfig(ToYaml(a), "roundtrip.yaml");
+  EXPECT_EQ(ToYaml(a), ToYaml(b));
+  EXPECT_EQ(b.arm.segments[1].large_s.wrap_angle_rad, a.arm.segments[1].large_s.wrap_angle_rad);
+  EXPECT_EQ(b.arm.driving.cables[5].hole_angle_rad, a.arm.driving.cables[5].hole_angle_rad);
+}
+
+TEST(Config, ValidateRejectsConfigBuiltInCode) {
+  Config c = LoadConfig(kPaperConfig);
+  c.arm.segments[0].link_length_m = 0.0;
+  EXPECT_THROW(Validate(c), InputError);
+}
+
+}  // namespace
+}  // namespace ccsrm::sim
