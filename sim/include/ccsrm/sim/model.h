@@ -1,0 +1,90 @@
+#pragma once
+// The immutable model of an arm (MuJoCo's "model"): geometry, inertia,
+// cable routing and coordinate layout, built once from a Config and shared
+// read-only by any number of runs (each run owns its own data).
+//
+// Frames and names follow docs/conventions.md: W is the world frame (origin
+// at joint 1, z along the straight arm, x normal to the table), B_i the body
+// frame of link i at its mass centre. p_BH is a hole H in its link's frame.
+#include <Eigen/Core>
+#include <vector>
+
+#include "ccsrm/sim/config.h"
+
+namespace ccsrm::sim {
+
+struct LinkModel {
+  int segment = 0;  // 0-based
+  double length_m = 0.0;
+  double mass_kg = 0.0;
+  Eigen::Vector3d inertia_kgm2 = Eigen::Vector3d::Zero();  // diagonal of J' in B
+};
+
+// One node of a driving cable. Input nodes sit on the ground with a
+// prescribed material coordinate; hole nodes are Eulerian (fixed to a disk,
+// free material coordinate); the anchor node is fixed to its link in both
+// position and material coordinate.
+struct CableNodeModel {
+  enum class Kind { kInput, kHole, kAnchor };
+  Kind kind = Kind::kHole;
+  int link = 0;  // 0 = ground, else 1-based link index
+  // Position in the link frame (or in W when link == 0).
+  Eigen::Vector3d p_LN = Eigen::Vector3d::Zero();
+};
+
+struct DrivingCableModel {
+  int segment = 0;  // 0-based
+  double radius_m = 0.0;
+  double angle_rad = 0.0;
+  std::vector<CableNodeModel> nodes;  // input, holes ..., anchor
+  int num_elements() const { return static_cast<int>(nodes.size()) - 1; }
+  int num_holes() const { return static_cast<int>(nodes.size()) - 2; }
+};
+
+// A connecting mechanism between joints i and j = i + 1 (1-based) of one
+// segment.
+struct ConnectingPairModel {
+  ConnectingKind kind = ConnectingKind::kSmallS;
+  int joint_i = 0;
+  int joint_j = 0;
+  double stiffness_nmprad = 0.0;  // small S: k_sc (eq. 41); large S: E_cA_c r_lc^2/l_lc
+  double damping_nmsprad = 0.0;
+  double pulley_radius_m = 0.0;  // large S: r_lc
+  double wrap_angle_rad = 0.0;   // large S: Theta_lc
+};
+
+class ArmModel {
+ public:
+  // Builds the model. Throws InputError if the configuration is invalid.
+  explicit ArmModel(const Config& config);
+
+  const Config& config() const { return config_; }
+  int num_links() const { return static_cast<int>(links_.size()); }
+  int num_joints() const { return num_links(); }  // joint i joins link i-1 and link i
+  int num_cables() const { return static_cast<int>(cables_.size()); }
+  const LinkModel& link(int i) const { return links_[i - 1]; }  // 1-based
+  const std::vector<LinkModel>& links() const { return links_; }
+  const std::vector<DrivingCableModel>& cables() const { return cables_; }
+  const std::vector<ConnectingPairModel>& connecting_pairs() const { return pairs_; }
+
+  // Coordinate layout (eq. 59): every cable node (x, y, z, s), then every
+  // link (x, y, z, e0, e1, e2, e3).
+  int num_coordinates() const { return num_coordinates_; }
+  int node_offset(int cable, int node) const { return node_offsets_[cable][node]; }
+  int link_offset(int link) const { return link_offsets_[link - 1]; }  // 1-based
+
+  // Joint i (1-based) in the frame of link i-1 (in W for i = 1) and of link i.
+  Eigen::Vector3d p_parent_joint(int joint) const;
+  Eigen::Vector3d p_child_joint(int joint) const;
+
+ private:
+  Config config_;
+  std::vector<LinkModel> links_;
+  std::vector<DrivingCableModel> cables_;
+  std::vector<ConnectingPairModel> pairs_;
+  std::vector<std::vector<int>> node_offsets_;
+  std::vector<int> link_offsets_;
+  int num_coordinates_ = 0;
+};
+
+}  // namespace ccsrm::sim

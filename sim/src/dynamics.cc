@@ -1,0 +1,639 @@
+#include "dynamics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "ccsrm/common/error.h"
+#include "kernels/ale_element.h"
+#include "kernels/connecting.h"
+#include "kernels/hole_friction.h"
+#include "kernels/rigid_body.h"
+
+namespace ccsrm::sim::internal {
+namespace {
+
+using Vector4 = Eigen::Vector4d;
+using Vector3 = Eigen::Vector3d;
+
+Vector4 Quaternion(const double* q, int offset) {
+  return Vector4(q[offset + 3], q[offset + 4], q[offset + 5], q[offset + 6]);
+}
+Vector3 Position(const double* q, int offset) {
+  return Vector3(q[offset], q[offset + 1], q[offset + 2]);
+}
+
+// The augmented system is made quasi-definite by -kRegularization on the
+// multiplier diagonal, so that a sparse LDL^T exists for any fill-reducing
+// ordering (Vanderbei 1995). It perturbs the constraint equations by
+// kRegularization * lambda, far below the Baumgarte-stabilised drift.
+constexpr double kRegularization = 1e-10;
+
+}  // namespace
+
+ArmDynamics::ArmDynamics(const ArmModel& model, const CableInputs& inputs)
+    : model_(model), inputs_(inputs), config_(model.config()), n_(model.num_coordinates()) {
+  CCSRM_CHECK(inputs.num_cables() == model.num_cables());
+  const DrivingCableConfig& d = config_.arm.driving;
+  stick_slip_ = d.friction_kinetic > 0.0 || d.friction_static > 0.0;
+  for (int c = 0; c < model_.num_cables(); ++c) {
+    const auto& cable = model_.cables()[c];
+    for (int k = 1; k + 1 < static_cast<int>(cable.nodes.size()); ++k) holes_.push_back({c, k});
+  }
+  modes_.assign(holes_.size(), stick_slip_ ? HoleMode::kStuck : HoleMode::kSlipUp);
+  reports_.assign(holes_.size(), HoleReport{});
+  tension_.resize(model_.num_cables());
+  for (int c = 0; c < model_.num_cables(); ++c)
+    tension_[c].assign(model_.cables()[c].num_elements(), 0.0);
+  rotation_.resize(model_.num_links());
+  theta_.resize(model_.num_joints());
+  theta_dot_.resize(model_.num_joints());
+
+  const Eigen::VectorXd y0 = InitialState();
+  for (int c = 0; c < model_.num_cables(); ++c) {
+    for (std::size_t k = 0; k < model_.cables()[c].nodes.size(); ++k) {
+      initial_s_.push_back(y0[model_.node_offset(c, static_cast<int>(k)) + 3]);
+    }
+  }
+  stuck_s_.resize(holes_.size());
+  for (std::size_t h = 0; h < holes_.size(); ++h) {
+    stuck_s_[h] = y0[model_.node_offset(holes_[h].cable, holes_[h].node) + 3];
+  }
+  BuildStructure();
+}
+
+Eigen::VectorXd ArmDynamics::InitialState() const {
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(state_size());
+  const std::vector<LinkPose> poses =
+      ForwardKinematics(model_, JointAngles(model_.num_joints(), Eigen::Vector2d::Zero()));
+  for (int i = 1; i <= model_.num_links(); ++i) {
+    const int o = model_.link_offset(i);
+    y.segment<3>(o) = poses[i - 1].p_WB;
+    y[o + 3] = 1.0;  // e = (1, 0, 0, 0): body axes along the world axes
+  }
+  // Uniform pre-strain: T_d0 = EA eps0 (eq. 13), so each element's
+  // unstretched length is its chord / sqrt(1 + 2 eps0) (Green strain).
+  const DrivingCableConfig& d = config_.arm.driving;
+  const double eps0 = d.pretension_n / (d.youngs_modulus_pa * d.cross_section_m2);
+  const double stretch = std::sqrt(1.0 + 2.0 * eps0);
+  for (int c = 0; c < model_.num_cables(); ++c) {
+    double s = 0.0;
+    Vector3 previous;
+    for (int k = 0; k < static_cast<int>(model_.cables()[c].nodes.size()); ++k) {
+      const Vector3 p = CableNodePosition(model_, c, k, poses);
+      if (k > 0) s += (p - previous).norm() / stretch;
+      const int o = model_.node_offset(c, k);
+      y.segment<3>(o) = p;
+      y[o + 3] = s;
+      previous = p;
+    }
+  }
+  return y;
+}
+
+void ArmDynamics::BuildStructure() {
+  // Rows: 4 per cable node, 1 per link (eq. 35), 4 per joint (eqs. 36-37).
+  auto add_row = [&](std::initializer_list<int> cols) {
+    RowData row;
+    for (int c : cols) row.cols[row.count++] = c;
+    rows_.push_back(row);
+  };
+  auto link_cols = [&](int link, int axis, std::vector<int>* cols) {
+    const int o = model_.link_offset(link);
+    cols->push_back(o + axis);
+    for (int k = 3; k < 7; ++k) cols->push_back(o + k);
+  };
+  for (int c = 0; c < model_.num_cables(); ++c) {
+    const auto& cable = model_.cables()[c];
+    for (int k = 0; k < static_cast<int>(cable.nodes.size()); ++k) {
+      const int o = model_.node_offset(c, k);
+      for (int a = 0; a < 3; ++a) {
+        std::vector<int> cols{o + a};
+        if (cable.nodes[k].link > 0) link_cols(cable.nodes[k].link, a, &cols);
+        RowData row;
+        for (int col : cols) row.cols[row.count++] = col;
+        rows_.push_back(row);
+        hole_of_node_row_.push_back(-1);
+      }
+      add_row({o + 3});
+      int hole = -1;
+      if (cable.nodes[k].kind == CableNodeModel::Kind::kHole) {
+        for (std::size_t h = 0; h < holes_.size(); ++h) {
+          if (holes_[h].cable == c && holes_[h].node == k) hole = static_cast<int>(h);
+        }
+      }
+      hole_of_node_row_.push_back(hole);
+    }
+  }
+  for (int i = 1; i <= model_.num_links(); ++i) {
+    const int o = model_.link_offset(i);
+    add_row({o + 3, o + 4, o + 5, o + 6});
+    hole_of_node_row_.push_back(-1);
+  }
+  for (int j = 1; j <= model_.num_joints(); ++j) {
+    for (int a = 0; a < 3; ++a) {
+      std::vector<int> cols;
+      if (j > 1) link_cols(j - 1, a, &cols);
+      link_cols(j, a, &cols);
+      RowData row;
+      for (int col : cols) row.cols[row.count++] = col;
+      rows_.push_back(row);
+      hole_of_node_row_.push_back(-1);
+    }
+    RowData row;
+    if (j > 1) {
+      const int p = model_.link_offset(j - 1);
+      for (int k = 3; k < 7; ++k) row.cols[row.count++] = p + k;
+    }
+    const int o = model_.link_offset(j);
+    for (int k = 3; k < 7; ++k) row.cols[row.count++] = o + k;
+    rows_.push_back(row);
+    hole_of_node_row_.push_back(-1);
+  }
+  m_ = static_cast<int>(rows_.size());
+
+  // Sparsity pattern of the augmented system
+  //   [ M + Phi_q^T Phi_q   Phi_q^T ] [ q_dd   ]   [ F - Phi_q^T b ]
+  //   [ Phi_q               D       ] [ lambda ] = [ -b            ]
+  // (eqs. 62-64 solved together; D = 1 on the rows of slipping hole nodes,
+  // whose stick constraint is switched off, so their lambda is 0).
+  std::vector<Eigen::Triplet<double>> pattern;
+  for (int c = 0; c < model_.num_cables(); ++c) {
+    for (int e = 0; e < model_.cables()[c].num_elements(); ++e) {
+      const int o1 = model_.node_offset(c, e), o2 = model_.node_offset(c, e + 1);
+      const int cols[8] = {o1, o1 + 1, o1 + 2, o2, o2 + 1, o2 + 2, o1 + 3, o2 + 3};
+      for (int a : cols)
+        for (int b : cols) pattern.emplace_back(a, b, 0.0);
+    }
+  }
+  for (int i = 1; i <= model_.num_links(); ++i) {
+    const int o = model_.link_offset(i);
+    for (int a = 0; a < 3; ++a) pattern.emplace_back(o + a, o + a, 0.0);
+    for (int a = 3; a < 7; ++a)
+      for (int b = 3; b < 7; ++b) pattern.emplace_back(o + a, o + b, 0.0);
+  }
+  for (int r = 0; r < m_; ++r) {
+    const RowData& row = rows_[r];
+    for (int a = 0; a < row.count; ++a) {
+      pattern.emplace_back(n_ + r, row.cols[a], 0.0);
+      pattern.emplace_back(row.cols[a], n_ + r, 0.0);
+      for (int b = 0; b < row.count; ++b) pattern.emplace_back(row.cols[a], row.cols[b], 0.0);
+    }
+    pattern.emplace_back(n_ + r, n_ + r, 0.0);
+  }
+  kkt_.resize(n_ + m_, n_ + m_);
+  kkt_.setFromTriplets(pattern.begin(), pattern.end());
+  kkt_.makeCompressed();
+
+  for (int c = 0; c < model_.num_cables(); ++c) {
+    for (int e = 0; e < model_.cables()[c].num_elements(); ++e) {
+      const int o1 = model_.node_offset(c, e), o2 = model_.node_offset(c, e + 1);
+      const int cols[8] = {o1, o1 + 1, o1 + 2, o2, o2 + 1, o2 + 2, o1 + 3, o2 + 3};
+      for (int a : cols)
+        for (int b : cols) element_index_.push_back(Index(a, b));
+    }
+  }
+  for (int i = 1; i <= model_.num_links(); ++i) {
+    const int o = model_.link_offset(i);
+    for (int a = 0; a < 3; ++a) link_index_.push_back(Index(o + a, o + a));
+    for (int a = 3; a < 7; ++a)
+      for (int b = 3; b < 7; ++b) link_index_.push_back(Index(o + a, o + b));
+  }
+  for (int r = 0; r < m_; ++r) {
+    const RowData& row = rows_[r];
+    for (int a = 0; a < row.count; ++a) {
+      row_kkt_index_.push_back(Index(n_ + r, row.cols[a]));
+      row_kkt_index_.push_back(Index(row.cols[a], n_ + r));
+    }
+    row_pair_offset_.push_back(static_cast<int>(row_pair_index_.size()));
+    for (int a = 0; a < row.count; ++a)
+      for (int b = 0; b < row.count; ++b)
+        row_pair_index_.push_back(Index(row.cols[a], row.cols[b]));
+    row_diag_index_.push_back(Index(n_ + r, n_ + r));
+  }
+  lu_.analyzePattern(kkt_);
+  rhs_.resize(n_ + m_);
+  force_.resize(n_);
+}
+
+int ArmDynamics::Index(int row, int col) const {
+  const int* inner = kkt_.innerIndexPtr();
+  const int begin = kkt_.outerIndexPtr()[col];
+  const int end = kkt_.outerIndexPtr()[col + 1];
+  const int* at = std::lower_bound(inner + begin, inner + end, row);
+  CCSRM_CHECK(at != inner + end && *at == row);
+  return static_cast<int>(at - inner);
+}
+
+void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, bool with_jacobian) {
+  const double alpha = config_.solver.baumgarte_alpha_per_s;
+  const double beta = config_.solver.baumgarte_beta_per_s2;
+  int r = 0;
+  int node_index = 0;
+  // Sets row r's Baumgarte right-hand side b = Phi_dd(q_dd = 0) + alpha Phi_d + beta Phi.
+  auto finish = [&](RowData& row, double phi, double phi_dot, double bias) {
+    row.phi = phi;
+    row.b = bias + alpha * phi_dot + beta * phi;
+  };
+  for (int c = 0; c < model_.num_cables(); ++c) {
+    const auto& cable = model_.cables()[c];
+    for (int k = 0; k < static_cast<int>(cable.nodes.size()); ++k, ++node_index) {
+      const CableNodeModel& node = cable.nodes[k];
+      const int o = model_.node_offset(c, k);
+      const Vector3 r_node = Position(q, o), v_node = Position(qd, o);
+      Vector3 phi, phi_dot, bias = Vector3::Zero();
+      Eigen::Matrix<double, 3, 4> jac = Eigen::Matrix<double, 3, 4>::Zero();
+      if (node.link == 0) {
+        phi = r_node - node.p_LN;
+        phi_dot = v_node;
+      } else {
+        const int lo = model_.link_offset(node.link);
+        const Vector4 e = Quaternion(q, lo), ed = Quaternion(qd, lo);
+        jac = PointJacobian(e, node.p_LN);
+        phi = r_node - Position(q, lo) - rotation_[node.link - 1] * node.p_LN;
+        phi_dot = v_node - Position(qd, lo) - jac * ed;
+        bias = -PointJacobian(ed, node.p_LN) * ed;
+      }
+      for (int a = 0; a < 3; ++a, ++r) {
+        RowData& row = rows_[r];
+        if (with_jacobian) {
+          row.vals[0] = 1.0;
+          if (node.link > 0) {
+            row.vals[1] = -1.0;
+            for (int k4 = 0; k4 < 4; ++k4) row.vals[2 + k4] = -jac(a, k4);
+          }
+        }
+        finish(row, phi[a], phi_dot[a], bias[a]);
+      }
+      RowData& srow = rows_[r++];
+      srow.vals[0] = 1.0;
+      const double s = q[o + 3], sd = qd[o + 3];
+      srow.active = true;
+      if (node.kind == CableNodeModel::Kind::kInput) {
+        double pulled, rate, accel;
+        inputs_.Evaluate(c, t, &pulled, &rate, &accel);
+        finish(srow, s - (initial_s_[node_index] + pulled), sd - rate, -accel);
+      } else if (node.kind == CableNodeModel::Kind::kAnchor) {
+        finish(srow, s - initial_s_[node_index], sd, 0.0);
+      } else {
+        const int h = hole_of_node_row_[r - 1];
+        srow.active = modes_[h] == HoleMode::kStuck;
+        finish(srow, srow.active ? s - stuck_s_[h] : 0.0, sd, 0.0);
+      }
+    }
+  }
+  for (int i = 1; i <= model_.num_links(); ++i, ++r) {
+    const int o = model_.link_offset(i);
+    const Vector4 e = Quaternion(q, o), ed = Quaternion(qd, o);
+    RowData& row = rows_[r];
+    for (int k = 0; k < 4; ++k) row.vals[k] = 2.0 * e[k];
+    finish(row, e.squaredNorm() - 1.0, 2.0 * e.dot(ed), 2.0 * ed.squaredNorm());
+  }
+  const Vector3 x_axis = Vector3::UnitX(), y_axis = Vector3::UnitY();
+  for (int j = 1; j <= model_.num_joints(); ++j) {
+    const Vector3 u_p = model_.p_parent_joint(j), u_c = model_.p_child_joint(j);
+    const int oc = model_.link_offset(j);
+    const Vector4 ec = Quaternion(q, oc), edc = Quaternion(qd, oc);
+    const Eigen::Matrix<double, 3, 4> jc = PointJacobian(ec, u_c);
+    Vector3 phi = -Position(q, oc) - rotation_[j - 1] * u_c;
+    Vector3 phi_dot = -Position(qd, oc) - jc * edc;
+    Vector3 bias = -PointJacobian(edc, u_c) * edc;
+    Eigen::Matrix<double, 3, 4> jp;
+    Vector4 ep, edp;
+    if (j > 1) {
+      const int op = model_.link_offset(j - 1);
+      ep = Quaternion(q, op);
+      edp = Quaternion(qd, op);
+      jp = PointJacobian(ep, u_p);
+      phi += Position(q, op) + rotation_[j - 2] * u_p;
+      phi_dot += Position(qd, op) + jp * edp;
+      bias += PointJacobian(edp, u_p) * edp;
+    } else {
+      phi += u_p;
+    }
+    for (int a = 0; a < 3; ++a, ++r) {
+      RowData& row = rows_[r];
+      int v = 0;
+      if (j > 1) {
+        row.vals[v++] = 1.0;
+        for (int k = 0; k < 4; ++k) row.vals[v++] = jp(a, k);
+      }
+      row.vals[v++] = -1.0;
+      for (int k = 0; k < 4; ++k) row.vals[v++] = -jc(a, k);
+      finish(row, phi[a], phi_dot[a], bias[a]);
+    }
+    // Orientation (eq. 37): (A_p x')^T (A_c y') = 0.
+    const Vector3 a_vec = j > 1 ? Vector3(rotation_[j - 2] * x_axis) : x_axis;
+    const Vector3 c_vec = rotation_[j - 1] * y_axis;
+    const Eigen::Matrix<double, 3, 4> dc = PointJacobian(ec, y_axis);
+    const Vector3 c_dot = dc * edc;
+    Vector3 a_dot = Vector3::Zero();
+    double bias_o = a_vec.dot(PointJacobian(edc, y_axis) * edc);
+    RowData& row = rows_[r++];
+    int v = 0;
+    if (j > 1) {
+      const Eigen::Matrix<double, 3, 4> dp = PointJacobian(ep, x_axis);
+      a_dot = dp * edp;
+      const Eigen::Matrix<double, 1, 4> g = c_vec.transpose() * dp;
+      for (int k = 0; k < 4; ++k) row.vals[v++] = g[k];
+      bias_o += c_vec.dot(PointJacobian(edp, x_axis) * edp) + 2.0 * a_dot.dot(c_dot);
+    }
+    const Eigen::Matrix<double, 1, 4> g = a_vec.transpose() * dc;
+    for (int k = 0; k < 4; ++k) row.vals[v++] = g[k];
+    finish(row, a_vec.dot(c_vec), a_dot.dot(c_vec) + a_vec.dot(c_dot), bias_o);
+  }
+  CCSRM_CHECK(r == m_);
+}
+
+bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
+  ++evaluations_;
+  const double* q = y;
+  const double* qd = y + n_;
+  const SolverConfig& solver = config_.solver;
+  const DrivingCableConfig& dc = config_.arm.driving;
+  const ConnectingCableConfig& cc = config_.arm.connecting;
+  double* values = kkt_.valuePtr();
+  std::fill(values, values + kkt_.nonZeros(), 0.0);
+  force_.setZero();
+  double dissipation = 0.0;  // W, power taken out by friction and damping
+  kinetic_ = 0.0;
+  elastic_ = 0.0;
+
+  // Stage 1: link kinematics.
+  std::vector<Vector3> omega(model_.num_links());
+  for (int i = 1; i <= model_.num_links(); ++i) {
+    const int o = model_.link_offset(i);
+    const Vector4 e = Quaternion(q, o), ed = Quaternion(qd, o);
+    rotation_[i - 1] = RotationFromQuaternion(e);
+    omega[i - 1] = QuaternionRateMatrix(e) * ed;
+  }
+
+  // Stage 2: driving-cable ALE elements (eqs. 1-6, 13, 17-20).
+  AleElementParams ale;
+  ale.linear_density_kgpm = dc.density_kgpm3 * dc.cross_section_m2;
+  ale.axial_stiffness_n = dc.youngs_modulus_pa * dc.cross_section_m2;
+  ale.rayleigh_beta_s = dc.rayleigh_beta_s;
+  ale.smoothing_step_s = solver.smoothing_step_s;
+  const double h = solver.smoothing_step_s;
+  struct ElementRate {
+    double coefficient;  // Δs EA (beta' eps_dot + gamma bias) -> dissipation with eps_dd
+    double gamma_term;   // Δs EA gamma eps_dot
+    Eigen::Matrix<double, 1, 8> jac;
+    int cols[8];
+  };
+  std::vector<ElementRate> element_rates;
+  element_rates.reserve(64);
+  int element_counter = 0;
+  for (int c = 0; c < model_.num_cables(); ++c) {
+    const int elements = model_.cables()[c].num_elements();
+    for (int e = 0; e < elements; ++e, ++element_counter) {
+      const int o1 = model_.node_offset(c, e), o2 = model_.node_offset(c, e + 1);
+      const int cols[8] = {o1, o1 + 1, o1 + 2, o2, o2 + 1, o2 + 2, o1 + 3, o2 + 3};
+      Vector8d qe, qde;
+      for (int k = 0; k < 8; ++k) {
+        qe[k] = q[cols[k]];
+        qde[k] = qd[cols[k]];
+      }
+      const double ds = qe[7] - qe[6];
+      if (!(ds > 0.0) || !std::isfinite(ds)) {
+        failure_ = "cable " + std::to_string(c + 1) + " element " + std::to_string(e + 1) +
+                   " collapsed (material length " + std::to_string(ds) + " m)";
+        return false;
+      }
+      const AleElementTerms terms = EvaluateAleElement(ale, qe, qde);
+      const int* index = &element_index_[64 * element_counter];
+      const Matrix8d mass = terms.mass + terms.elastic_mass;
+      for (int a = 0; a < 8; ++a)
+        for (int b = 0; b < 8; ++b) values[index[8 * a + b]] += mass(a, b);
+      const Vector8d f = terms.ale_inertia_force + terms.elastic_force;
+      for (int a = 0; a < 8; ++a) force_[cols[a]] += f[a];
+      tension_[c][e] = terms.tension;
+      kinetic_ += 0.5 * qde.dot(terms.mass * qde);
+      const double k = terms.taut ? 1.0 : 0.0;
+      elastic_ += 0.5 * ale.axial_stiffness_n * k * terms.strain * terms.strain * ds;
+      const double beta_p = dc.rayleigh_beta_s + k * h / 2.0;
+      const double gamma = dc.rayleigh_beta_s * h / 2.0 + k * h * h / 6.0;
+      const double scale = ds * ale.axial_stiffness_n * terms.strain_rate;
+      ElementRate rate;
+      rate.coefficient = scale * (beta_p * terms.strain_rate + gamma * terms.strain_accel_bias);
+      rate.gamma_term = scale * gamma;
+      rate.jac = terms.strain_jacobian;
+      std::copy(cols, cols + 8, rate.cols);
+      element_rates.push_back(rate);
+    }
+  }
+
+  // Stage 3: capstan friction at the hole nodes (eqs. 9-12).
+  for (std::size_t hidx = 0; hidx < holes_.size(); ++hidx) {
+    const HoleNodeRef& hole = holes_[hidx];
+    const int o = model_.node_offset(hole.cable, hole.node);
+    const Vector3 r_prev = Position(q, model_.node_offset(hole.cable, hole.node - 1));
+    const Vector3 r_next = Position(q, model_.node_offset(hole.cable, hole.node + 1));
+    HoleReport& report = reports_[hidx];
+    report.s_dot = qd[o + 3];
+    report.wrap_angle = WrapAngle(r_prev, Position(q, o), r_next);
+    const double t_before = tension_[hole.cable][hole.node - 1];
+    const double t_after = tension_[hole.cable][hole.node];
+    report.friction_limit =
+        LimitingStaticFriction(t_before, t_after, dc.friction_static, report.wrap_angle);
+    report.required_friction = 0.0;
+    if (modes_[hidx] != HoleMode::kStuck && dc.friction_kinetic > 0.0) {
+      const double sigma = modes_[hidx] == HoleMode::kSlipUp ? 1.0 : -1.0;
+      const double f = HoleSlipFriction(t_before, dc.friction_kinetic, report.wrap_angle, sigma);
+      force_[o + 3] += f;
+      dissipation -= f * qd[o + 3];
+    }
+  }
+
+  // Stage 4: joint angles (eqs. 23-29) and connecting-cable moments (eqs. 38-58).
+  std::vector<Eigen::Matrix3d> rel(model_.num_joints());
+  for (int j = 1; j <= model_.num_joints(); ++j) {
+    rel[j - 1] =
+        j > 1 ? Eigen::Matrix3d(rotation_[j - 2].transpose() * rotation_[j - 1]) : rotation_[0];
+    theta_[j - 1] = UniversalJointAngles(rel[j - 1]);
+    const Vector3 w_parent = j > 1 ? omega[j - 2] : Vector3::Zero();
+    theta_dot_[j - 1] = UniversalJointRates(
+        theta_[j - 1][1], RelativeAngularVelocity(rel[j - 1], omega[j - 1], w_parent));
+  }
+  std::vector<Eigen::Vector2d> joint_moment(model_.num_joints(), Eigen::Vector2d::Zero());
+  const double ea_c = cc.youngs_modulus_pa * cc.cross_section_m2;
+  for (const ConnectingPairModel& pair : model_.connecting_pairs()) {
+    const int i = pair.joint_i - 1, j = pair.joint_j - 1;
+    for (int axis = 0; axis < 2; ++axis) {
+      const double th_i = theta_[i][axis], th_j = theta_[j][axis];
+      const double rt_i = theta_dot_[i][axis], rt_j = theta_dot_[j][axis];
+      ConnectingMoments m;
+      double k_conservative = 0.0;
+      if (pair.kind == ConnectingKind::kSmallS) {
+        const SegmentConfig& seg = config_.arm.segments[model_.link(pair.joint_i).segment];
+        SmallSParams p;
+        p.axial_stiffness_n = ea_c;
+        p.pulley_radius_m = seg.small_s.pulley_radius_m;
+        p.cable_length_m = seg.small_s.cable_length_m;
+        p.damping_nmsprad = pair.damping_nmsprad;
+        m = SmallSMoments(p, th_i, th_j, rt_i, rt_j);
+        k_conservative = SmallSStiffness(p);
+      } else {
+        const SegmentConfig& seg = config_.arm.segments[model_.link(pair.joint_i).segment];
+        LargeSParams p;
+        p.axial_stiffness_n = ea_c;
+        p.pulley_radius_m = seg.large_s.pulley_radius_m;
+        p.cable_length_m = seg.large_s.cable_length_m;
+        p.wrap_angle_rad = seg.large_s.wrap_angle_rad;
+        p.pretension_n = cc.pretension_n;
+        p.damping_nmsprad = pair.damping_nmsprad;
+        p.friction.mu_kinetic = cc.friction_kinetic;
+        p.friction.mu_static = cc.friction_static;
+        p.friction.v_static_mps = solver.large_s_static_velocity_mps;
+        p.friction.v_dynamic_mps = solver.large_s_dynamic_velocity_mps;
+        m = LargeSMoments(p, th_i, th_j, rt_i, rt_j).moments;
+        k_conservative = 2.0 * pair.stiffness_nmprad;
+      }
+      joint_moment[i][axis] += m.on_i;
+      joint_moment[j][axis] += m.on_j;
+      const double d_theta = th_j - th_i, d_rate = rt_j - rt_i;
+      elastic_ += 0.5 * k_conservative * d_theta * d_theta;
+      // Dissipated = -(power of the moments) - d/dt(conservative energy).
+      dissipation += -(m.on_i * rt_i + m.on_j * rt_j) - k_conservative * d_theta * d_rate;
+    }
+  }
+  for (int j = 1; j <= model_.num_joints(); ++j) {
+    if (joint_moment[j - 1].isZero(0.0)) continue;
+    const JointBodyMoments body =
+        JointMomentsToBodies(rel[j - 1], theta_[j - 1][1], joint_moment[j - 1]);
+    const int oc = model_.link_offset(j);
+    force_.segment<4>(oc + 3) += QuaternionMomentForce(Quaternion(q, oc), body.on_child_body);
+    if (j > 1) {
+      const int op = model_.link_offset(j - 1);
+      force_.segment<4>(op + 3) += QuaternionMomentForce(Quaternion(q, op), body.on_parent_body);
+    }
+  }
+
+  // Stage 5: rigid links (eqs. 30-34).
+  for (int i = 1; i <= model_.num_links(); ++i) {
+    const LinkModel& link = model_.link(i);
+    const int o = model_.link_offset(i);
+    const Vector4 e = Quaternion(q, o), ed = Quaternion(qd, o);
+    const Eigen::Matrix3d inertia = link.inertia_kgm2.asDiagonal();
+    const int* index = &link_index_[19 * (i - 1)];
+    for (int a = 0; a < 3; ++a) values[index[a]] += link.mass_kg;
+    const Eigen::Matrix4d me = QuaternionMass(e, inertia);
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) values[index[3 + 4 * a + b]] += me(a, b);
+    force_.segment<3>(o) += link.mass_kg * config_.arm.gravity_mps2;
+    force_.segment<4>(o + 3) += QuaternionVelocityForce(e, ed, inertia);
+    kinetic_ += 0.5 * link.mass_kg * Position(qd, o).squaredNorm() +
+                0.5 * omega[i - 1].dot(inertia * omega[i - 1]);
+  }
+
+  // Stage 6: constraints with Baumgarte stabilisation (eqs. 35-37, 61-63).
+  FillConstraints(t, q, qd, true);
+  rhs_.head(n_) = force_;
+  for (int r = 0; r < m_; ++r) {
+    const RowData& row = rows_[r];
+    values[row_diag_index_[r]] = -kRegularization;
+    if (!row.active) {
+      values[row_diag_index_[r]] = -1.0;
+      rhs_[n_ + r] = 0.0;
+      continue;
+    }
+    rhs_[n_ + r] = -row.b;
+    const int* pair = &row_pair_index_[row_pair_offset_[r]];
+    for (int a = 0; a < row.count; ++a) {
+      rhs_[row.cols[a]] -= row.vals[a] * row.b;
+      for (int b = 0; b < row.count; ++b)
+        values[pair[row.count * a + b]] += row.vals[a] * row.vals[b];
+    }
+  }
+  {
+    int k = 0;
+    for (int r = 0; r < m_; ++r) {
+      const RowData& row = rows_[r];
+      for (int a = 0; a < row.count; ++a, k += 2) {
+        if (!row.active) continue;
+        values[row_kkt_index_[k]] += row.vals[a];
+        values[row_kkt_index_[k + 1]] += row.vals[a];
+      }
+    }
+  }
+
+  // Stage 7: solve the augmented system (eqs. 64-68) for q_dd and lambda.
+  lu_.factorize(kkt_);
+  if (lu_.info() != Eigen::Success) {
+    failure_ = "augmented mass matrix is singular";
+    return false;
+  }
+  const Eigen::VectorXd solution = lu_.solve(rhs_);
+  for (int k = 0; k < n_; ++k) {
+    ydot[k] = qd[k];
+    ydot[n_ + k] = solution[k];
+  }
+  // Element smoothing and Rayleigh damping dissipate
+  // Δs EA eps_dot (beta' eps_dot + gamma eps_dd) with eps_dd = bias + eps_q q_dd.
+  for (const ElementRate& rate : element_rates) {
+    double eps_q_qdd = 0.0;
+    for (int k = 0; k < 8; ++k) eps_q_qdd += rate.jac[k] * solution[rate.cols[k]];
+    dissipation += rate.coefficient + rate.gamma_term * eps_q_qdd;
+  }
+  ydot[2 * n_] = dissipation;
+
+  // Friction a stuck node needs: the reaction of its constraint, -lambda.
+  for (int r = 0; r < m_; ++r) {
+    const int hidx = hole_of_node_row_[r];
+    if (hidx >= 0 && rows_[r].active) reports_[hidx].required_friction = -solution[n_ + r];
+  }
+  for (int k = 0; k < 2 * n_ + 1; ++k) {
+    if (!std::isfinite(ydot[k])) {
+      failure_ = "non-finite acceleration";
+      return false;
+    }
+  }
+  return true;
+}
+
+double ArmDynamics::ConstraintViolation(double t, const double* y) {
+  for (int i = 1; i <= model_.num_links(); ++i) {
+    rotation_[i - 1] = RotationFromQuaternion(Quaternion(y, model_.link_offset(i)));
+  }
+  FillConstraints(t, y, y + n_, false);
+  double sum = 0.0;
+  for (const RowData& row : rows_) {
+    if (row.active) sum += row.phi * row.phi;
+  }
+  return std::sqrt(sum);
+}
+
+void ArmDynamics::Observe(double t, const double* y, Observation* out) {
+  std::vector<double> ydot(state_size());
+  Evaluate(t, y, ydot.data());
+  out->joint_angles = theta_;
+  out->joint_rates = theta_dot_;
+  out->link_pose.resize(model_.num_links());
+  for (int i = 1; i <= model_.num_links(); ++i) {
+    const int o = model_.link_offset(i);
+    Eigen::Matrix<double, 7, 1> pose;
+    pose.head<3>() = Position(y, o);
+    pose.tail<4>() = Quaternion(y, o).normalized();
+    out->link_pose[i - 1] = pose;
+  }
+  out->element_tension = tension_;
+  out->hole_slip_velocity.assign(model_.num_cables(), {});
+  out->hole_stuck.assign(model_.num_cables(), {});
+  for (std::size_t hidx = 0; hidx < holes_.size(); ++hidx) {
+    const int c = holes_[hidx].cable;
+    out->hole_slip_velocity[c].push_back(reports_[hidx].s_dot);
+    out->hole_stuck[c].push_back(modes_[hidx] == HoleMode::kStuck ? 1 : 0);
+  }
+  out->input_length_change.resize(model_.num_cables());
+  for (int c = 0; c < model_.num_cables(); ++c) {
+    double value, rate, accel;
+    inputs_.Evaluate(c, t, &value, &rate, &accel);
+    out->input_length_change[c] = value;
+  }
+  out->constraint_violation = ConstraintViolation(t, y);
+  out->kinetic_energy = kinetic_;
+  out->elastic_energy = elastic_;
+  out->dissipated_energy = y[2 * n_];
+}
+
+}  // namespace ccsrm::sim::internal

@@ -1,0 +1,90 @@
+#include "connecting.h"
+
+#include <cmath>
+
+namespace ccsrm::sim::internal {
+namespace {
+
+// E_c A_c r^2 / l, the stiffness of one cable of the couple seen from a joint.
+// Shared by both mechanisms so the frictionless large S equals the small S
+// bitwise (multiplying by 2 is exact in floating point).
+double HalfCoupleStiffness(double axial_stiffness, double radius, double length) {
+  return axial_stiffness * radius * radius / length;
+}
+
+}  // namespace
+
+double SmallSStiffness(const SmallSParams& params) {
+  return 2.0 * HalfCoupleStiffness(params.axial_stiffness_n, params.pulley_radius_m,
+                                   params.cable_length_m);
+}
+
+ConnectingMoments SmallSMoments(const SmallSParams& params, double theta_i, double theta_j,
+                                double theta_i_dot, double theta_j_dot) {
+  const double k = SmallSStiffness(params);
+  const double c = params.damping_nmsprad;
+  ConnectingMoments m;
+  m.on_i = k * (theta_j - theta_i) + c * (theta_j_dot - theta_i_dot);
+  m.on_j = k * (theta_i - theta_j) + c * (theta_i_dot - theta_j_dot);
+  return m;
+}
+
+double ModifiedCoulomb(const ModifiedCoulombParams& params, double v) {
+  const double speed = std::abs(v);
+  const double sign = v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0);
+  if (speed > params.v_dynamic_mps) return -params.mu_kinetic * sign;
+  if (speed >= params.v_static_mps) {
+    // SPEC §3 (a): smooth step from mu'_c at v_s to mu_c at v_d. The paper's
+    // printed branch swaps mu_c and mu'_c, which makes mu_m jump at both ends
+    // unless mu_c = mu'_c.
+    const double x = (speed - params.v_static_mps) / (params.v_dynamic_mps - params.v_static_mps);
+    return -(params.mu_static + (params.mu_kinetic - params.mu_static) * x * x * (3.0 - 2.0 * x)) *
+           sign;
+  }
+  // Paper's lower branch (eq. 45): a cubic through +mu'_c at -v_s, 0 at 0 and
+  // -mu'_c at v_s with zero slope at both ends.
+  const double u = (v + params.v_static_mps) / (2.0 * params.v_static_mps);
+  return params.mu_static - 2.0 * params.mu_static * u * u * (3.0 - 2.0 * u);
+}
+
+double CapstanFactor(double x) {
+  // x / (1 - e^{-x}) -> 1 as x -> 0 (eqs. 46-53 without friction). expm1
+  // keeps full relative precision for small |x|; only x == 0 needs the limit.
+  if (x == 0.0) return 1.0;
+  return -x / std::expm1(-x);
+}
+
+LargeSResult LargeSMoments(const LargeSParams& params, double theta_i, double theta_j,
+                           double theta_i_dot, double theta_j_dot) {
+  LargeSResult out;
+  // Sliding speeds of the couple in the conduit; sign chosen so that the
+  // friction moments dissipate (see the header).
+  out.slip_velocity_1 = -0.5 * params.pulley_radius_m * (theta_i_dot + theta_j_dot);
+  const double v2 = -out.slip_velocity_1;
+  const double a1 = ModifiedCoulomb(params.friction, out.slip_velocity_1) * params.wrap_angle_rad;
+  const double a2 = ModifiedCoulomb(params.friction, v2) * params.wrap_angle_rad;
+
+  // Tension factors at the i ends (eqs. 46-47: T_i = (EA dl / l) phi(a)) and
+  // at the j ends (T_j = T_i e^{-a} = (EA dl / l) phi(-a)).
+  const double phi_1 = CapstanFactor(a1);
+  const double phi_2 = CapstanFactor(a2);
+  const double phi_m1 = CapstanFactor(-a1);
+  const double phi_m2 = CapstanFactor(-a2);
+
+  const double tp_r = params.pretension_n * params.pulley_radius_m;
+  const double k0 =
+      HalfCoupleStiffness(params.axial_stiffness_n, params.pulley_radius_m, params.cable_length_m);
+  out.friction_i = tp_r * (phi_2 - phi_1);    // eq. 50
+  out.stiffness_i = k0 * (phi_2 + phi_1);     // eq. 50
+  out.friction_j = tp_r * (phi_m1 - phi_m2);  // eq. 53
+  out.stiffness_j = k0 * (phi_m1 + phi_m2);   // eq. 53
+
+  const double c = params.damping_nmsprad;
+  out.moments.on_i = out.friction_i + out.stiffness_i * (theta_j - theta_i) +
+                     c * (theta_j_dot - theta_i_dot);  // eq. 51
+  out.moments.on_j = out.friction_j + out.stiffness_j * (theta_i - theta_j) +
+                     c * (theta_i_dot - theta_j_dot);  // eq. 52
+  return out;
+}
+
+}  // namespace ccsrm::sim::internal

@@ -1,0 +1,88 @@
+#pragma once
+// Connecting cables between two adjacent joints i and j = i + 1 of a segment
+// (paper eqs. 38-53). Every function works on one bending axis: theta_i,
+// theta_j are that axis's joint angles [rad] and the caller applies the
+// function to x and to y. Moments are joint-space moments [N m] acting on the
+// joint's own angle, right-hand-side signed (they enter M_joint of eq. 54).
+#include <Eigen/Core>
+
+namespace ccsrm::sim::internal {
+
+// Moments of one connecting mechanism on its two joints.
+struct ConnectingMoments {
+  double on_i = 0.0;  // M_ci [N m]
+  double on_j = 0.0;  // M_cj [N m]
+};
+
+// Small "S" mechanism (eqs. 38-43): a linear torsional spring-damper.
+struct SmallSParams {
+  double axial_stiffness_n = 0.0;  // E_c A_c [N]
+  double pulley_radius_m = 0.0;    // r_sc
+  double cable_length_m = 0.0;     // l_sc
+  double damping_nmsprad = 0.0;    // c_sc [N m s/rad]
+};
+
+// k_sc = 2 E_c A_c r_sc^2 / l_sc (eq. 41) [N m/rad]. Precondition: l_sc > 0.
+double SmallSStiffness(const SmallSParams& params);
+
+// M_i = k_sc (theta_j - theta_i) + c_sc (theta_j_dot - theta_i_dot) (eq. 42),
+// M_j = k_sc (theta_i - theta_j) + c_sc (theta_i_dot - theta_j_dot) (eq. 43).
+ConnectingMoments SmallSMoments(const SmallSParams& params, double theta_i, double theta_j,
+                                double theta_i_dot, double theta_j_dot);
+
+// Modified Coulomb friction law of eq. 45 with SPEC §3 correction (a).
+struct ModifiedCoulombParams {
+  double mu_kinetic = 0.0;     // mu_c
+  double mu_static = 0.0;      // mu'_c
+  double v_static_mps = 0.0;   // v_s > 0
+  double v_dynamic_mps = 0.0;  // v_d > v_s
+};
+
+// mu_m(v) [1], an odd function of v with mu_m(v) v <= 0 (when mu_c, mu'_c >= 0):
+//   |v| > v_d:        -mu_c sgn v
+//   v_s <= |v| <= v_d: -[mu'_c + (mu_c - mu'_c) x^2 (3 - 2x)] sgn v,
+//                      x = (|v| - v_s) / (v_d - v_s)     (corrected, continuous)
+//   |v| < v_s:        mu'_c - 2 mu'_c u^2 (3 - 2u), u = (v + v_s) / (2 v_s)
+//                      (the paper's lower branch: +mu'_c at -v_s, 0 at 0, -mu'_c at v_s).
+// Continuous and C1 at |v| = v_s and |v| = v_d. Preconditions: 0 < v_s < v_d.
+double ModifiedCoulomb(const ModifiedCoulombParams& params, double v);
+
+// phi(x) = x / (1 - e^{-x}) [1], evaluated as -x / expm1(-x) so it is accurate
+// for small |x|; phi(0) = 1 exactly (the frictionless limit of eqs. 46-53).
+// phi(x) e^{-x} = phi(-x) and phi(x) - phi(-x) = x.
+double CapstanFactor(double x);
+
+// Large "S" mechanism (eqs. 44-53).
+struct LargeSParams {
+  double axial_stiffness_n = 0.0;  // E_c A_c [N]
+  double pulley_radius_m = 0.0;    // r_lc
+  double cable_length_m = 0.0;     // l_lc
+  double wrap_angle_rad = 0.0;     // Theta_lc
+  double pretension_n = 0.0;       // T_p
+  double damping_nmsprad = 0.0;    // c_lc [N m s/rad]
+  ModifiedCoulombParams friction;  // mu_c, mu'_c, v_s, v_d
+};
+
+// Moments and the intermediate quantities of eqs. 49-53.
+struct LargeSResult {
+  ConnectingMoments moments;     // M_ci (eq. 51), M_cj (eq. 52)
+  double friction_i = 0.0;       // M_pi (eq. 50) [N m]
+  double friction_j = 0.0;       // M_pj (eq. 53) [N m]
+  double stiffness_i = 0.0;      // k_lci (eq. 50) [N m/rad]
+  double stiffness_j = 0.0;      // k_lcj (eq. 53) [N m/rad]
+  double slip_velocity_1 = 0.0;  // v_tau1 [m/s] (v_tau2 = -v_tau1)
+};
+
+// Evaluates eqs. 45-53 with the sliding speeds
+//   v_tau1 = -r_lc (theta_i_dot + theta_j_dot) / 2,  v_tau2 = -v_tau1.
+// The minus sign (SPEC §3 correction (b) prints +) is the one that makes the
+// friction moments dissipate with eqs. 50 and 53 as written: since
+// phi(x) - phi(-x) = x and mu_m is odd, M_pi = M_pj = -T_p r_lc Theta mu_m(v_tau1),
+// and with v_tau1 = -r (theta_i_dot + theta_j_dot)/2 their power is
+// 2 T_p Theta mu_m(v_tau1) v_tau1 <= 0. With mu_c = mu'_c = 0 the result is
+// the small-S law with k = 2 E_c A_c r_lc^2 / l_lc bitwise.
+// Preconditions: l_lc > 0, 0 < v_s < v_d.
+LargeSResult LargeSMoments(const LargeSParams& params, double theta_i, double theta_j,
+                           double theta_i_dot, double theta_j_dot);
+
+}  // namespace ccsrm::sim::internal

@@ -1,0 +1,41 @@
+#include "hole_friction.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+namespace ccsrm::sim::internal {
+
+double WrapAngle(const Eigen::Vector3d& r_prev, const Eigen::Vector3d& r_i,
+                 const Eigen::Vector3d& r_next) {
+  const Eigen::Vector3d a = r_prev - r_i;
+  const Eigen::Vector3d b = r_next - r_i;
+  // pi - arccos(cos(a, b)) = angle between a and -b (eq. 12). atan2 of the
+  // sine and cosine parts (both scaled by |a||b|) avoids the ill-conditioned
+  // arccos near a straight cable; atan2(0, 0) = 0 for a degenerate side.
+  return std::atan2(a.cross(b).norm(), -a.dot(b));
+}
+
+double LimitingStaticFriction(double tension_1, double tension_2, double mu_static,
+                              double wrap_angle) {
+  const double t_min = std::max(0.0, std::min(tension_1, tension_2));
+  // expm1 keeps f_max accurate for the small wrap angles of a nearly straight cable.
+  return t_min * std::expm1(mu_static * wrap_angle);
+}
+
+double HoleSlipFriction(double tension_before, double mu, double wrap_angle, double s_dot) {
+  if (s_dot == 0.0) return 0.0;
+  const double sigma = s_dot > 0.0 ? 1.0 : -1.0;
+  const double t_b = std::max(0.0, tension_before);
+  // eq. 9 with sgn(v_tau) = -sigma: f_t = T_b (1 - e^{-mu theta sigma});
+  // F = -f_t = T_b expm1(-mu theta sigma), which has the sign of -sigma.
+  return t_b * std::expm1(-mu * wrap_angle * sigma);
+}
+
+double HoleStickFriction(double tension_before, double tension_after, double f_max) {
+  const double diff = tension_before - tension_after;
+  const double magnitude = std::min(std::abs(diff), f_max);
+  return diff > 0.0 ? -magnitude : (diff < 0.0 ? magnitude : 0.0);
+}
+
+}  // namespace ccsrm::sim::internal

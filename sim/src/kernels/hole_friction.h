@@ -1,0 +1,54 @@
+#pragma once
+// Capstan friction between a driving cable and a hole (paper eqs. 8-12).
+//
+// A hole node i is Eulerian (eq. 7): its position is fixed to a disk and only
+// its material coordinate s_i moves. Friction acts on s_i only (eq. 11).
+// Notation for node i: the element "before" is the one that ends at node i
+// (lower s, towards the input), the element "after" starts at node i. Their
+// tensions (eq. 13) are T_b and T_a [N].
+//
+// Sign convention: forces are generalized forces on s_i [N], right-hand-side
+// signed (M q'' = F + ...), i.e. F = -f_t of eq. 9 (the paper's Q_f sits on
+// the left of eq. 5). The cable slides through the hole with tangential
+// velocity v_tau = -s_i_dot (section 2.3), so the slip direction used below is
+// sigma = sgn(s_i_dot) = -sgn(v_tau).
+#include <Eigen/Core>
+
+namespace ccsrm::sim::internal {
+
+// Wrap angle of the cable at node i (eq. 12) [rad], in [0, pi]: 0 for a
+// straight cable, pi for a cable folded back on itself.
+// Evaluated as atan2(|a x b|, -a.b) with a = r_prev - r_i, b = r_next - r_i,
+// which equals pi - arccos(a.b / (|a| |b|)) of eq. 12 but needs no clamping of
+// the cosine and keeps full precision near 0 and pi.
+// Precondition: r_prev != r_i and r_next != r_i (not checked; a zero-length
+// side gives 0).
+double WrapAngle(const Eigen::Vector3d& r_prev, const Eigen::Vector3d& r_i,
+                 const Eigen::Vector3d& r_next);
+
+// Limiting static friction (eq. 10) [N]:
+//   f_max = min(T1, T2) (exp(mu_static * theta) - 1),
+// with both tensions clamped at >= 0 (a slack side holds nothing).
+// Symmetric in T1, T2. Preconditions: mu_static >= 0, theta >= 0.
+double LimitingStaticFriction(double tension_1, double tension_2, double mu_static,
+                              double wrap_angle);
+
+// Kinetic (slipping) friction on s_i (eq. 9, v_tau != 0), right-hand-side
+// signed:
+//   F = -T_b (1 - exp(-mu theta sigma)),  sigma = sgn(s_i_dot),  T_b >= 0 clamped.
+// sigma = +1: cable drawn towards the "before" side, |F| = T_b (1 - e^{-mu theta})
+//   (= T_b - T_a when T_b = T_a e^{mu theta}, the capstan relation);
+// sigma = -1: F = T_b (e^{mu theta} - 1), the capstan value.
+// F * s_i_dot <= 0 always (friction dissipates); F = 0 when s_i_dot == 0.
+// The caller decides stick or slip (velocity tolerance v_eps, trial and
+// error); this function does not look at the magnitude of s_i_dot.
+// Preconditions: mu >= 0, theta >= 0.
+double HoleSlipFriction(double tension_before, double mu, double wrap_angle, double s_dot);
+
+// Static-friction branch of eq. 9 (v_tau = 0) in force form, right-hand-side
+// signed: F = -min(|T_b - T_a|, f_max) sgn(T_b - T_a). The net elastic pull of
+// the two elements on s_i is about T_b - T_a, so a stuck node sees friction
+// that cancels it up to the limit f_max. Precondition: f_max >= 0.
+double HoleStickFriction(double tension_before, double tension_after, double f_max);
+
+}  // namespace ccsrm::sim::internal

@@ -1,0 +1,95 @@
+#include "ccsrm/sim/model.h"
+
+#include <cmath>
+
+namespace ccsrm::sim {
+
+ArmModel::ArmModel(const Config& config) : config_(config) {
+  Validate(config_);
+  const ArmConfig& arm = config_.arm;
+  const double d = arm.joint_disk_gap_m;
+
+  for (std::size_t s = 0; s < arm.segments.size(); ++s) {
+    const SegmentConfig& seg = arm.segments[s];
+    const int first_link = static_cast<int>(links_.size()) + 1;
+    for (int k = 0; k < seg.links; ++k) {
+      LinkModel link;
+      link.segment = static_cast<int>(s);
+      link.length_m = seg.link_length_m;
+      link.mass_kg = seg.link_mass_kg;
+      link.inertia_kgm2 = seg.link_inertia_kgm2;
+      links_.push_back(link);
+    }
+    for (int k = 0; k + 1 < seg.links; ++k) {
+      ConnectingPairModel pair;
+      pair.kind = seg.connecting_pattern[k];
+      pair.joint_i = first_link + k;
+      pair.joint_j = first_link + k + 1;
+      const ConnectingCableConfig& cc = arm.connecting;
+      const double ea = cc.youngs_modulus_pa * cc.cross_section_m2;
+      if (pair.kind == ConnectingKind::kSmallS) {
+        const double r = seg.small_s.pulley_radius_m;
+        pair.stiffness_nmprad = 2.0 * ea * r * r / seg.small_s.cable_length_m;  // eq. 41
+        pair.damping_nmsprad = cc.damping_small_nmsprad;
+        pair.pulley_radius_m = r;
+      } else {
+        const double r = seg.large_s.pulley_radius_m;
+        pair.stiffness_nmprad = ea * r * r / seg.large_s.cable_length_m;  // eq. 50 prefactor
+        pair.damping_nmsprad = cc.damping_large_nmsprad;
+        pair.pulley_radius_m = r;
+        pair.wrap_angle_rad = seg.large_s.wrap_angle_rad;
+      }
+      pairs_.push_back(pair);
+    }
+  }
+
+  for (const DrivingCableRoute& route : arm.driving.cables) {
+    DrivingCableModel cable;
+    cable.segment = route.segment - 1;
+    cable.radius_m = arm.segments[cable.segment].hole_circle_radius_m;
+    cable.angle_rad = route.hole_angle_rad;
+    const double x = cable.radius_m * std::cos(cable.angle_rad);
+    const double y = cable.radius_m * std::sin(cable.angle_rad);
+    const double ground_z = -0.5 * d;
+    cable.nodes.push_back({CableNodeModel::Kind::kInput, 0,
+                           Eigen::Vector3d(x, y, ground_z - arm.driving.input_offset_m)});
+    cable.nodes.push_back({CableNodeModel::Kind::kHole, 0, Eigen::Vector3d(x, y, ground_z)});
+    int last_link = 0;
+    for (int s = 0; s <= cable.segment; ++s) last_link += arm.segments[s].links;
+    for (int i = 1; i <= last_link; ++i) {
+      const double half = 0.5 * links_[i - 1].length_m;
+      cable.nodes.push_back(
+          {CableNodeModel::Kind::kHole, i, Eigen::Vector3d(x, y, -half + 0.5 * d)});
+      const auto distal_kind =
+          i == last_link ? CableNodeModel::Kind::kAnchor : CableNodeModel::Kind::kHole;
+      cable.nodes.push_back({distal_kind, i, Eigen::Vector3d(x, y, half - 0.5 * d)});
+    }
+    cables_.push_back(cable);
+  }
+
+  int offset = 0;
+  for (const auto& cable : cables_) {
+    std::vector<int> offsets;
+    for (std::size_t n = 0; n < cable.nodes.size(); ++n) {
+      offsets.push_back(offset);
+      offset += 4;
+    }
+    node_offsets_.push_back(offsets);
+  }
+  for (std::size_t i = 0; i < links_.size(); ++i) {
+    link_offsets_.push_back(offset);
+    offset += 7;
+  }
+  num_coordinates_ = offset;
+}
+
+Eigen::Vector3d ArmModel::p_parent_joint(int joint) const {
+  if (joint == 1) return Eigen::Vector3d::Zero();
+  return Eigen::Vector3d(0, 0, 0.5 * link(joint - 1).length_m);
+}
+
+Eigen::Vector3d ArmModel::p_child_joint(int joint) const {
+  return Eigen::Vector3d(0, 0, -0.5 * link(joint).length_m);
+}
+
+}  // namespace ccsrm::sim

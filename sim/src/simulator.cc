@@ -1,0 +1,390 @@
+#include "ccsrm/sim/simulator.h"
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+#include "ccsrm/common/error.h"
+#include "dynamics.h"
+
+namespace ccsrm::sim {
+namespace {
+
+using internal::ArmDynamics;
+using internal::HoleMode;
+using internal::HoleReport;
+using internal::Observation;
+using Clock = std::chrono::steady_clock;
+
+int RightHandSide(double t, const double y[], double dydt[], void* params) {
+  auto* dynamics = static_cast<ArmDynamics*>(params);
+  // GSL_FAILURE (not GSL_EBADFUNC) lets evolve retry with a smaller step: a
+  // trial step that went too far can collapse an element.
+  return dynamics->Evaluate(t, y, dydt) ? GSL_SUCCESS : GSL_FAILURE;
+}
+
+// Owns the GSL objects of one run.
+struct GslIntegrator {
+  gsl_odeiv2_step* step = nullptr;
+  gsl_odeiv2_control* control = nullptr;
+  gsl_odeiv2_evolve* evolve = nullptr;
+  GslIntegrator(std::size_t dim, double atol, double rtol) {
+    step = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rkf45, dim);
+    control = gsl_odeiv2_control_standard_new(atol, rtol, 1.0, 0.0);
+    evolve = gsl_odeiv2_evolve_alloc(dim);
+  }
+  ~GslIntegrator() {
+    gsl_odeiv2_evolve_free(evolve);
+    gsl_odeiv2_control_free(control);
+    gsl_odeiv2_step_free(step);
+  }
+  void Reset() {
+    gsl_odeiv2_step_reset(step);
+    gsl_odeiv2_evolve_reset(evolve);
+  }
+};
+
+// Stick-slip switching of the hole nodes at (t, y) (paper section 2.3,
+// trial and error). A stuck node slips once the friction its constraint needs
+// exceeds f_max (eq. 10); a slipping node sticks once its slip reverses past
+// v_eps. Both are located in time. Where even the static limit f_max is below
+// the force tolerance (a nearly straight cable) friction is negligible: such a
+// node never sticks and a reversal just flips its slip direction, so that the
+// straight arm at t = 0 does not chatter.
+class SwitchDetector {
+ public:
+  SwitchDetector(const ArmModel& model, ArmDynamics* dynamics, const SolverConfig& solver)
+      : model_(model), dynamics_(dynamics), solver_(solver), scratch_(dynamics->state_size()) {}
+
+  struct Switches {
+    std::vector<int> located;  // must be located in time, then switched
+    std::vector<int> flips;    // negligible friction: flip the slip direction at once
+    bool any() const { return !located.empty() || !flips.empty(); }
+  };
+
+  // Returns false if the evaluation at (t, y) failed.
+  bool Scan(double t, const double* y, Switches* out) {
+    out->located.clear();
+    out->flips.clear();
+    if (!dynamics_->has_stick_slip()) return true;
+    if (!dynamics_->Evaluate(t, y, scratch_.data())) return false;
+    const auto& modes = dynamics_->hole_modes();
+    const auto& reports = dynamics_->hole_reports();
+    const double f_tol = solver_.stick_force_tolerance_n;
+    for (std::size_t h = 0; h < modes.size(); ++h) {
+      const HoleReport& r = reports[h];
+      if (modes[h] == HoleMode::kStuck) {
+        if (std::abs(r.required_friction) > r.friction_limit + f_tol)
+          out->located.push_back(static_cast<int>(h));
+      } else {
+        const double sigma = modes[h] == HoleMode::kSlipUp ? 1.0 : -1.0;
+        if (sigma * r.s_dot < -solver_.stick_velocity_tolerance_mps) {
+          (r.friction_limit > f_tol ? out->located : out->flips).push_back(static_cast<int>(h));
+        }
+      }
+    }
+    return true;
+  }
+
+  // Applies the switches found by the last Scan at y.
+  std::int64_t Apply(const double* y, const Switches& switches) {
+    auto& modes = dynamics_->hole_modes();
+    const auto& reports = dynamics_->hole_reports();
+    for (int h : switches.flips) {
+      modes[h] = modes[h] == HoleMode::kSlipUp ? HoleMode::kSlipDown : HoleMode::kSlipUp;
+    }
+    for (int h : switches.located) {
+      if (modes[h] == HoleMode::kStuck) {
+        // The node moves against the friction its constraint was applying.
+        modes[h] = reports[h].required_friction > 0.0 ? HoleMode::kSlipDown : HoleMode::kSlipUp;
+      } else {
+        const auto& hole = dynamics_->holes()[h];
+        modes[h] = HoleMode::kStuck;
+        dynamics_->stuck_position()[h] = y[model_.node_offset(hole.cable, hole.node) + 3];
+      }
+    }
+    return static_cast<std::int64_t>(switches.located.size() + switches.flips.size());
+  }
+
+ private:
+  const ArmModel& model_;
+  ArmDynamics* dynamics_;
+  const SolverConfig& solver_;
+  std::vector<double> scratch_;
+};
+
+void AppendFrame(const Observation& o, double t, std::vector<double>* time,
+                 std::vector<Observation>* frames) {
+  time->push_back(t);
+  frames->push_back(o);
+}
+
+datasets::RunFile BuildRunFile(const ArmModel& model, const std::vector<double>& time,
+                               const std::vector<Observation>& frames) {
+  using datasets::Array;
+  datasets::RunFile run;
+  const std::size_t T = time.size();
+  const std::size_t J = model.num_joints(), L = model.num_links(), C = model.num_cables();
+  run.time = Array({T});
+  run.joint_angles = Array({T, J, 2});
+  run.joint_rates = Array({T, J, 2});
+  run.link_pose = Array({T, L, 7});
+  run.input_tension = Array({T, C});
+  run.input_length_change = Array({T, C});
+  run.stuck_nodes = Array({T, C});
+  run.constraint_violation = Array({T});
+  run.energy = Array({T, 3});
+  run.cables.resize(C);
+  for (std::size_t c = 0; c < C; ++c) {
+    const std::size_t elements = model.cables()[c].num_elements();
+    const std::size_t holes = model.cables()[c].num_holes();
+    run.cables[c].tension = Array({T, elements});
+    run.cables[c].stuck = Array({T, holes});
+    run.cables[c].slip_velocity = Array({T, holes});
+  }
+  for (std::size_t f = 0; f < T; ++f) {
+    const Observation& o = frames[f];
+    run.time.at(f) = time[f];
+    for (std::size_t j = 0; j < J; ++j) {
+      for (int a = 0; a < 2; ++a) {
+        run.joint_angles.at(f, j, a) = o.joint_angles[j][a];
+        run.joint_rates.at(f, j, a) = o.joint_rates[j][a];
+      }
+    }
+    for (std::size_t i = 0; i < L; ++i)
+      for (int k = 0; k < 7; ++k) run.link_pose.at(f, i, k) = o.link_pose[i][k];
+    for (std::size_t c = 0; c < C; ++c) {
+      run.input_tension.at(f, c) = o.element_tension[c][0];
+      run.input_length_change.at(f, c) = o.input_length_change[c];
+      int stuck = 0;
+      for (std::size_t e = 0; e < o.element_tension[c].size(); ++e) {
+        run.cables[c].tension.at(f, e) = o.element_tension[c][e];
+      }
+      for (std::size_t h = 0; h < o.hole_stuck[c].size(); ++h) {
+        run.cables[c].stuck.at(f, h) = o.hole_stuck[c][h];
+        run.cables[c].slip_velocity.at(f, h) = o.hole_slip_velocity[c][h];
+        stuck += o.hole_stuck[c][h];
+      }
+      run.stuck_nodes.at(f, c) = stuck;
+    }
+    run.constraint_violation.at(f) = o.constraint_violation;
+    run.energy.at(f, 0) = o.kinetic_energy;
+    run.energy.at(f, 1) = o.elastic_energy;
+    run.energy.at(f, 2) = o.dissipated_energy;
+  }
+  return run;
+}
+
+std::string FormatTime(double t) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.6g s", t);
+  return text;
+}
+
+}  // namespace
+
+bool SimulationOptions::IsValid(std::string* error) const {
+  if (!(duration_s > 0.0) || !std::isfinite(duration_s)) {
+    *error = "duration must be > 0 s";
+    return false;
+  }
+  if (!(progress_interval_s > 0.0)) {
+    *error = "progress interval must be > 0 s";
+    return false;
+  }
+  return true;
+}
+
+std::string SimulationSummary::BriefReport() const {
+  char text[256];
+  std::snprintf(text, sizeof(text), "%s at t = %.4g s: %.3g s wall, %.3gx real time, %lld steps",
+                completed ? "completed" : "diverged", simulated_s, wall_time_s, real_time_factor,
+                static_cast<long long>(steps));
+  return text;
+}
+
+std::string SimulationSummary::FullReport() const {
+  std::ostringstream out;
+  out << "simulation " << (completed ? "completed" : "DIVERGED") << "\n";
+  if (!completed) out << "  cause:                     " << message << "\n";
+  char line[160];
+  std::snprintf(line, sizeof(line), "  simulated time:            %.6g s\n", simulated_s);
+  out << line;
+  std::snprintf(line, sizeof(line), "  wall time:                 %.3f s\n", wall_time_s);
+  out << line;
+  std::snprintf(line, sizeof(line), "  real-time factor:          %.3f (simulated s per wall s)\n",
+                real_time_factor);
+  out << line;
+  std::snprintf(line, sizeof(line), "  steps:                     %lld accepted, %lld rejected\n",
+                static_cast<long long>(steps), static_cast<long long>(rejected_steps));
+  out << line;
+  std::snprintf(line, sizeof(line), "  right-hand-side evals:     %lld (%.0f per wall s)\n",
+                static_cast<long long>(rhs_evaluations),
+                wall_time_s > 0 ? rhs_evaluations / wall_time_s : 0.0);
+  out << line;
+  std::snprintf(line, sizeof(line), "  stick-slip switches:       %lld\n",
+                static_cast<long long>(stick_slip_switches));
+  out << line;
+  std::snprintf(line, sizeof(line), "  max constraint violation:  %.3g\n",
+                max_constraint_violation);
+  out << line;
+  return out.str();
+}
+
+SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
+                          const SimulationOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) ThrowInputError("simulation options", "", error);
+  if (inputs.num_cables() != model.num_cables()) {
+    ThrowInputError("cable inputs", "",
+                    "has " + std::to_string(inputs.num_cables()) + " cables, the model has " +
+                        std::to_string(model.num_cables()));
+  }
+  gsl_set_error_handler_off();
+  const SolverConfig& solver = model.config().solver;
+  const auto wall_start = Clock::now();
+  auto wall_seconds = [&] {
+    return std::chrono::duration<double>(Clock::now() - wall_start).count();
+  };
+
+  ArmDynamics dynamics(model, inputs);
+  const std::size_t dim = dynamics.state_size();
+  Eigen::VectorXd y = dynamics.InitialState();
+  std::vector<double> y_saved(dim), y_mid(dim), y_err(dim);
+  gsl_odeiv2_system system{RightHandSide, nullptr, dim, &dynamics};
+  GslIntegrator gsl(dim, solver.absolute_tolerance, solver.relative_tolerance);
+  SwitchDetector switches(model, &dynamics, solver);
+
+  SimulationSummary summary;
+  std::vector<double> time;
+  std::vector<Observation> frames;
+  Observation observation;
+  double t = 0.0;
+  double h = solver.initial_step_s;
+  const double dt_out = 1.0 / solver.output_rate_hz;
+  const long frames_total = static_cast<long>(std::floor(options.duration_s / dt_out + 1e-9)) + 1;
+  double next_progress = options.progress_interval_s;
+  SwitchDetector::Switches found;
+
+  auto diverge = [&](const std::string& cause) {
+    summary.completed = false;
+    summary.message = cause + " at t = " + FormatTime(t);
+  };
+
+  // Consistent initial modes: nothing may need to switch at t = 0.
+  for (int pass = 0; pass < 8 && switches.Scan(t, y.data(), &found) && found.any(); ++pass) {
+    summary.stick_slip_switches += switches.Apply(y.data(), found);
+  }
+  dynamics.Observe(t, y.data(), &observation);
+  AppendFrame(observation, t, &time, &frames);
+  summary.max_constraint_violation = observation.constraint_violation;
+  summary.completed = true;
+
+  for (long frame = 1; frame < frames_total && summary.completed; ++frame) {
+    const double t_out = std::min(options.duration_s, frame * dt_out);
+    while (t < t_out && summary.completed) {
+      const double t0 = t;
+      std::copy(y.data(), y.data() + dim, y_saved.begin());
+      h = std::min(h, solver.max_step_s);
+      const int status = gsl_odeiv2_evolve_apply(gsl.evolve, gsl.control, gsl.step, &system, &t,
+                                                 t_out, &h, y.data());
+      if (status != GSL_SUCCESS) {
+        diverge(dynamics.failure().empty() ? "integrator failure" : dynamics.failure());
+        break;
+      }
+      ++summary.steps;
+      if (h < solver.min_step_s) {
+        diverge("step size collapsed to " + FormatTime(h));
+        break;
+      }
+      if (!switches.Scan(t, y.data(), &found)) {
+        diverge(dynamics.failure());
+        break;
+      }
+      if (found.located.empty()) {
+        summary.stick_slip_switches += switches.Apply(y.data(), found);
+        continue;
+      }
+      // A switch happened inside [t0, t]: bisect to locate it within
+      // switch_time_tolerance_s, restarting single steps from the last
+      // point known to need no switch.
+      double ta = t0, tb = t;
+      std::vector<double> ya(y_saved), yb(y.data(), y.data() + dim);
+      while (tb - ta > solver.switch_time_tolerance_s) {
+        const double tm = 0.5 * (ta + tb);
+        y_mid = ya;
+        gsl_odeiv2_step_reset(gsl.step);
+        if (gsl_odeiv2_step_apply(gsl.step, ta, tm - ta, y_mid.data(), y_err.data(), nullptr,
+                                  nullptr, &system) != GSL_SUCCESS) {
+          break;
+        }
+        if (switches.Scan(tm, y_mid.data(), &found) && !found.located.empty()) {
+          tb = tm;
+          yb = y_mid;
+        } else {
+          ta = tm;
+          ya = y_mid;
+        }
+      }
+      t = tb;
+      std::copy(yb.begin(), yb.end(), y.data());
+      // Switch, then re-check: a node that has just stuck may at once need
+      // more friction than it can hold (a reversal), and so on.
+      for (int pass = 0; pass < 8 && switches.Scan(t, y.data(), &found) && found.any(); ++pass) {
+        summary.stick_slip_switches += switches.Apply(y.data(), found);
+      }
+      gsl.Reset();
+    }
+    if (!summary.completed) break;
+    if (!y.allFinite()) {
+      diverge("non-finite state");
+      break;
+    }
+    dynamics.Observe(t, y.data(), &observation);
+    summary.max_constraint_violation =
+        std::max(summary.max_constraint_violation, observation.constraint_violation);
+    if (observation.constraint_violation > solver.max_constraint_violation) {
+      char text[128];
+      std::snprintf(text, sizeof(text), "constraint violation %.3g above bound %.3g",
+                    observation.constraint_violation, solver.max_constraint_violation);
+      diverge(text);
+      AppendFrame(observation, t, &time, &frames);
+      break;
+    }
+    AppendFrame(observation, t, &time, &frames);
+    if (options.progress && wall_seconds() >= next_progress) {
+      next_progress = wall_seconds() + options.progress_interval_s;
+      SimulationProgress p{t, options.duration_s, wall_seconds(),
+                           t / std::max(1e-9, wall_seconds())};
+      options.progress(p);
+    }
+  }
+  if (summary.completed) summary.message = "completed";
+
+  summary.simulated_s = t;
+  summary.wall_time_s = wall_seconds();
+  summary.real_time_factor = summary.wall_time_s > 0 ? t / summary.wall_time_s : 0.0;
+  summary.rejected_steps = static_cast<std::int64_t>(gsl.evolve->failed_steps);
+  summary.rhs_evaluations = dynamics.evaluations();
+
+  SimulationResult result;
+  result.run = BuildRunFile(model, time, frames);
+  result.run.case_name = options.case_name;
+  result.run.config_yaml = ToYaml(model.config());
+  result.run.wall_time_s = summary.wall_time_s;
+  result.run.steps = summary.steps;
+  result.run.rejected_steps = summary.rejected_steps;
+  result.run.rhs_evaluations = summary.rhs_evaluations;
+  result.run.status =
+      summary.completed ? datasets::RunStatus::kCompleted : datasets::RunStatus::kDiverged;
+  result.run.status_message = summary.message;
+  result.summary = summary;
+  return result;
+}
+
+}  // namespace ccsrm::sim

@@ -1,0 +1,155 @@
+// Tests of the connecting-cable mechanisms (eqs. 38-53).
+#include "kernels/connecting.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace ccsrm::sim::internal {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kEcAc = 2.6e10 * 1.3273e-6;  // Table 1 [N]
+
+ModifiedCoulombParams Table1Friction() {
+  ModifiedCoulombParams f;
+  f.mu_kinetic = 0.21;
+  f.mu_static = 0.21;
+  f.v_static_mps = 1e-4;
+  f.v_dynamic_mps = 2e-4;
+  return f;
+}
+
+// Segment 1 large S of Table 1.
+LargeSParams Table1LargeS() {
+  LargeSParams p;
+  p.axial_stiffness_n = kEcAc;
+  p.pulley_radius_m = 0.016;
+  p.cable_length_m = 0.109;
+  p.wrap_angle_rad = 184.0 * kPi / 180.0;
+  p.pretension_n = 50.0;
+  p.damping_nmsprad = 0.05;
+  p.friction = Table1Friction();
+  return p;
+}
+
+TEST(ConnectingCables, SmallSIsTorsionalSpringDamper) {
+  SmallSParams p;
+  p.axial_stiffness_n = kEcAc;
+  p.pulley_radius_m = 0.006;
+  p.cable_length_m = 0.084;
+  p.damping_nmsprad = 0.05;
+  const double k = SmallSStiffness(p);
+  EXPECT_NEAR(k, 2.0 * kEcAc * 0.006 * 0.006 / 0.084, 1e-12 * k);
+  const ConnectingMoments m = SmallSMoments(p, 0.1, 0.08, 0.3, -0.2);
+  EXPECT_NEAR(m.on_i, k * (0.08 - 0.1) + 0.05 * (-0.2 - 0.3), 1e-12);
+  EXPECT_EQ(m.on_i, -m.on_j);
+}
+
+TEST(ConnectingCables, FrictionlessLargeSIsSmallSBitwise) {
+  LargeSParams large = Table1LargeS();
+  large.friction.mu_kinetic = 0.0;
+  large.friction.mu_static = 0.0;
+  SmallSParams small;
+  small.axial_stiffness_n = large.axial_stiffness_n;
+  small.pulley_radius_m = large.pulley_radius_m;
+  small.cable_length_m = large.cable_length_m;
+  small.damping_nmsprad = large.damping_nmsprad;
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(-0.2, 0.2);
+  for (int trial = 0; trial < 100; ++trial) {
+    const double ti = u(rng), tj = u(rng), wi = u(rng), wj = u(rng);
+    const LargeSResult l = LargeSMoments(large, ti, tj, wi, wj);
+    const ConnectingMoments s = SmallSMoments(small, ti, tj, wi, wj);
+    EXPECT_EQ(l.friction_i, 0.0);
+    EXPECT_EQ(l.friction_j, 0.0);
+    EXPECT_EQ(l.stiffness_i, SmallSStiffness(small));
+    EXPECT_EQ(l.stiffness_j, SmallSStiffness(small));
+    EXPECT_EQ(l.moments.on_i, s.on_i);
+    EXPECT_EQ(l.moments.on_j, s.on_j);
+  }
+}
+
+TEST(ConnectingCables, ModifiedCoulombIsContinuousAndOdd) {
+  ModifiedCoulombParams f = Table1Friction();
+  f.mu_static = 0.3;  // distinct static and kinetic values exercise correction (a)
+  const double eps = 1e-12;
+  for (double v : {f.v_static_mps, f.v_dynamic_mps, -f.v_static_mps, -f.v_dynamic_mps, 0.0}) {
+    const double lo = ModifiedCoulomb(f, v - eps * 1e-4);
+    const double hi = ModifiedCoulomb(f, v + eps * 1e-4);
+    EXPECT_NEAR(lo, hi, 1e-10) << "v " << v;
+  }
+  EXPECT_EQ(ModifiedCoulomb(f, 0.0), 0.0);
+  EXPECT_NEAR(ModifiedCoulomb(f, f.v_static_mps), -f.mu_static, 1e-15);
+  EXPECT_NEAR(ModifiedCoulomb(f, -f.v_static_mps), f.mu_static, 1e-15);
+  EXPECT_NEAR(ModifiedCoulomb(f, f.v_dynamic_mps), -f.mu_kinetic, 1e-15);
+  EXPECT_EQ(ModifiedCoulomb(f, 1.0), -f.mu_kinetic);
+  std::mt19937 rng(32);
+  std::uniform_real_distribution<double> u(-3e-4, 3e-4);
+  for (int trial = 0; trial < 1000; ++trial) {
+    const double v = u(rng);
+    EXPECT_NEAR(ModifiedCoulomb(f, -v), -ModifiedCoulomb(f, v), 1e-15);
+    EXPECT_LE(ModifiedCoulomb(f, v) * v, 0.0);
+  }
+}
+
+TEST(ConnectingCables, ModifiedCoulombMiddleBranchIsThePapersWhenCoefficientsAgree) {
+  const ModifiedCoulombParams f = Table1Friction();  // mu_c = mu'_c
+  for (double v = f.v_static_mps; v <= f.v_dynamic_mps; v += 1e-6) {
+    const double x = (v - f.v_static_mps) / (f.v_dynamic_mps - f.v_static_mps);
+    const double paper = -(f.mu_kinetic + (f.mu_static - f.mu_kinetic) * x * x * (3 - 2 * x));
+    EXPECT_NEAR(ModifiedCoulomb(f, v), paper, 1e-15);
+  }
+}
+
+TEST(ConnectingCables, CapstanFactorIsAccurateNearZero) {
+  EXPECT_EQ(CapstanFactor(0.0), 1.0);
+  for (double mag = 1e-12; mag <= 1e-3; mag *= 10.0) {
+    for (double x : {mag, -mag}) {
+      const double series = 1.0 + x / 2.0 + x * x / 12.0 - x * x * x * x / 720.0;
+      EXPECT_NEAR(CapstanFactor(x), series, 4e-16) << "x " << x;
+    }
+  }
+  for (double x : {-3.0, -0.7, 0.2, 0.6, 2.5}) {
+    EXPECT_NEAR(CapstanFactor(x) * std::exp(-x), CapstanFactor(-x), 1e-15);
+    EXPECT_NEAR(CapstanFactor(x) - CapstanFactor(-x), x, 1e-15);
+    EXPECT_NEAR(CapstanFactor(x), x / (1.0 - std::exp(-x)), 1e-15);
+  }
+}
+
+TEST(ConnectingCables, LargeSFrictionMomentsDissipate) {
+  LargeSParams p = Table1LargeS();
+  p.friction.mu_static = 0.3;
+  std::mt19937 rng(33);
+  std::uniform_real_distribution<double> rate(-0.05, 0.05), angle(-0.1, 0.1);
+  for (int trial = 0; trial < 10000; ++trial) {
+    // Rates both small (inside the v_s band) and large.
+    const double scale = (trial % 2 == 0) ? 1.0 : 1e-3;
+    const double wi = scale * rate(rng), wj = scale * rate(rng);
+    const LargeSResult r = LargeSMoments(p, angle(rng), angle(rng), wi, wj);
+    EXPECT_LE(r.friction_i * wi + r.friction_j * wj, 0.0);
+    // The friction moments oppose the pair's common rotation.
+    EXPECT_LE(r.friction_i * (wi + wj), 0.0);
+    EXPECT_NEAR(r.friction_i, r.friction_j, 1e-12);
+    EXPECT_NEAR(r.stiffness_i, r.stiffness_j, 1e-9 * r.stiffness_i);
+  }
+}
+
+TEST(ConnectingCables, LargeSSlidingMomentHasTable1Scale) {
+  const LargeSParams p = Table1LargeS();
+  // Both joints rotating at 0.05 rad/s: |v_tau| = 8e-4 m/s > v_d, sliding.
+  const LargeSResult r = LargeSMoments(p, 0.0, 0.0, 0.05, 0.05);
+  const double expected = p.pretension_n * p.pulley_radius_m * 0.21 * p.wrap_angle_rad;
+  EXPECT_NEAR(std::abs(r.friction_i), expected, 1e-12);
+  EXPECT_NEAR(std::abs(r.friction_i), 0.54, 0.005);
+  EXPECT_LT(r.friction_i, 0.0);
+  EXPECT_NEAR(r.slip_velocity_1, -8e-4, 1e-15);
+  // Friction also stiffens the couple: k = (EA r^2 / l) a coth(a / 2) > 2 EA r^2 / l.
+  const double a = 0.21 * p.wrap_angle_rad;
+  const double k0 = kEcAc * 0.016 * 0.016 / 0.109;
+  EXPECT_NEAR(r.stiffness_i, k0 * a / std::tanh(a / 2.0), 1e-9 * r.stiffness_i);
+}
+
+}  // namespace
+}  // namespace ccsrm::sim::internal

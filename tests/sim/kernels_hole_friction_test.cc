@@ -1,0 +1,85 @@
+// Tests of cable-hole capstan friction (eqs. 9-12).
+#include "kernels/hole_friction.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+namespace ccsrm::sim::internal {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+TEST(HoleFriction, WrapAngleOfStraightRightAngleAndFoldedCable) {
+  const Eigen::Vector3d node(0.1, 0.2, 0.3);
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
+  EXPECT_EQ(WrapAngle(node - 0.5 * x, node, node + 2.0 * x), 0.0);
+  EXPECT_NEAR(WrapAngle(node - x, node, node + y), kPi / 2, 1e-15);
+  EXPECT_NEAR(WrapAngle(node + x, node, node + 3.0 * x), kPi, 1e-15);
+  // Nearly straight: full precision where eq. 12's arccos returns exactly 0.
+  const Eigen::Vector3d o = Eigen::Vector3d::Zero();
+  EXPECT_NEAR(WrapAngle(o - x, o, o + x + 1e-9 * y), 1e-9, 1e-22);
+}
+
+TEST(HoleFriction, WrapAngleEqualsEq12) {
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 1000; ++trial) {
+    const Eigen::Vector3d a(u(rng), u(rng), u(rng)), b(u(rng), u(rng), u(rng)),
+        c(u(rng), u(rng), u(rng));
+    const Eigen::Vector3d da = a - b, dc = c - b;
+    const double cosine = std::clamp(da.dot(dc) / (da.norm() * dc.norm()), -1.0, 1.0);
+    EXPECT_NEAR(WrapAngle(a, b, c), kPi - std::acos(cosine), 1e-12);
+  }
+}
+
+TEST(HoleFriction, LimitingStaticFrictionIsSymmetricAndVanishesWithoutFriction) {
+  std::mt19937 rng(22);
+  std::uniform_real_distribution<double> t(-20.0, 200.0), th(0.0, 1.0), mu(0.0, 0.5);
+  for (int trial = 0; trial < 1000; ++trial) {
+    const double t1 = t(rng), t2 = t(rng), theta = th(rng), m = mu(rng);
+    const double f = LimitingStaticFriction(t1, t2, m, theta);
+    EXPECT_EQ(f, LimitingStaticFriction(t2, t1, m, theta));
+    EXPECT_EQ(LimitingStaticFriction(t1, t2, 0.0, theta), 0.0);
+    EXPECT_GE(f, 0.0);
+    EXPECT_NEAR(f, std::max(0.0, std::min(t1, t2)) * (std::exp(m * theta) - 1.0), 1e-12);
+  }
+}
+
+TEST(HoleFriction, SlipFrictionAlwaysDissipates) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> t(-20.0, 200.0), th(0.0, kPi), mu(0.0, 0.5), v(-1.0, 1.0);
+  for (int trial = 0; trial < 10000; ++trial) {
+    const double s_dot = v(rng);
+    const double f = HoleSlipFriction(t(rng), mu(rng), th(rng), s_dot);
+    EXPECT_LE(f * s_dot, 0.0);
+  }
+  EXPECT_EQ(HoleSlipFriction(100.0, 0.21, 1.0, 0.0), 0.0);
+}
+
+TEST(HoleFriction, SlipFrictionIsTheCapstanValue) {
+  const double mu = 0.21, theta = 0.4, t_b = 80.0;
+  // Cable drawn towards the "after" side (s_dot < 0): the before side is the
+  // slack side and friction is T_b (e^{mu theta} - 1).
+  EXPECT_NEAR(HoleSlipFriction(t_b, mu, theta, -1e-3), t_b * (std::exp(mu * theta) - 1.0), 1e-12);
+  // Drawn towards the "before" side (s_dot > 0) with T_b = T_a e^{mu theta}:
+  // friction balances the tension difference.
+  const double t_a = t_b * std::exp(-mu * theta);
+  EXPECT_NEAR(HoleSlipFriction(t_b, mu, theta, 1e-3), -(t_b - t_a), 1e-12);
+  // A slack before side carries nothing.
+  EXPECT_EQ(HoleSlipFriction(-5.0, mu, theta, 1e-3), 0.0);
+}
+
+TEST(HoleFriction, StickFrictionCancelsTensionDifferenceUpToLimit) {
+  const double f_max = LimitingStaticFriction(100.0, 90.0, 0.21, 0.4);
+  EXPECT_NEAR(HoleStickFriction(100.0, 98.0, f_max), -2.0, 1e-12);
+  EXPECT_NEAR(HoleStickFriction(98.0, 100.0, f_max), 2.0, 1e-12);
+  EXPECT_NEAR(HoleStickFriction(200.0, 90.0, f_max), -f_max, 1e-12);
+  EXPECT_EQ(HoleStickFriction(50.0, 50.0, f_max), 0.0);
+}
+
+}  // namespace
+}  // namespace ccsrm::sim::internal
