@@ -1,0 +1,57 @@
+// ccsrm config check FILE
+#include <cstdio>
+#include <string>
+
+#include "ccsrm/sim/config.h"
+#include "commands.h"
+
+namespace ccsrm::app {
+namespace {
+
+void RunConfigCheck(const std::string& path) {
+  const sim::Config c = sim::LoadConfig(path);
+  int holes = 0;
+  for (const auto& cable : c.arm.driving.cables) {
+    // Ground disk, then a proximal and a distal disk on every link up to the
+    // segment's last link, whose distal disk holds the anchor.
+    int links = 0;
+    for (int s = 0; s < cable.segment; ++s) links += c.arm.segments[s].links;
+    holes += 2 * links;
+  }
+  std::printf("%s: ok\n", path.c_str());
+  std::printf("  segments: %zu, links: %d, universal joints: %d\n", c.arm.segments.size(),
+              c.arm.total_links(), c.arm.total_links());
+  for (const auto& s : c.arm.segments) {
+    std::string pattern;
+    for (auto k : s.connecting_pattern) {
+      pattern += pattern.empty() ? "" : "-";
+      pattern += k == sim::ConnectingKind::kSmallS ? "small" : "large";
+    }
+    std::printf("  %s: %d links of %.4g m, %.4g kg, holes at r = %.4g m, pattern %s\n",
+                s.name.c_str(), s.links, s.link_length_m, s.link_mass_kg, s.hole_circle_radius_m,
+                pattern.c_str());
+  }
+  std::printf("  driving cables: %zu (%d hole nodes), pre-tension %.4g N, mu %.3g / mu' %.3g\n",
+              c.arm.driving.cables.size(), holes, c.arm.driving.pretension_n,
+              c.arm.driving.friction_kinetic, c.arm.driving.friction_static);
+  std::printf("  connecting cables: T_p %.4g N, mu_c %.3g / mu'_c %.3g\n",
+              c.arm.connecting.pretension_n, c.arm.connecting.friction_kinetic,
+              c.arm.connecting.friction_static);
+  std::printf("  protocol: amplitude %.4g deg over %.4g s; solver: h = %.4g s, output %.4g Hz\n",
+              c.protocol.amplitude_rad * 180.0 / 3.14159265358979323846, c.protocol.duration_s(),
+              c.solver.smoothing_step_s, c.solver.output_rate_hz);
+}
+
+}  // namespace
+
+void AddConfigCommands(CLI::App& root) {
+  CLI::App* config = root.add_subcommand("config", "Check arm configuration files");
+  config->require_subcommand(1);
+  CLI::App* check = config->add_subcommand(
+      "check", "Parse and validate a YAML configuration; print what it describes");
+  auto path = std::make_shared<std::string>();
+  check->add_option("FILE", *path, "Configuration file (YAML)")->required();
+  check->callback([path] { RunConfigCheck(*path); });
+}
+
+}  // namespace ccsrm::app

@@ -1,0 +1,11 @@
+#pragma once
+// Each group of subcommands registers itself on the root CLI11 app. A
+// command's callback throws ccsrm::InputError for bad input; main() prints
+// the message as one line on stderr and exits with status 2.
+#include <CLI/CLI.hpp>
+
+namespace ccsrm::app {
+void AddConfigCommands(CLI::App& root);
+void AddDatasetCommands(CLI::App& root);
+void AddSimulateCommand(CLI::App& root);
+}  // namespace ccsrm::app
