@@ -1,0 +1,59 @@
+#pragma once
+// Helpers shared by the mocap tests: paths of the vendor files in
+// ../shared/data/mocap (used in place, never copied) and scratch directories.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "ccsrm/common/error.h"
+
+namespace ccsrm::mocap::testing {
+
+inline std::string SharedMocapFile(const std::string& relative) {
+  return std::string(CCSRM_SHARED_DIR) + "/data/mocap/" + relative;
+}
+
+inline std::string C3dFile(const std::string& name) { return SharedMocapFile("c3d/" + name); }
+
+inline std::vector<std::uint8_t> ReadBytes(const std::string& path) {
+  std::ifstream stream(path, std::ios::binary);
+  EXPECT_TRUE(stream.good()) << "cannot open " << path;
+  return std::vector<std::uint8_t>((std::istreambuf_iterator<char>(stream)),
+                                   std::istreambuf_iterator<char>());
+}
+
+inline std::filesystem::path FreshTempDir(const std::string& name) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("ccsrm_mocap_test_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+inline void WriteFile(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream stream(path, std::ios::binary);
+  stream << text;
+}
+
+// Runs `read` and returns the InputError message ("" and a test failure when
+// nothing or something else is thrown).
+template <typename Read>
+std::string InputErrorOf(Read read) {
+  try {
+    read();
+  } catch (const InputError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "expected InputError, nothing was thrown";
+  return "";
+}
+
+}  // namespace ccsrm::mocap::testing
