@@ -13,7 +13,8 @@ function(ccsrm_add_library module)
 endfunction()
 
 function(ccsrm_set_warnings target)
-  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow=local
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic
+    $<$<CXX_COMPILER_ID:GNU>:-Wshadow=local>
     -Wno-unused-parameter)
 endfunction()
 

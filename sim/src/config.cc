@@ -70,6 +70,14 @@ class MapReader {
     return static_cast<int>(value);
   }
 
+  bool Boolean(const std::string& key) {
+    const YAML::Node node = Require(key);
+    const std::string text = node.IsScalar() ? node.Scalar() : "";
+    if (text == "true") return true;
+    if (text == "false") return false;
+    Fail(Join(key), node, "expected true or false, found '" + text + "'");
+  }
+
   std::string String(const std::string& key) {
     const YAML::Node node = Require(key);
     if (!node.IsScalar()) Fail(Join(key), node, "expected a string");
@@ -413,6 +421,7 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
     sc.baumgarte_alpha_per_s = s.Number("baumgarte_alpha_per_s");
     sc.baumgarte_beta_per_s2 = s.Number("baumgarte_beta_per_s2");
     sc.smoothing_step_s = s.Number("smoothing_step_s");
+    sc.smooth_connecting_friction = s.Boolean("smooth_connecting_friction");
     sc.stick_velocity_tolerance_mps = s.Number("stick_velocity_tolerance_mps");
     sc.stick_force_tolerance_n = s.Number("stick_force_tolerance_n");
     sc.large_s_static_velocity_mps = s.Number("large_s_static_velocity_mps");
@@ -535,6 +544,7 @@ std::string ToYaml(const Config& c) {
   out << YAML::Key << "baumgarte_alpha_per_s" << YAML::Value << s.baumgarte_alpha_per_s;
   out << YAML::Key << "baumgarte_beta_per_s2" << YAML::Value << s.baumgarte_beta_per_s2;
   out << YAML::Key << "smoothing_step_s" << YAML::Value << s.smoothing_step_s;
+  out << YAML::Key << "smooth_connecting_friction" << YAML::Value << s.smooth_connecting_friction;
   out << YAML::Key << "stick_velocity_tolerance_mps" << YAML::Value
       << s.stick_velocity_tolerance_mps;
   out << YAML::Key << "stick_force_tolerance_n" << YAML::Value << s.stick_force_tolerance_n;

@@ -36,6 +36,10 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const CableInputs& inputs)
   CCSRM_CHECK(inputs.num_cables() == model.num_cables());
   const DrivingCableConfig& d = config_.arm.driving;
   stick_slip_ = d.friction_kinetic > 0.0 || d.friction_static > 0.0;
+  smooth_connecting_friction_ = config_.solver.smooth_connecting_friction &&
+                                config_.solver.smoothing_step_s > 0.0 &&
+                                (config_.arm.connecting.friction_kinetic > 0.0 ||
+                                 config_.arm.connecting.friction_static > 0.0);
   for (int c = 0; c < model_.num_cables(); ++c) {
     const auto& cable = model_.cables()[c];
     for (int k = 1; k + 1 < static_cast<int>(cable.nodes.size()); ++k) holes_.push_back({c, k});
@@ -46,6 +50,32 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const CableInputs& inputs)
   for (int c = 0; c < model_.num_cables(); ++c)
     tension_[c].assign(model_.cables()[c].num_elements(), 0.0);
   rotation_.resize(model_.num_links());
+  rate_matrix_.resize(model_.num_links());
+  const ConnectingCableConfig& cc = config_.arm.connecting;
+  for (const ConnectingPairModel& pair : model_.connecting_pairs()) {
+    const SegmentConfig& seg = config_.arm.segments[model_.link(pair.joint_i).segment];
+    PairKernel k;
+    k.kind = pair.kind;
+    k.joint_i = pair.joint_i;
+    k.small.axial_stiffness_n = cc.youngs_modulus_pa * cc.cross_section_m2;
+    k.small.pulley_radius_m = seg.small_s.pulley_radius_m;
+    k.small.cable_length_m = seg.small_s.cable_length_m;
+    k.small.damping_nmsprad = pair.damping_nmsprad;
+    k.large.axial_stiffness_n = cc.youngs_modulus_pa * cc.cross_section_m2;
+    k.large.pulley_radius_m = seg.large_s.pulley_radius_m;
+    k.large.cable_length_m = seg.large_s.cable_length_m;
+    k.large.wrap_angle_rad = seg.large_s.wrap_angle_rad;
+    k.large.pretension_n = cc.pretension_n;
+    k.large.damping_nmsprad = pair.damping_nmsprad;
+    k.large.friction.mu_kinetic = cc.friction_kinetic;
+    k.large.friction.mu_static = cc.friction_static;
+    k.large.friction.v_static_mps = config_.solver.large_s_static_velocity_mps;
+    k.large.friction.v_dynamic_mps = config_.solver.large_s_dynamic_velocity_mps;
+    for (int link = pair.joint_i - 1; link <= pair.joint_i + 1; ++link) {
+      if (link >= 1) k.links.push_back(link);
+    }
+    pair_kernels_.push_back(k);
+  }
   theta_.resize(model_.num_joints());
   theta_dot_.resize(model_.num_joints());
 
@@ -172,6 +202,17 @@ void ArmDynamics::BuildStructure() {
     for (int a = 3; a < 7; ++a)
       for (int b = 3; b < 7; ++b) pattern.emplace_back(o + a, o + b, 0.0);
   }
+  auto pair_cols = [&](const PairKernel& k) {
+    std::vector<int> cols;
+    for (int link : k.links)
+      for (int a = 3; a < 7; ++a) cols.push_back(model_.link_offset(link) + a);
+    return cols;
+  };
+  for (const PairKernel& k : pair_kernels_) {
+    if (k.kind != ConnectingKind::kLargeS) continue;
+    for (int a : pair_cols(k))
+      for (int b : pair_cols(k)) pattern.emplace_back(a, b, 0.0);
+  }
   for (int r = 0; r < m_; ++r) {
     const RowData& row = rows_[r];
     for (int a = 0; a < row.count; ++a) {
@@ -198,6 +239,11 @@ void ArmDynamics::BuildStructure() {
     for (int a = 0; a < 3; ++a) link_index_.push_back(Index(o + a, o + a));
     for (int a = 3; a < 7; ++a)
       for (int b = 3; b < 7; ++b) link_index_.push_back(Index(o + a, o + b));
+  }
+  for (PairKernel& k : pair_kernels_) {
+    if (k.kind != ConnectingKind::kLargeS) continue;
+    for (int a : pair_cols(k))
+      for (int b : pair_cols(k)) k.block_index.push_back(Index(a, b));
   }
   for (int r = 0; r < m_; ++r) {
     const RowData& row = rows_[r];
@@ -356,6 +402,7 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
   std::fill(values, values + kkt_.nonZeros(), 0.0);
   force_.setZero();
   double dissipation = 0.0;  // W, power taken out by friction and damping
+  const double h = solver.smoothing_step_s;
   kinetic_ = 0.0;
   elastic_ = 0.0;
 
@@ -365,7 +412,8 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
     const int o = model_.link_offset(i);
     const Vector4 e = Quaternion(q, o), ed = Quaternion(qd, o);
     rotation_[i - 1] = RotationFromQuaternion(e);
-    omega[i - 1] = QuaternionRateMatrix(e) * ed;
+    rate_matrix_[i - 1] = QuaternionRateMatrix(e);
+    omega[i - 1] = rate_matrix_[i - 1] * ed;
   }
 
   // Stage 2: driving-cable ALE elements (eqs. 1-6, 13, 17-20).
@@ -374,7 +422,6 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
   ale.axial_stiffness_n = dc.youngs_modulus_pa * dc.cross_section_m2;
   ale.rayleigh_beta_s = dc.rayleigh_beta_s;
   ale.smoothing_step_s = solver.smoothing_step_s;
-  const double h = solver.smoothing_step_s;
   struct ElementRate {
     double coefficient;  // Δs EA (beta' eps_dot + gamma bias) -> dissipation with eps_dd
     double gamma_term;   // Δs EA gamma eps_dot
@@ -456,38 +503,63 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
         theta_[j - 1][1], RelativeAngularVelocity(rel[j - 1], omega[j - 1], w_parent));
   }
   std::vector<Eigen::Vector2d> joint_moment(model_.num_joints(), Eigen::Vector2d::Zero());
-  const double ea_c = cc.youngs_modulus_pa * cc.cross_section_m2;
-  for (const ConnectingPairModel& pair : model_.connecting_pairs()) {
-    const int i = pair.joint_i - 1, j = pair.joint_j - 1;
+  // Row `axis` of d(theta_dot of joint k)/d(e_dot of link), 1-based k and link.
+  auto rate_row = [&](int k, int link, int axis) -> Eigen::Matrix<double, 1, 4> {
+    const Matrix32d b = UniversalJointRateMatrix(theta_[k - 1][1]);
+    if (link == k) return (b.transpose() * rate_matrix_[link - 1]).row(axis);
+    if (link == k - 1) {
+      return -(b.transpose() * rel[k - 1].transpose() * rate_matrix_[link - 1]).row(axis);
+    }
+    return Eigen::Matrix<double, 1, 4>::Zero();
+  };
+  smoothing_power_.clear();
+  for (const PairKernel& pair : pair_kernels_) {
+    const int i = pair.joint_i - 1, j = pair.joint_i;
     for (int axis = 0; axis < 2; ++axis) {
       const double th_i = theta_[i][axis], th_j = theta_[j][axis];
       const double rt_i = theta_dot_[i][axis], rt_j = theta_dot_[j][axis];
       ConnectingMoments m;
       double k_conservative = 0.0;
       if (pair.kind == ConnectingKind::kSmallS) {
-        const SegmentConfig& seg = config_.arm.segments[model_.link(pair.joint_i).segment];
-        SmallSParams p;
-        p.axial_stiffness_n = ea_c;
-        p.pulley_radius_m = seg.small_s.pulley_radius_m;
-        p.cable_length_m = seg.small_s.cable_length_m;
-        p.damping_nmsprad = pair.damping_nmsprad;
-        m = SmallSMoments(p, th_i, th_j, rt_i, rt_j);
-        k_conservative = SmallSStiffness(p);
+        m = SmallSMoments(pair.small, th_i, th_j, rt_i, rt_j);
+        k_conservative = SmallSStiffness(pair.small);
       } else {
-        const SegmentConfig& seg = config_.arm.segments[model_.link(pair.joint_i).segment];
-        LargeSParams p;
-        p.axial_stiffness_n = ea_c;
-        p.pulley_radius_m = seg.large_s.pulley_radius_m;
-        p.cable_length_m = seg.large_s.cable_length_m;
-        p.wrap_angle_rad = seg.large_s.wrap_angle_rad;
-        p.pretension_n = cc.pretension_n;
-        p.damping_nmsprad = pair.damping_nmsprad;
-        p.friction.mu_kinetic = cc.friction_kinetic;
-        p.friction.mu_static = cc.friction_static;
-        p.friction.v_static_mps = solver.large_s_static_velocity_mps;
-        p.friction.v_dynamic_mps = solver.large_s_dynamic_velocity_mps;
-        m = LargeSMoments(p, th_i, th_j, rt_i, rt_j).moments;
-        k_conservative = 2.0 * pair.stiffness_nmprad;
+        m = LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j).moments;
+        k_conservative = SmallSStiffness({pair.large.axial_stiffness_n, pair.large.pulley_radius_m,
+                                          pair.large.cable_length_m, 0.0});
+        if (smooth_connecting_friction_) {
+          // Model smoothing of the conduit friction (interpretation beyond the
+          // paper, as eqs. 14-16 do for strain): the moments see the rates
+          // averaged over h, theta_dot + (h/2) theta_dd. Linearised, that
+          // adds (h/2) J^T C J to the mass, C = -dM/d(theta_dot), and takes
+          // the microsecond time constant of eq. 45's steep slope out of the
+          // explicit integration.
+          const double delta = 1e-3 * pair.large.friction.v_static_mps / pair.large.pulley_radius_m;
+          const ConnectingMoments pi = LargeSMoments(pair.large, th_i, th_j, rt_i + delta, rt_j).moments;
+          const ConnectingMoments mi = LargeSMoments(pair.large, th_i, th_j, rt_i - delta, rt_j).moments;
+          const ConnectingMoments pj = LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j + delta).moments;
+          const ConnectingMoments mj = LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j - delta).moments;
+          Eigen::Matrix2d d;
+          d << pi.on_i - mi.on_i, pj.on_i - mj.on_i, pi.on_j - mi.on_j, pj.on_j - mj.on_j;
+          d /= 2.0 * delta;
+          const Eigen::Matrix2d c = -0.5 * (d + d.transpose());
+          const int links = static_cast<int>(pair.links.size());
+          Eigen::Matrix<double, 2, 12> jac = Eigen::Matrix<double, 2, 12>::Zero();
+          for (int l = 0; l < links; ++l) {
+            jac.block<1, 4>(0, 4 * l) = rate_row(pair.joint_i, pair.links[l], axis);
+            jac.block<1, 4>(1, 4 * l) = rate_row(pair.joint_i + 1, pair.links[l], axis);
+          }
+          const Eigen::Matrix<double, 12, 12> added = (0.5 * h) * jac.transpose() * c * jac;
+          const int width = 4 * links;
+          for (int a = 0; a < width; ++a)
+            for (int b = 0; b < width; ++b) values[pair.block_index[width * a + b]] += added(a, b);
+          SmoothingPower power;
+          power.weights = (0.5 * h) * (Eigen::RowVector2d(rt_i, rt_j) * c * jac).transpose();
+          for (int l = 0; l < links; ++l)
+            for (int a = 0; a < 4; ++a) power.cols[4 * l + a] = model_.link_offset(pair.links[l]) + 3 + a;
+          power.count = width;
+          smoothing_power_.push_back(power);
+        }
       }
       joint_moment[i][axis] += m.on_i;
       joint_moment[j][axis] += m.on_j;
@@ -574,6 +646,9 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
     double eps_q_qdd = 0.0;
     for (int k = 0; k < 8; ++k) eps_q_qdd += rate.jac[k] * solution[rate.cols[k]];
     dissipation += rate.coefficient + rate.gamma_term * eps_q_qdd;
+  }
+  for (const SmoothingPower& power : smoothing_power_) {
+    for (int k = 0; k < power.count; ++k) dissipation += power.weights[k] * solution[power.cols[k]];
   }
   ydot[2 * n_] = dissipation;
 

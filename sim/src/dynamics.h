@@ -16,6 +16,7 @@
 
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/protocol.h"
+#include "kernels/connecting.h"
 
 namespace ccsrm::sim::internal {
 
@@ -96,6 +97,15 @@ class ArmDynamics {
   int n_ = 0;  // coordinates
   int m_ = 0;  // constraint rows
   bool stick_slip_ = false;
+  bool smooth_connecting_friction_ = false;
+  // Power of the friction-smoothing term, (h/2) theta_dot^T C J q_dd, per
+  // large-S pair and axis of the last evaluation (needs q_dd, so after the solve).
+  struct SmoothingPower {
+    Eigen::Matrix<double, 12, 1> weights;
+    int cols[12];
+    int count = 0;
+  };
+  std::vector<SmoothingPower> smoothing_power_;
 
   std::vector<HoleNodeRef> holes_;
   std::vector<int> hole_of_node_row_;  // row -> hole index, or -1
@@ -120,6 +130,18 @@ class ArmDynamics {
   std::vector<int> row_diag_index_;  // index of (n+r, n+r)
   std::vector<int> element_index_;   // per element: 64 indices
   std::vector<int> link_index_;      // per link: 3 + 16 indices
+  // Connecting pairs with their kernel parameters; for large S pairs the
+  // links whose quaternion rates their joint rates involve (i-1, i, i+1)
+  // and the KKT indices of those quaternion blocks (friction smoothing mass).
+  struct PairKernel {
+    ConnectingKind kind = ConnectingKind::kSmallS;
+    int joint_i = 0;  // 1-based; the other joint is joint_i + 1
+    SmallSParams small;
+    LargeSParams large;
+    std::vector<int> links;
+    std::vector<int> block_index;
+  };
+  std::vector<PairKernel> pair_kernels_;
 
   Eigen::SparseMatrix<double> kkt_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> lu_;
@@ -131,6 +153,7 @@ class ArmDynamics {
   // Scratch of the last evaluation.
   std::vector<std::vector<double>> tension_;  // per cable element
   std::vector<Eigen::Matrix3d> rotation_;     // per link A(e)
+  std::vector<Eigen::Matrix<double, 3, 4>> rate_matrix_;  // per link G(e)
   std::vector<Eigen::Vector2d> theta_, theta_dot_;
   double kinetic_ = 0.0, elastic_ = 0.0;
 };

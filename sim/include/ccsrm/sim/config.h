@@ -82,6 +82,9 @@ struct SolverConfig {
   double baumgarte_alpha_per_s = 100.0;
   double baumgarte_beta_per_s2 = 100.0;
   double smoothing_step_s = 0.01;
+  // Extends model smoothing to the large-S conduit friction (see
+  // docs/model-notes.md): without it eq. 45's slope makes cases 2 and 4 stiff.
+  bool smooth_connecting_friction = true;
   double stick_velocity_tolerance_mps = 1e-6;
   double stick_force_tolerance_n = 1e-3;
   double large_s_static_velocity_mps = 1e-4;
