@@ -298,6 +298,13 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
         break;
       }
       ++summary.steps;
+      if (options.progress && (summary.steps & 255) == 0 && wall_seconds() >= next_progress) {
+        next_progress = wall_seconds() + options.progress_interval_s;
+        SimulationProgress p{t, options.duration_s, wall_seconds(),
+                             t / std::max(1e-9, wall_seconds()), summary.steps,
+                             summary.stick_slip_switches};
+        options.progress(p);
+      }
       if (h < solver.min_step_s) {
         diverge("step size collapsed to " + FormatTime(h));
         break;
@@ -357,12 +364,6 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
       break;
     }
     AppendFrame(observation, t, &time, &frames);
-    if (options.progress && wall_seconds() >= next_progress) {
-      next_progress = wall_seconds() + options.progress_interval_s;
-      SimulationProgress p{t, options.duration_s, wall_seconds(),
-                           t / std::max(1e-9, wall_seconds())};
-      options.progress(p);
-    }
   }
   if (summary.completed) summary.message = "completed";
 

@@ -20,6 +20,8 @@ struct SimulationProgress {
   double duration_s = 0.0;
   double wall_time_s = 0.0;
   double real_time_factor = 0.0;  // simulated seconds per wall second
+  std::int64_t steps = 0;
+  std::int64_t stick_slip_switches = 0;
 };
 
 struct SimulationOptions {
