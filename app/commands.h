@@ -8,4 +8,5 @@ namespace ccsrm::app {
 void AddConfigCommands(CLI::App& root);
 void AddDatasetCommands(CLI::App& root);
 void AddSimulateCommand(CLI::App& root);
+void AddBenchCommand(CLI::App& root);
 }  // namespace ccsrm::app

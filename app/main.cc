@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   ccsrm::app::AddConfigCommands(root);
   ccsrm::app::AddDatasetCommands(root);
   ccsrm::app::AddSimulateCommand(root);
+  ccsrm::app::AddBenchCommand(root);
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

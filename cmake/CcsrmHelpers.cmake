@@ -18,20 +18,30 @@ function(ccsrm_set_warnings target)
     -Wno-unused-parameter)
 endfunction()
 
-# ccsrm_add_test(<name> SOURCES ... DEPS ... [LABELS ...])
-# One GoogleTest executable, registered through gtest_discover_tests.
+# ccsrm_add_test(<name> SOURCES ... DEPS ... [LABELS ...] [ONE_PROCESS])
+# One GoogleTest executable, registered through gtest_discover_tests (one
+# CTest entry per test). ONE_PROCESS registers the executable as a single
+# CTest entry instead, for suites whose tests share expensive results.
 # Tests find ../shared via CCSRM_SHARED_DIR and the source tree via
 # CCSRM_SOURCE_DIR.
+set(CCSRM_SHARED_DIR "${PROJECT_SOURCE_DIR}/../shared" CACHE PATH
+  "The shared folder beside the repository (paper, real mocap files)")
+
 function(ccsrm_add_test name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "ONE_PROCESS" "" "SOURCES;DEPS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   ccsrm_set_warnings(${name})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest_main GTest::gmock)
   target_compile_definitions(${name} PRIVATE
     CCSRM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
-    CCSRM_SHARED_DIR="${PROJECT_SOURCE_DIR}/../shared"
+    CCSRM_SHARED_DIR="${CCSRM_SHARED_DIR}"
     CCSRM_BINARY_DIR="${PROJECT_BINARY_DIR}")
-  if(ARG_LABELS)
+  if(ARG_ONE_PROCESS)
+    add_test(NAME ${name} COMMAND ${name})
+    if(ARG_LABELS)
+      set_tests_properties(${name} PROPERTIES LABELS "${ARG_LABELS}")
+    endif()
+  elseif(ARG_LABELS)
     gtest_discover_tests(${name} TEST_PREFIX "${name}." DISCOVERY_TIMEOUT 60
       PROPERTIES LABELS "${ARG_LABELS}")
   else()

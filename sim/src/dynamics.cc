@@ -484,7 +484,12 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
     report.friction_limit =
         LimitingStaticFriction(t_before, t_after, dc.friction_static, report.wrap_angle);
     report.required_friction = 0.0;
-    if (modes_[hidx] != HoleMode::kStuck && dc.friction_kinetic > 0.0) {
+    // Where even the static limit is below the force tolerance (a cable
+    // running nearly straight through the hole) friction is negligible and
+    // left out, so that its direction need not follow a slip speed that
+    // hovers around zero.
+    const bool negligible = report.friction_limit < solver.stick_force_tolerance_n;
+    if (modes_[hidx] != HoleMode::kStuck && dc.friction_kinetic > 0.0 && !negligible) {
       const double sigma = modes_[hidx] == HoleMode::kSlipUp ? 1.0 : -1.0;
       const double f = HoleSlipFriction(t_before, dc.friction_kinetic, report.wrap_angle, sigma);
       force_[o + 3] += f;
@@ -535,10 +540,14 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
           // the microsecond time constant of eq. 45's steep slope out of the
           // explicit integration.
           const double delta = 1e-3 * pair.large.friction.v_static_mps / pair.large.pulley_radius_m;
-          const ConnectingMoments pi = LargeSMoments(pair.large, th_i, th_j, rt_i + delta, rt_j).moments;
-          const ConnectingMoments mi = LargeSMoments(pair.large, th_i, th_j, rt_i - delta, rt_j).moments;
-          const ConnectingMoments pj = LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j + delta).moments;
-          const ConnectingMoments mj = LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j - delta).moments;
+          const ConnectingMoments pi =
+              LargeSMoments(pair.large, th_i, th_j, rt_i + delta, rt_j).moments;
+          const ConnectingMoments mi =
+              LargeSMoments(pair.large, th_i, th_j, rt_i - delta, rt_j).moments;
+          const ConnectingMoments pj =
+              LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j + delta).moments;
+          const ConnectingMoments mj =
+              LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j - delta).moments;
           Eigen::Matrix2d d;
           d << pi.on_i - mi.on_i, pj.on_i - mj.on_i, pi.on_j - mi.on_j, pj.on_j - mj.on_j;
           d /= 2.0 * delta;
@@ -556,7 +565,8 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
           SmoothingPower power;
           power.weights = (0.5 * h) * (Eigen::RowVector2d(rt_i, rt_j) * c * jac).transpose();
           for (int l = 0; l < links; ++l)
-            for (int a = 0; a < 4; ++a) power.cols[4 * l + a] = model_.link_offset(pair.links[l]) + 3 + a;
+            for (int a = 0; a < 4; ++a)
+              power.cols[4 * l + a] = model_.link_offset(pair.links[l]) + 3 + a;
           power.count = width;
           smoothing_power_.push_back(power);
         }

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <sstream>
 
@@ -51,11 +52,11 @@ struct GslIntegrator {
 
 // Stick-slip switching of the hole nodes at (t, y) (paper section 2.3,
 // trial and error). A stuck node slips once the friction its constraint needs
-// exceeds f_max (eq. 10); a slipping node sticks once its slip reverses past
-// v_eps. Both are located in time. Where even the static limit f_max is below
-// the force tolerance (a nearly straight cable) friction is negligible: such a
-// node never sticks and a reversal just flips its slip direction, so that the
-// straight arm at t = 0 does not chatter.
+// exceeds f_max (eq. 10) by the force tolerance; a slipping node sticks once
+// its slip reverses past v_eps. Both are located in time. Where even f_max is
+// below the force tolerance (a cable running nearly straight through the
+// hole) the dynamics leave friction out, so such a node never sticks and its
+// slip direction just follows the slip speed, without an event.
 class SwitchDetector {
  public:
   SwitchDetector(const ArmModel& model, ArmDynamics* dynamics, const SolverConfig& solver)
@@ -63,12 +64,18 @@ class SwitchDetector {
 
   struct Switches {
     std::vector<int> located;  // must be located in time, then switched
-    std::vector<int> flips;    // negligible friction: flip the slip direction at once
+    std::vector<int> flips;    // negligible friction: flip the slip direction, no event
     bool any() const { return !located.empty() || !flips.empty(); }
   };
 
-  // Returns false if the evaluation at (t, y) failed.
-  bool Scan(double t, const double* y, Switches* out) {
+  // Returns false if the evaluation at (t, y) failed. A slip reversal is
+  // detected past v_eps (hysteresis against noise) but, with `locating`,
+  // located at the zero crossing of the slip speed, so that the node sticks
+  // with no speed left for the stick constraint to take out at once.
+  // `only`, when given, restricts the scan to those nodes (the ones whose
+  // switch is being located).
+  bool Scan(double t, const double* y, Switches* out, bool locating = false,
+            const std::vector<int>* only = nullptr) {
     out->located.clear();
     out->flips.clear();
     if (!dynamics_->has_stick_slip()) return true;
@@ -76,22 +83,29 @@ class SwitchDetector {
     const auto& modes = dynamics_->hole_modes();
     const auto& reports = dynamics_->hole_reports();
     const double f_tol = solver_.stick_force_tolerance_n;
-    for (std::size_t h = 0; h < modes.size(); ++h) {
+    std::vector<int> all;
+    if (only == nullptr) {
+      for (std::size_t h = 0; h < modes.size(); ++h) all.push_back(static_cast<int>(h));
+      only = &all;
+    }
+    for (int h : *only) {
       const HoleReport& r = reports[h];
       if (modes[h] == HoleMode::kStuck) {
         if (std::abs(r.required_friction) > r.friction_limit + f_tol)
           out->located.push_back(static_cast<int>(h));
       } else {
         const double sigma = modes[h] == HoleMode::kSlipUp ? 1.0 : -1.0;
-        if (sigma * r.s_dot < -solver_.stick_velocity_tolerance_mps) {
-          (r.friction_limit > f_tol ? out->located : out->flips).push_back(static_cast<int>(h));
+        const double threshold = locating ? 0.0 : solver_.stick_velocity_tolerance_mps;
+        if (sigma * r.s_dot < -threshold) {
+          (r.friction_limit >= f_tol ? out->located : out->flips).push_back(h);
         }
       }
     }
     return true;
   }
 
-  // Applies the switches found by the last Scan at y.
+  // Applies the switches found by the last Scan at y; returns how many
+  // stick-slip switches (not direction flips) it made.
   std::int64_t Apply(const double* y, const Switches& switches) {
     auto& modes = dynamics_->hole_modes();
     const auto& reports = dynamics_->hole_reports();
@@ -99,16 +113,30 @@ class SwitchDetector {
       modes[h] = modes[h] == HoleMode::kSlipUp ? HoleMode::kSlipDown : HoleMode::kSlipUp;
     }
     for (int h : switches.located) {
+      if (trace_ != nullptr) {
+        const auto& hole = dynamics_->holes()[h];
+        std::fprintf(
+            trace_, "switch cable %d node %d: %s, s_dot %.3e m/s, friction %.4g / limit %.4g N\n",
+            hole.cable + 1, hole.node, modes[h] == HoleMode::kStuck ? "stick->slip" : "slip->stick",
+            reports[h].s_dot, reports[h].required_friction, reports[h].friction_limit);
+      }
       if (modes[h] == HoleMode::kStuck) {
-        // The node moves against the friction its constraint was applying.
-        modes[h] = reports[h].required_friction > 0.0 ? HoleMode::kSlipDown : HoleMode::kSlipUp;
+        // A node still moving (the stick constraint had not yet taken its
+        // speed out) slips the way it moves; a node at rest moves against
+        // the friction its constraint was applying.
+        const double s_dot = reports[h].s_dot;
+        if (std::abs(s_dot) > solver_.stick_velocity_tolerance_mps) {
+          modes[h] = s_dot > 0.0 ? HoleMode::kSlipUp : HoleMode::kSlipDown;
+        } else {
+          modes[h] = reports[h].required_friction > 0.0 ? HoleMode::kSlipDown : HoleMode::kSlipUp;
+        }
       } else {
         const auto& hole = dynamics_->holes()[h];
         modes[h] = HoleMode::kStuck;
         dynamics_->stuck_position()[h] = y[model_.node_offset(hole.cable, hole.node) + 3];
       }
     }
-    return static_cast<std::int64_t>(switches.located.size() + switches.flips.size());
+    return static_cast<std::int64_t>(switches.located.size());  // flips are not stick-slip switches
   }
 
  private:
@@ -116,6 +144,8 @@ class SwitchDetector {
   ArmDynamics* dynamics_;
   const SolverConfig& solver_;
   std::vector<double> scratch_;
+  // CCSRM_TRACE_SWITCHES=1 prints every stick-slip switch on stderr.
+  std::FILE* trace_ = std::getenv("CCSRM_TRACE_SWITCHES") != nullptr ? stderr : nullptr;
 };
 
 void AppendFrame(const Observation& o, double t, std::vector<double>* time,
@@ -300,8 +330,11 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
       ++summary.steps;
       if (options.progress && (summary.steps & 255) == 0 && wall_seconds() >= next_progress) {
         next_progress = wall_seconds() + options.progress_interval_s;
-        SimulationProgress p{t, options.duration_s, wall_seconds(),
-                             t / std::max(1e-9, wall_seconds()), summary.steps,
+        SimulationProgress p{t,
+                             options.duration_s,
+                             wall_seconds(),
+                             t / std::max(1e-9, wall_seconds()),
+                             summary.steps,
                              summary.stick_slip_switches};
         options.progress(p);
       }
@@ -314,12 +347,13 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
         break;
       }
       if (found.located.empty()) {
-        summary.stick_slip_switches += switches.Apply(y.data(), found);
+        switches.Apply(y.data(), found);  // direction flips only: not stick-slip switches
         continue;
       }
       // A switch happened inside [t0, t]: bisect to locate it within
       // switch_time_tolerance_s, restarting single steps from the last
       // point known to need no switch.
+      const std::vector<int> candidates = found.located;
       double ta = t0, tb = t;
       std::vector<double> ya(y_saved), yb(y.data(), y.data() + dim);
       while (tb - ta > solver.switch_time_tolerance_s) {
@@ -330,7 +364,8 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
                                   nullptr, &system) != GSL_SUCCESS) {
           break;
         }
-        if (switches.Scan(tm, y_mid.data(), &found) && !found.located.empty()) {
+        if (switches.Scan(tm, y_mid.data(), &found, /*locating=*/true, &candidates) &&
+            !found.located.empty()) {
           tb = tm;
           yb = y_mid;
         } else {
@@ -340,8 +375,11 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
       }
       t = tb;
       std::copy(yb.begin(), yb.end(), y.data());
-      // Switch, then re-check: a node that has just stuck may at once need
-      // more friction than it can hold (a reversal), and so on.
+      // Switch the located nodes, then re-check: a node that has just stuck
+      // may at once need more friction than it can hold (a reversal), and so on.
+      if (switches.Scan(t, y.data(), &found, /*locating=*/true, &candidates)) {
+        summary.stick_slip_switches += switches.Apply(y.data(), found);
+      }
       for (int pass = 0; pass < 8 && switches.Scan(t, y.data(), &found) && found.any(); ++pass) {
         summary.stick_slip_switches += switches.Apply(y.data(), found);
       }

@@ -1,0 +1,85 @@
+// ccsrm bench: the speed figures of SPEC 10 for the paper's case 2.
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ccsrm/common/error.h"
+#include "ccsrm/sim/config.h"
+#include "ccsrm/sim/model.h"
+#include "ccsrm/sim/protocol.h"
+#include "ccsrm/sim/simulator.h"
+#include "commands.h"
+
+namespace ccsrm::app {
+namespace {
+
+struct BenchArgs {
+  std::string config = "configs/paper.yaml";
+  int case_number = 2;
+  double duration_s = NAN;
+  int repeat = 3;
+};
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+void RunBench(const BenchArgs& a) {
+  if (a.repeat < 1) ThrowInputError("--repeat", "", "must be >= 1");
+  sim::Config config = sim::LoadConfig(a.config);
+  sim::ApplyPaperCase(a.case_number, &config);
+  const double duration = std::isnan(a.duration_s) ? config.protocol.duration_s() : a.duration_s;
+  if (!(duration > 0.0)) ThrowInputError("--duration", "", "must be > 0 s");
+  const sim::ArmModel model(config);
+  const sim::CableInputs inputs =
+      sim::PlanCableInputs(model, sim::PaperTrajectory(model, config.protocol), duration);
+  sim::SimulationOptions options;
+  options.duration_s = duration;
+  std::printf("ccsrm bench: case %d, %+.3g deg, %.4g s simulated, %d run(s), one thread\n",
+              a.case_number, config.protocol.amplitude_rad * 180.0 / M_PI, duration, a.repeat);
+  std::vector<double> wall, rtf, rhs_rate;
+  sim::SimulationSummary last;
+  for (int k = 0; k < a.repeat; ++k) {
+    const sim::SimulationResult result = sim::Simulate(model, inputs, options);
+    last = result.summary;
+    if (!last.completed) ThrowInputError(a.config, "", "the benchmark run diverged: " + last.message);
+    wall.push_back(last.wall_time_s);
+    rtf.push_back(last.real_time_factor);
+    rhs_rate.push_back(last.rhs_evaluations / last.wall_time_s);
+    std::printf("  run %d: wall %.2f s, real-time factor %.3f, %.0f rhs/s\n", k + 1, last.wall_time_s,
+                last.real_time_factor, rhs_rate.back());
+  }
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  std::printf("median wall time:          %.2f s\n", Median(wall));
+  std::printf("median real-time factor:   %.3f (simulated s per wall s)\n", Median(rtf));
+  std::printf("median rhs evaluations/s:  %.0f\n", Median(rhs_rate));
+  std::printf("steps:                     %lld accepted, %lld rejected\n",
+              static_cast<long long>(last.steps), static_cast<long long>(last.rejected_steps));
+  std::printf("rhs evaluations:           %lld\n", static_cast<long long>(last.rhs_evaluations));
+  std::printf("stick-slip switches:       %lld\n", static_cast<long long>(last.stick_slip_switches));
+  std::printf("peak memory (max RSS):     %.1f MiB\n", usage.ru_maxrss / 1024.0);
+}
+
+}  // namespace
+
+void AddBenchCommand(CLI::App& root) {
+  CLI::App* cmd = root.add_subcommand(
+      "bench", "Time the paper's case 2 (+6 deg, 48 s): wall time, real-time factor, "
+               "right-hand-side evaluations per second, steps, peak memory");
+  auto a = std::make_shared<BenchArgs>();
+  cmd->add_option("--config", a->config, "Arm configuration (YAML)")->capture_default_str();
+  cmd->add_option("--case", a->case_number, "Paper case 1..4")->check(CLI::Range(1, 4))->capture_default_str();
+  cmd->add_option("--duration", a->duration_s, "Simulated time [s] (default: the whole protocol)");
+  cmd->add_option("--repeat", a->repeat, "Runs; medians are reported")->capture_default_str();
+  cmd->callback([a] { RunBench(*a); });
+}
+
+}  // namespace ccsrm::app
