@@ -49,12 +49,13 @@ void RunBench(const BenchArgs& a) {
   for (int k = 0; k < a.repeat; ++k) {
     const sim::SimulationResult result = sim::Simulate(model, inputs, options);
     last = result.summary;
-    if (!last.completed) ThrowInputError(a.config, "", "the benchmark run diverged: " + last.message);
+    if (!last.completed)
+      ThrowInputError(a.config, "", "the benchmark run diverged: " + last.message);
     wall.push_back(last.wall_time_s);
     rtf.push_back(last.real_time_factor);
     rhs_rate.push_back(last.rhs_evaluations / last.wall_time_s);
-    std::printf("  run %d: wall %.2f s, real-time factor %.3f, %.0f rhs/s\n", k + 1, last.wall_time_s,
-                last.real_time_factor, rhs_rate.back());
+    std::printf("  run %d: wall %.2f s, real-time factor %.3f, %.0f rhs/s\n", k + 1,
+                last.wall_time_s, last.real_time_factor, rhs_rate.back());
   }
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
@@ -64,19 +65,23 @@ void RunBench(const BenchArgs& a) {
   std::printf("steps:                     %lld accepted, %lld rejected\n",
               static_cast<long long>(last.steps), static_cast<long long>(last.rejected_steps));
   std::printf("rhs evaluations:           %lld\n", static_cast<long long>(last.rhs_evaluations));
-  std::printf("stick-slip switches:       %lld\n", static_cast<long long>(last.stick_slip_switches));
+  std::printf("stick-slip switches:       %lld\n",
+              static_cast<long long>(last.stick_slip_switches));
   std::printf("peak memory (max RSS):     %.1f MiB\n", usage.ru_maxrss / 1024.0);
 }
 
 }  // namespace
 
 void AddBenchCommand(CLI::App& root) {
-  CLI::App* cmd = root.add_subcommand(
-      "bench", "Time the paper's case 2 (+6 deg, 48 s): wall time, real-time factor, "
-               "right-hand-side evaluations per second, steps, peak memory");
+  CLI::App* cmd =
+      root.add_subcommand("bench",
+                          "Time the paper's case 2 (+6 deg, 48 s): wall time, real-time factor, "
+                          "right-hand-side evaluations per second, steps, peak memory");
   auto a = std::make_shared<BenchArgs>();
   cmd->add_option("--config", a->config, "Arm configuration (YAML)")->capture_default_str();
-  cmd->add_option("--case", a->case_number, "Paper case 1..4")->check(CLI::Range(1, 4))->capture_default_str();
+  cmd->add_option("--case", a->case_number, "Paper case 1..4")
+      ->check(CLI::Range(1, 4))
+      ->capture_default_str();
   cmd->add_option("--duration", a->duration_s, "Simulated time [s] (default: the whole protocol)");
   cmd->add_option("--repeat", a->repeat, "Runs; medians are reported")->capture_default_str();
   cmd->callback([a] { RunBench(*a); });

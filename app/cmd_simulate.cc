@@ -44,7 +44,8 @@ int RunSimulate(const SimulateArgs& a) {
   options.case_name = a.case_number != 0 ? std::to_string(a.case_number) : "custom";
   if (!a.quiet) {
     options.progress = [](const sim::SimulationProgress& p) {
-      std::fprintf(stderr, "  t = %6.2f / %.2f s   real-time factor %.2f   steps %lld   switches %lld\n",
+      std::fprintf(stderr,
+                   "  t = %6.2f / %.2f s   real-time factor %.2f   steps %lld   switches %lld\n",
                    p.simulated_s, p.duration_s, p.real_time_factor, static_cast<long long>(p.steps),
                    static_cast<long long>(p.stick_slip_switches));
     };

@@ -29,7 +29,8 @@ void BM_RightHandSide(benchmark::State& state) {
   Eigen::VectorXd y = dynamics.InitialState();
   Eigen::VectorXd ydot(y.size());
   // A little velocity everywhere so that no term is trivially zero.
-  for (int k = 0; k < dynamics.num_coordinates(); ++k) y[dynamics.num_coordinates() + k] = 1e-4 * ((k % 7) - 3);
+  for (int k = 0; k < dynamics.num_coordinates(); ++k)
+    y[dynamics.num_coordinates() + k] = 1e-4 * ((k % 7) - 3);
   for (auto _ : state) {
     benchmark::DoNotOptimize(dynamics.Evaluate(10.0, y.data(), ydot.data()));
   }

@@ -84,7 +84,8 @@ TEST(Cli, MissingFileAndUnknownSubcommandFail) {
 TEST(Cli, SimulateWritesARunFileThatInspectReads) {
   const fs::path dir = FreshDir("simulate");
   const std::string run = (dir / "run.h5").string();
-  const Outcome sim = RunCcsrm("simulate --config " + Paper() + " --case 1 --duration 0.05 --quiet --out " + run);
+  const Outcome sim =
+      RunCcsrm("simulate --config " + Paper() + " --case 1 --duration 0.05 --quiet --out " + run);
   ASSERT_EQ(sim.status, 0) << sim.err;
   EXPECT_THAT(sim.out, HasSubstr("simulation completed"));
   EXPECT_THAT(sim.out, HasSubstr("real-time factor"));
@@ -106,10 +107,12 @@ TEST(Cli, SimulateWritesARunFileThatInspectReads) {
 
 TEST(Cli, SimulateRejectsBadArgumentsBeforeRunning) {
   EXPECT_NE(RunCcsrm("simulate --config " + Paper() + " --case 5 --out /tmp/x.h5").status, 0);
-  const Outcome no_dir = RunCcsrm("simulate --config " + Paper() + " --case 1 --out /nonexistent-dir/run.h5");
+  const Outcome no_dir =
+      RunCcsrm("simulate --config " + Paper() + " --case 1 --out /nonexistent-dir/run.h5");
   EXPECT_EQ(no_dir.status, 2);
   EXPECT_THAT(no_dir.err, HasSubstr("does not exist"));
-  const Outcome bad_duration = RunCcsrm("simulate --config " + Paper() + " --duration -1 --out /tmp/x.h5");
+  const Outcome bad_duration =
+      RunCcsrm("simulate --config " + Paper() + " --duration -1 --out /tmp/x.h5");
   EXPECT_EQ(bad_duration.status, 2);
   EXPECT_THAT(bad_duration.err, HasSubstr("--duration"));
 }

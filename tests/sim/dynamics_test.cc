@@ -22,7 +22,8 @@ Config SmallArm(int links) {
   c.arm.segments.resize(1);
   c.arm.segments[0].links = links;
   c.arm.segments[0].connecting_pattern.assign(links - 1, ConnectingKind::kSmallS);
-  for (int k = 1; k < links - 1; k += 2) c.arm.segments[0].connecting_pattern[k] = ConnectingKind::kLargeS;
+  for (int k = 1; k < links - 1; k += 2)
+    c.arm.segments[0].connecting_pattern[k] = ConnectingKind::kLargeS;
   c.arm.driving.cables.resize(3);
   Validate(c);
   return c;
@@ -81,10 +82,11 @@ TEST(ArmDynamics, EnergyIsConservedWithoutDissipation) {
     kinetic_max = std::max(kinetic_max, run.energy.at(f, 0));
     exchanged = std::max(exchanged, std::abs(run.energy.at(f, 1) - run.energy.at(start, 1)));
   }
-  std::printf("energy after the pull: %.6e J; kinetic up to %.3e J; elastic swings %.3e J; "
-              "drift %.3e J over %.2f s (%zu steps, violation %.2e)\n",
-              reference, kinetic_max, exchanged, drift, run.time.at(run.frames() - 1) - run.time.at(start),
-              static_cast<std::size_t>(result.summary.steps), result.summary.max_constraint_violation);
+  std::printf(
+      "energy after the pull: %.6e J; kinetic up to %.3e J; elastic swings %.3e J; "
+      "drift %.3e J over %.2f s (%zu steps, violation %.2e)\n",
+      reference, kinetic_max, exchanged, drift, run.time.at(run.frames() - 1) - run.time.at(start),
+      static_cast<std::size_t>(result.summary.steps), result.summary.max_constraint_violation);
   ASSERT_GT(kinetic_max, 1e-7) << "the pull must set the arm moving for the test to mean anything";
   // Stated tolerance: drift below 1 % of the energy that sloshes between
   // kinetic and elastic form. The paper's Q_e (eq. 6) is Δs ε_qᵀ EA ε, which

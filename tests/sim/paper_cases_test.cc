@@ -159,11 +159,13 @@ TEST(PaperCases, Case3HoldsUnequalJointsWhileInputsAreHeld) {
   int stuck = 0;
   for (std::size_t f = a; f <= b; ++f) {
     for (int j = 1; j <= 12; ++j) drift = std::max(drift, std::abs(r.Theta(f, j) - r.Theta(a, j)));
-    for (std::size_t c = 0; c < 6; ++c) stuck = std::max(stuck, static_cast<int>(r.run.stuck_nodes.at(f, c)));
+    for (std::size_t c = 0; c < 6; ++c)
+      stuck = std::max(stuck, static_cast<int>(r.run.stuck_nodes.at(f, c)));
   }
-  std::printf("case 3: drift during hold %.5f deg, most stuck nodes on a cable %d, segment spreads "
-              "%.2f / %.2f deg, max |theta_y| %.3f deg\n",
-              drift, stuck, r.Spread(a, 0), r.Spread(a, 1), r.MaxAbsThetaY());
+  std::printf(
+      "case 3: drift during hold %.5f deg, most stuck nodes on a cable %d, segment spreads "
+      "%.2f / %.2f deg, max |theta_y| %.3f deg\n",
+      drift, stuck, r.Spread(a, 0), r.Spread(a, 1), r.MaxAbsThetaY());
   // The joint angles stay put (0.01 deg, a tenth of what mocap resolves) and unequal.
   EXPECT_LT(drift, 0.01);
   EXPECT_GT(r.Spread(a, 0), 0.5);
@@ -199,8 +201,9 @@ TEST(PaperCases, MoreFrictionNeedsMoreInputTension) {
   const double t2 = RunCase(2, 6.0).RampTensionSwing();
   const double t3 = RunCase(3, 6.0).RampTensionSwing();
   const double t4 = RunCase(4, 6.0).RampTensionSwing();
-  std::printf("ramp swing of the largest input tension: case 1 %.1f N, 2 %.1f N, 3 %.1f N, 4 %.1f N\n",
-              t1, t2, t3, t4);
+  std::printf(
+      "ramp swing of the largest input tension: case 1 %.1f N, 2 %.1f N, 3 %.1f N, 4 %.1f N\n", t1,
+      t2, t3, t4);
   EXPECT_GT(t2, t3);
   EXPECT_GT(t3, t4);
   EXPECT_GT(t4, t1);
@@ -212,7 +215,8 @@ TEST(PaperCases, PlusAndMinusSixDegreesMirror) {
   ASSERT_EQ(plus.run.frames(), minus.run.frames());
   double worst = 0.0;
   for (std::size_t f = 0; f < plus.run.frames(); ++f)
-    for (int j = 1; j <= 12; ++j) worst = std::max(worst, std::abs(plus.Theta(f, j) + minus.Theta(f, j)));
+    for (int j = 1; j <= 12; ++j)
+      worst = std::max(worst, std::abs(plus.Theta(f, j) + minus.Theta(f, j)));
   std::printf("case 2: largest |theta_x(+6) + theta_x(-6)| %.4f deg\n", worst);
   // Mirror symmetry of the layout (SPEC 2); 0.05 deg allows for the
   // switching times, located only to the solver's tolerance.

@@ -94,8 +94,10 @@ TEST(KinematicPlanner, MirroredAmplitudeMirrorsTheInputs) {
   Config minus = plus;
   minus.protocol.amplitude_rad = -plus.protocol.amplitude_rad;
   const ArmModel model_plus(plus), model_minus(minus);
-  const CableInputs a = PlanCableInputs(model_plus, PaperTrajectory(model_plus, plus.protocol), 48.0, 0.01);
-  const CableInputs b = PlanCableInputs(model_minus, PaperTrajectory(model_minus, minus.protocol), 48.0, 0.01);
+  const CableInputs a =
+      PlanCableInputs(model_plus, PaperTrajectory(model_plus, plus.protocol), 48.0, 0.01);
+  const CableInputs b =
+      PlanCableInputs(model_minus, PaperTrajectory(model_minus, minus.protocol), 48.0, 0.01);
   // Cables 2 <-> 3 (120 / 240 deg) and 4 <-> 6 (60 / 300 deg) swap roles.
   const int swap[6] = {0, 2, 1, 5, 4, 3};
   for (int k = 0; k < 6; ++k) {
