@@ -14,14 +14,13 @@
 #include "ccsrm/sim/protocol.h"
 #include "ccsrm/sim/simulator.h"
 #include "commands.h"
+#include "paper_run.h"
 
 namespace ccsrm::app {
 namespace {
 
 struct BenchArgs {
-  std::string config = "configs/paper.yaml";
-  int case_number = 2;
-  double duration_s = NAN;
+  PaperRunArgs run{"configs/paper.yaml", 2};
   int repeat = 3;
 };
 
@@ -33,24 +32,20 @@ double Median(std::vector<double> v) {
 
 void RunBench(const BenchArgs& a) {
   if (a.repeat < 1) ThrowInputError("--repeat", "", "must be >= 1");
-  sim::Config config = sim::LoadConfig(a.config);
-  sim::ApplyPaperCase(a.case_number, &config);
-  const double duration = std::isnan(a.duration_s) ? config.protocol.duration_s() : a.duration_s;
-  if (!(duration > 0.0)) ThrowInputError("--duration", "", "must be > 0 s");
-  const sim::ArmModel model(config);
-  const sim::CableInputs inputs =
-      sim::PlanCableInputs(model, sim::PaperTrajectory(model, config.protocol), duration);
+  const PaperRun run = PreparePaperRun(a.run);
+  const sim::Config& config = run.model.config();
   sim::SimulationOptions options;
-  options.duration_s = duration;
+  options.duration_s = run.duration_s;
   std::printf("ccsrm bench: case %d, %+.3g deg, %.4g s simulated, %d run(s), one thread\n",
-              a.case_number, config.protocol.amplitude_rad * 180.0 / M_PI, duration, a.repeat);
+              a.run.case_number, config.protocol.amplitude_rad * 180.0 / M_PI, run.duration_s,
+              a.repeat);
   std::vector<double> wall, rtf, rhs_rate;
   sim::SimulationSummary last;
   for (int k = 0; k < a.repeat; ++k) {
-    const sim::SimulationResult result = sim::Simulate(model, inputs, options);
+    const sim::SimulationResult result = sim::Simulate(run.model, run.inputs, options);
     last = result.summary;
     if (!last.completed)
-      ThrowInputError(a.config, "", "the benchmark run diverged: " + last.message);
+      ThrowInputError(a.run.config_path, "", "the benchmark run diverged: " + last.message);
     wall.push_back(last.wall_time_s);
     rtf.push_back(last.real_time_factor);
     rhs_rate.push_back(last.rhs_evaluations / last.wall_time_s);
@@ -78,11 +73,13 @@ void AddBenchCommand(CLI::App& root) {
                           "Time the paper's case 2 (+6 deg, 48 s): wall time, real-time factor, "
                           "right-hand-side evaluations per second, steps, peak memory");
   auto a = std::make_shared<BenchArgs>();
-  cmd->add_option("--config", a->config, "Arm configuration (YAML)")->capture_default_str();
-  cmd->add_option("--case", a->case_number, "Paper case 1..4")
+  cmd->add_option("--config", a->run.config_path, "Arm configuration (YAML)")
+      ->capture_default_str();
+  cmd->add_option("--case", a->run.case_number, "Paper case 1..4")
       ->check(CLI::Range(1, 4))
       ->capture_default_str();
-  cmd->add_option("--duration", a->duration_s, "Simulated time [s] (default: the whole protocol)");
+  cmd->add_option("--duration", a->run.duration_s,
+                  "Simulated time [s] (default: the whole protocol)");
   cmd->add_option("--repeat", a->repeat, "Runs; medians are reported")->capture_default_str();
   cmd->callback([a] { RunBench(*a); });
 }

@@ -397,7 +397,6 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
   const double* qd = y + n_;
   const SolverConfig& solver = config_.solver;
   const DrivingCableConfig& dc = config_.arm.driving;
-  const ConnectingCableConfig& cc = config_.arm.connecting;
   double* values = kkt_.valuePtr();
   std::fill(values, values + kkt_.nonZeros(), 0.0);
   force_.setZero();
