@@ -393,6 +393,7 @@ void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, b
 
 bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
   ++evaluations_;
+  failure_.clear();
   const double* q = y;
   const double* qd = y + n_;
   const SolverConfig& solver = config_.solver;

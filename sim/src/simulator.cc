@@ -104,32 +104,19 @@ class SwitchDetector {
     return true;
   }
 
-  // Applies the switches found by the last Scan at y; returns how many
+  // Applies the switches found by the last Scan at (t, y); returns how many
   // stick-slip switches (not direction flips) it made.
-  std::int64_t Apply(const double* y, const Switches& switches) {
+  std::int64_t Apply(double t, const double* y, const Switches& switches) {
     auto& modes = dynamics_->hole_modes();
-    const auto& reports = dynamics_->hole_reports();
     for (int h : switches.flips) {
       modes[h] = modes[h] == HoleMode::kSlipUp ? HoleMode::kSlipDown : HoleMode::kSlipUp;
     }
+    // Reports of the Scan, before the trials below overwrite them.
+    const std::vector<HoleReport> reports = dynamics_->hole_reports();
     for (int h : switches.located) {
-      if (trace_ != nullptr) {
-        const auto& hole = dynamics_->holes()[h];
-        std::fprintf(
-            trace_, "switch cable %d node %d: %s, s_dot %.3e m/s, friction %.4g / limit %.4g N\n",
-            hole.cable + 1, hole.node, modes[h] == HoleMode::kStuck ? "stick->slip" : "slip->stick",
-            reports[h].s_dot, reports[h].required_friction, reports[h].friction_limit);
-      }
+      Trace(h, modes[h], reports[h]);
       if (modes[h] == HoleMode::kStuck) {
-        // A node still moving (the stick constraint had not yet taken its
-        // speed out) slips the way it moves; a node at rest moves against
-        // the friction its constraint was applying.
-        const double s_dot = reports[h].s_dot;
-        if (std::abs(s_dot) > solver_.stick_velocity_tolerance_mps) {
-          modes[h] = s_dot > 0.0 ? HoleMode::kSlipUp : HoleMode::kSlipDown;
-        } else {
-          modes[h] = reports[h].required_friction > 0.0 ? HoleMode::kSlipDown : HoleMode::kSlipUp;
-        }
+        modes[h] = SlipDirection(t, y, h, reports[h]);
       } else {
         const auto& hole = dynamics_->holes()[h];
         modes[h] = HoleMode::kStuck;
@@ -140,6 +127,39 @@ class SwitchDetector {
   }
 
  private:
+  // The direction a released node slips (trial and error, section 2.3). A
+  // node still moving slips the way it moves. A node at rest is tried both
+  // ways, starting against the friction its constraint was applying, and
+  // takes the direction in which its acceleration agrees with the slip: with
+  // the coupled (smoothed) mass matrix the sign of the reaction alone does
+  // not say which way the node will move.
+  HoleMode SlipDirection(double t, const double* y, int h, const HoleReport& report) {
+    if (std::abs(report.s_dot) > solver_.stick_velocity_tolerance_mps) {
+      return report.s_dot > 0.0 ? HoleMode::kSlipUp : HoleMode::kSlipDown;
+    }
+    const auto& hole = dynamics_->holes()[h];
+    const int s_index =
+        dynamics_->num_coordinates() + model_.node_offset(hole.cable, hole.node) + 3;
+    const HoleMode first = report.required_friction > 0.0 ? HoleMode::kSlipDown : HoleMode::kSlipUp;
+    const HoleMode second = first == HoleMode::kSlipUp ? HoleMode::kSlipDown : HoleMode::kSlipUp;
+    for (HoleMode trial : {first, second}) {
+      dynamics_->hole_modes()[h] = trial;
+      if (!dynamics_->Evaluate(t, y, scratch_.data())) break;
+      const double sigma = trial == HoleMode::kSlipUp ? 1.0 : -1.0;
+      if (sigma * scratch_[s_index] > 0.0) return trial;
+    }
+    return first;
+  }
+
+  void Trace(int h, HoleMode mode, const HoleReport& r) const {
+    if (trace_ == nullptr) return;
+    const auto& hole = dynamics_->holes()[h];
+    std::fprintf(
+        trace_, "switch cable %d node %d: %s, s_dot %.3e m/s, friction %.4g / limit %.4g N\n",
+        hole.cable + 1, hole.node, mode == HoleMode::kStuck ? "stick->slip" : "slip->stick",
+        r.s_dot, r.required_friction, r.friction_limit);
+  }
+
   const ArmModel& model_;
   ArmDynamics* dynamics_;
   const SolverConfig& solver_;
@@ -308,7 +328,7 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
 
   // Consistent initial modes: nothing may need to switch at t = 0.
   for (int pass = 0; pass < 8 && switches.Scan(t, y.data(), &found) && found.any(); ++pass) {
-    summary.stick_slip_switches += switches.Apply(y.data(), found);
+    summary.stick_slip_switches += switches.Apply(t, y.data(), found);
   }
   dynamics.Observe(t, y.data(), &observation);
   AppendFrame(observation, t, &time, &frames);
@@ -339,7 +359,8 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
         options.progress(p);
       }
       if (h < solver.min_step_s) {
-        diverge("step size collapsed to " + FormatTime(h));
+        diverge("step size collapsed to " + FormatTime(h) +
+                (dynamics.failure().empty() ? "" : " (" + dynamics.failure() + ")"));
         break;
       }
       if (!switches.Scan(t, y.data(), &found)) {
@@ -347,7 +368,7 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
         break;
       }
       if (found.located.empty()) {
-        switches.Apply(y.data(), found);  // direction flips only: not stick-slip switches
+        switches.Apply(t, y.data(), found);  // direction flips only: not stick-slip switches
         continue;
       }
       // A switch happened inside [t0, t]: bisect to locate it within
@@ -378,10 +399,10 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
       // Switch the located nodes, then re-check: a node that has just stuck
       // may at once need more friction than it can hold (a reversal), and so on.
       if (switches.Scan(t, y.data(), &found, /*locating=*/true, &candidates)) {
-        summary.stick_slip_switches += switches.Apply(y.data(), found);
+        summary.stick_slip_switches += switches.Apply(t, y.data(), found);
       }
       for (int pass = 0; pass < 8 && switches.Scan(t, y.data(), &found) && found.any(); ++pass) {
-        summary.stick_slip_switches += switches.Apply(y.data(), found);
+        summary.stick_slip_switches += switches.Apply(t, y.data(), found);
       }
       gsl.Reset();
     }
