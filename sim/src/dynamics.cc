@@ -51,6 +51,9 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const CableInputs& inputs)
     tension_[c].assign(model_.cables()[c].num_elements(), 0.0);
   rotation_.resize(model_.num_links());
   rate_matrix_.resize(model_.num_links());
+  omega_.resize(model_.num_links());
+  relative_rotation_.resize(model_.num_joints());
+  joint_moment_.resize(model_.num_joints());
   const ConnectingCableConfig& cc = config_.arm.connecting;
   for (const ConnectingPairModel& pair : model_.connecting_pairs()) {
     const SegmentConfig& seg = config_.arm.segments[model_.link(pair.joint_i).segment];
@@ -407,7 +410,7 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
   elastic_ = 0.0;
 
   // Stage 1: link kinematics.
-  std::vector<Vector3> omega(model_.num_links());
+  std::vector<Vector3>& omega = omega_;
   for (int i = 1; i <= model_.num_links(); ++i) {
     const int o = model_.link_offset(i);
     const Vector4 e = Quaternion(q, o), ed = Quaternion(qd, o);
@@ -422,14 +425,8 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
   ale.axial_stiffness_n = dc.youngs_modulus_pa * dc.cross_section_m2;
   ale.rayleigh_beta_s = dc.rayleigh_beta_s;
   ale.smoothing_step_s = solver.smoothing_step_s;
-  struct ElementRate {
-    double coefficient;  // Δs EA (beta' eps_dot + gamma bias) -> dissipation with eps_dd
-    double gamma_term;   // Δs EA gamma eps_dot
-    Eigen::Matrix<double, 1, 8> jac;
-    int cols[8];
-  };
-  std::vector<ElementRate> element_rates;
-  element_rates.reserve(64);
+  std::vector<ElementRate>& element_rates = element_rates_;
+  element_rates.clear();
   int element_counter = 0;
   for (int c = 0; c < model_.num_cables(); ++c) {
     const int elements = model_.cables()[c].num_elements();
@@ -498,7 +495,7 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
   }
 
   // Stage 4: joint angles (eqs. 23-29) and connecting-cable moments (eqs. 38-58).
-  std::vector<Eigen::Matrix3d> rel(model_.num_joints());
+  std::vector<Eigen::Matrix3d>& rel = relative_rotation_;
   for (int j = 1; j <= model_.num_joints(); ++j) {
     rel[j - 1] =
         j > 1 ? Eigen::Matrix3d(rotation_[j - 2].transpose() * rotation_[j - 1]) : rotation_[0];
@@ -507,7 +504,8 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
     theta_dot_[j - 1] = UniversalJointRates(
         theta_[j - 1][1], RelativeAngularVelocity(rel[j - 1], omega[j - 1], w_parent));
   }
-  std::vector<Eigen::Vector2d> joint_moment(model_.num_joints(), Eigen::Vector2d::Zero());
+  std::vector<Eigen::Vector2d>& joint_moment = joint_moment_;
+  std::fill(joint_moment.begin(), joint_moment.end(), Eigen::Vector2d::Zero());
   // Row `axis` of d(theta_dot of joint k)/d(e_dot of link), 1-based k and link.
   auto rate_row = [&](int k, int link, int axis) -> Eigen::Matrix<double, 1, 4> {
     const Matrix32d b = UniversalJointRateMatrix(theta_[k - 1][1]);

@@ -151,9 +151,20 @@ class ArmDynamics {
   std::int64_t evaluations_ = 0;
 
   // Scratch of the last evaluation.
-  std::vector<std::vector<double>> tension_;  // per cable element
-  std::vector<Eigen::Matrix3d> rotation_;     // per link A(e)
+  std::vector<std::vector<double>> tension_;              // per cable element
+  std::vector<Eigen::Matrix3d> rotation_;                 // per link A(e)
   std::vector<Eigen::Matrix<double, 3, 4>> rate_matrix_;  // per link G(e)
+  std::vector<Eigen::Vector3d> omega_;                    // per link w' [rad/s]
+  std::vector<Eigen::Matrix3d> relative_rotation_;        // per joint R_{L(i-1) L(i)}
+  std::vector<Eigen::Vector2d> joint_moment_;             // per joint [N m]
+  // Per element, what the dissipated power needs once q_dd is known.
+  struct ElementRate {
+    double coefficient;  // Δs EA eps_dot (beta' eps_dot + gamma eps_dot_q q_dot)
+    double gamma_term;   // Δs EA gamma eps_dot, times eps_q q_dd
+    Eigen::Matrix<double, 1, 8> jac;
+    int cols[8];
+  };
+  std::vector<ElementRate> element_rates_;
   std::vector<Eigen::Vector2d> theta_, theta_dot_;
   double kinetic_ = 0.0, elastic_ = 0.0;
 };

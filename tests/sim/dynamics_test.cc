@@ -98,5 +98,23 @@ TEST(ArmDynamics, EnergyIsConservedWithoutDissipation) {
   EXPECT_LT(drift, 0.01 * std::max(kinetic_max, exchanged));
 }
 
+TEST(ArmDynamics, SameInputsGiveBitIdenticalRuns) {
+  // Identification differentiates simulations by finite differences, so a
+  // run must be a pure function of its inputs.
+  Config c = SmallArm(4);
+  const ArmModel model(c);
+  const CableInputs inputs = PullAndHold(model, 2, 1e-3, 0.05, 0.1);
+  SimulationOptions options;
+  options.duration_s = 0.1;
+  const SimulationResult a = Simulate(model, inputs, options);
+  const SimulationResult b = Simulate(model, inputs, options);
+  ASSERT_TRUE(a.summary.completed) << a.summary.message;
+  EXPECT_EQ(a.summary.steps, b.summary.steps);
+  EXPECT_EQ(a.summary.stick_slip_switches, b.summary.stick_slip_switches);
+  EXPECT_EQ(a.run.joint_angles.values, b.run.joint_angles.values);
+  EXPECT_EQ(a.run.link_pose.values, b.run.link_pose.values);
+  EXPECT_EQ(a.run.input_tension.values, b.run.input_tension.values);
+}
+
 }  // namespace
 }  // namespace ccsrm::sim
