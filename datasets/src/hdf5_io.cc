@@ -570,40 +570,32 @@ std::string FileReader::ReadStringAttribute(const std::string& name) const {
   return value;
 }
 
-double FileReader::ReadDoubleAttribute(const std::string& name) const {
+void FileReader::ReadScalarAttribute(const std::string& name, H5T_class_t expected_class,
+                                     hid_t memory_type, const char* what, void* value) const {
   Handle attribute = OpenRootAttribute(name);
   Handle type(H5Aget_type(attribute.get()), H5Tclose);
   Handle space(H5Aget_space(attribute.get()), H5Sclose);
   const std::string where = "attribute '" + name + "'";
   if (!type.valid() || !space.valid()) Fail(where, WithHdf5Detail("cannot read"));
   const H5T_class_t type_class = H5Tget_class(type.get());
-  if (type_class != H5T_FLOAT) {
-    Fail(where, std::string("expected a floating-point number, found ") +
-                    TypeClassName(type_class) + " values");
+  if (type_class != expected_class) {
+    Fail(where,
+         std::string("expected ") + what + ", found " + TypeClassName(type_class) + " values");
   }
-  if (H5Sget_simple_extent_npoints(space.get()) != 1) Fail(where, "expected one number");
+  if (H5Sget_simple_extent_npoints(space.get()) != 1)
+    Fail(where, std::string("expected one value"));
+  if (H5Aread(attribute.get(), memory_type, value) < 0) Fail(where, WithHdf5Detail("cannot read"));
+}
+
+double FileReader::ReadDoubleAttribute(const std::string& name) const {
   double value = 0.0;
-  if (H5Aread(attribute.get(), H5T_NATIVE_DOUBLE, &value) < 0) {
-    Fail(where, WithHdf5Detail("cannot read"));
-  }
+  ReadScalarAttribute(name, H5T_FLOAT, H5T_NATIVE_DOUBLE, "a floating-point number", &value);
   return value;
 }
 
 std::int64_t FileReader::ReadInt64Attribute(const std::string& name) const {
-  Handle attribute = OpenRootAttribute(name);
-  Handle type(H5Aget_type(attribute.get()), H5Tclose);
-  Handle space(H5Aget_space(attribute.get()), H5Sclose);
-  const std::string where = "attribute '" + name + "'";
-  if (!type.valid() || !space.valid()) Fail(where, WithHdf5Detail("cannot read"));
-  const H5T_class_t type_class = H5Tget_class(type.get());
-  if (type_class != H5T_INTEGER) {
-    Fail(where, std::string("expected an integer, found ") + TypeClassName(type_class) + " values");
-  }
-  if (H5Sget_simple_extent_npoints(space.get()) != 1) Fail(where, "expected one integer");
   std::int64_t value = 0;
-  if (H5Aread(attribute.get(), H5T_NATIVE_INT64, &value) < 0) {
-    Fail(where, WithHdf5Detail("cannot read"));
-  }
+  ReadScalarAttribute(name, H5T_INTEGER, H5T_NATIVE_INT64, "an integer", &value);
   return value;
 }
 

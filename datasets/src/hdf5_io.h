@@ -139,6 +139,10 @@ class FileReader {
   Array ReadFloatData(const Handle& dataset, const std::string& path) const;
   std::string ReadUnits(const Handle& dataset, const std::string& path) const;
   Handle OpenRootAttribute(const std::string& name) const;
+  // Reads a one-element root attribute of class `expected_class` into
+  // `value` as `memory_type`; `what` names the expected kind in errors.
+  void ReadScalarAttribute(const std::string& name, H5T_class_t expected_class, hid_t memory_type,
+                           const char* what, void* value) const;
 
   std::string label_;
   Handle file_;
