@@ -3,6 +3,7 @@
 #include <string>
 
 #include "ccsrm/sim/config.h"
+#include "ccsrm/sim/model.h"
 #include "commands.h"
 
 namespace ccsrm::app {
@@ -10,14 +11,11 @@ namespace {
 
 void RunConfigCheck(const std::string& path) {
   const sim::Config c = sim::LoadConfig(path);
+  // The model holds the cable routing; count its hole nodes rather than
+  // re-deriving the layout here.
+  const sim::ArmModel model(c);
   int holes = 0;
-  for (const auto& cable : c.arm.driving.cables) {
-    // Ground disk, then a proximal and a distal disk on every link up to the
-    // segment's last link, whose distal disk holds the anchor.
-    int links = 0;
-    for (int s = 0; s < cable.segment; ++s) links += c.arm.segments[s].links;
-    holes += 2 * links;
-  }
+  for (const auto& cable : model.cables()) holes += cable.num_holes();
   std::printf("%s: ok\n", path.c_str());
   std::printf("  segments: %zu, links: %d, universal joints: %d\n", c.arm.segments.size(),
               c.arm.total_links(), c.arm.total_links());

@@ -83,12 +83,10 @@ class SwitchDetector {
     const auto& modes = dynamics_->hole_modes();
     const auto& reports = dynamics_->hole_reports();
     const double f_tol = solver_.stick_force_tolerance_n;
-    std::vector<int> all;
-    if (only == nullptr) {
-      for (std::size_t h = 0; h < modes.size(); ++h) all.push_back(static_cast<int>(h));
-      only = &all;
-    }
-    for (int h : *only) {
+    const int count =
+        only != nullptr ? static_cast<int>(only->size()) : static_cast<int>(modes.size());
+    for (int k = 0; k < count; ++k) {
+      const int h = only != nullptr ? (*only)[k] : k;
       const HoleReport& r = reports[h];
       if (modes[h] == HoleMode::kStuck) {
         if (std::abs(r.required_friction) > r.friction_limit + f_tol)

@@ -1,9 +1,8 @@
 // The four cases of the paper (section 6; SPEC 3 "The four cases"), each
 // claim checked with a tolerance stated beside it, over the paper's 48 s
-// protocol (CTest label `slow`). CCSRM_FULL_PROTOCOL=0 compresses the
-// protocol tenfold in time for quick looks; that is not a faithful
-// shortcut (at a 2 s ramp the smoothed cables' inertia spreads the joints
-// of case 1 by about 1 deg), so no test relies on it.
+// protocol (CTest label `slow`). A protocol compressed in time is no
+// shortcut: at a 2 s ramp the smoothed cables' inertia alone spreads the
+// joints of case 1 by about 1 deg.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,14 +15,9 @@
 #include "ccsrm/sim/protocol.h"
 #include "ccsrm/sim/simulator.h"
 
-#ifndef CCSRM_FULL_PROTOCOL
-#define CCSRM_FULL_PROTOCOL 1
-#endif
-
 namespace ccsrm::sim {
 namespace {
 
-constexpr double kTimeScale = CCSRM_FULL_PROTOCOL ? 1.0 : 0.1;
 constexpr double kDeg = M_PI / 180.0;
 const std::string kPaper = std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml";
 
@@ -93,11 +87,6 @@ const CaseRun& RunCase(int case_number, double amplitude_deg) {
   ApplyPaperCase(case_number, &r.config);
   ProtocolConfig& p = r.config.protocol;
   p.amplitude_rad = amplitude_deg * kDeg;
-  p.ramp_s *= kTimeScale;
-  p.hold_s *= kTimeScale;
-  p.return_s *= kTimeScale;
-  p.rest_s *= kTimeScale;
-  r.config.solver.output_rate_hz = 100.0 / std::sqrt(kTimeScale);
   const ArmModel model(r.config);
   const CableInputs inputs = PlanCableInputs(model, PaperTrajectory(model, p), p.duration_s());
   SimulationOptions options;
