@@ -12,10 +12,10 @@ namespace {
 // hole circle, spread along the link. Heights differ so the cluster is not
 // planar (better conditioned fits), and all six pairwise distances differ.
 constexpr double kPlate[4][3] = {
-    {0.030, -0.014, -0.028},
-    {0.034, 0.017, -0.010},
-    {0.038, -0.006, 0.013},
-    {0.031, 0.011, 0.030},
+    {0.030, -0.028, -0.028},
+    {0.034, 0.030, -0.016},
+    {0.038, -0.016, 0.010},
+    {0.031, 0.022, 0.030},
 };
 // Ground cluster behind joint 1, (x, y, z) in W [m]; non-planar so a camera's
 // pose follows from it alone.

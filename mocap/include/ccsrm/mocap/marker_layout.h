@@ -48,7 +48,8 @@ struct DefaultMarkerLayoutOptions {
 
 // The default layout for an arm. Marker names are "L<ii>_<A..D>" on link ii
 // (two digits) and "B0_<A..>" on the ground. The plate pattern is the same on
-// every link, scaled along z' to fit links shorter than 0.07 m, and no two of
+// every link (about 6 cm square, wider than the link so orientation is well
+// determined), scaled along z' to fit links shorter than 0.07 m, and no two of
 // its distances are equal, so a labeller can tell its markers apart.
 MarkerLayout DefaultMarkerLayout(const sim::ArmModel& model,
                                  const DefaultMarkerLayoutOptions& options = {});
