@@ -23,9 +23,9 @@ constexpr double kBase[6][3] = {
     {0.020, -0.045, -0.060}, {0.045, 0.040, -0.065},  {0.030, 0.000, -0.105},
     {0.055, 0.025, -0.135},  {0.025, -0.030, -0.150}, {0.040, 0.050, -0.115},
 };
-// The plate spans z' in [-0.028, 0.030]: keep 1.5 cm clear of each joint.
+// The plate spans z' in [-0.028, 0.030]: keep 1.2 cm clear of each joint.
 constexpr double kPlateHalfSpan = 0.030;
-constexpr double kJointClearance = 0.015;
+constexpr double kJointClearance = 0.012;
 
 std::string MarkerName(const char* prefix, int number, int index) {
   char buf[32];

@@ -30,7 +30,8 @@ TEST(DefaultMarkerLayout, PaperArmHasFourMarkersPerLinkAndAFourMarkerBase) {
 }
 
 TEST(DefaultMarkerLayout, PlateDistancesAreAllDifferentSoMarkersCanBeTold) {
-  const RigidBody& link = DefaultMarkerLayout(PaperModel()).bodies[1];
+  const MarkerLayout layout = DefaultMarkerLayout(PaperModel());
+  const RigidBody& link = layout.bodies[1];
   std::vector<double> d;
   for (size_t a = 0; a < link.p_BM.size(); ++a)
     for (size_t b = a + 1; b < link.p_BM.size(); ++b)
