@@ -422,6 +422,7 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
     sc.baumgarte_beta_per_s2 = s.Number("baumgarte_beta_per_s2");
     sc.smoothing_step_s = s.Number("smoothing_step_s");
     sc.smooth_connecting_friction = s.Boolean("smooth_connecting_friction");
+    sc.smooth_connecting_elasticity = s.Boolean("smooth_connecting_elasticity");
     sc.stick_velocity_tolerance_mps = s.Number("stick_velocity_tolerance_mps");
     sc.stick_force_tolerance_n = s.Number("stick_force_tolerance_n");
     sc.large_s_static_velocity_mps = s.Number("large_s_static_velocity_mps");
@@ -545,6 +546,8 @@ std::string ToYaml(const Config& c) {
   out << YAML::Key << "baumgarte_beta_per_s2" << YAML::Value << s.baumgarte_beta_per_s2;
   out << YAML::Key << "smoothing_step_s" << YAML::Value << s.smoothing_step_s;
   out << YAML::Key << "smooth_connecting_friction" << YAML::Value << s.smooth_connecting_friction;
+  out << YAML::Key << "smooth_connecting_elasticity" << YAML::Value
+      << s.smooth_connecting_elasticity;
   out << YAML::Key << "stick_velocity_tolerance_mps" << YAML::Value
       << s.stick_velocity_tolerance_mps;
   out << YAML::Key << "stick_force_tolerance_n" << YAML::Value << s.stick_force_tolerance_n;

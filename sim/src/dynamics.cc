@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include <Eigen/Eigenvalues>
+
 #include "ccsrm/common/error.h"
 #include "kernels/ale_element.h"
 #include "kernels/connecting.h"
@@ -40,6 +42,8 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const CableInputs& inputs)
                                 config_.solver.smoothing_step_s > 0.0 &&
                                 (config_.arm.connecting.friction_kinetic > 0.0 ||
                                  config_.arm.connecting.friction_static > 0.0);
+  smooth_connecting_elasticity_ =
+      config_.solver.smooth_connecting_elasticity && config_.solver.smoothing_step_s > 0.0;
   for (int c = 0; c < model_.num_cables(); ++c) {
     const auto& cable = model_.cables()[c];
     for (int k = 1; k + 1 < static_cast<int>(cable.nodes.size()); ++k) holes_.push_back({c, k});
@@ -212,7 +216,6 @@ void ArmDynamics::BuildStructure() {
     return cols;
   };
   for (const PairKernel& k : pair_kernels_) {
-    if (k.kind != ConnectingKind::kLargeS) continue;
     for (int a : pair_cols(k))
       for (int b : pair_cols(k)) pattern.emplace_back(a, b, 0.0);
   }
@@ -224,6 +227,19 @@ void ArmDynamics::BuildStructure() {
       for (int b = 0; b < row.count; ++b) pattern.emplace_back(row.cols[a], row.cols[b], 0.0);
     }
     pattern.emplace_back(n_ + r, n_ + r, 0.0);
+  }
+  {
+    // AMD on the pattern, in the convention of Eigen's own ordering step:
+    // the ordering yields the inverse permutation.
+    Eigen::SparseMatrix<double> model_order(n_ + m_, n_ + m_);
+    model_order.setFromTriplets(pattern.begin(), pattern.end());
+    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> inverse;
+    Eigen::AMDOrdering<int>()(model_order, inverse);
+    const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> order = inverse.inverse();
+    kkt_order_.assign(order.indices().data(), order.indices().data() + n_ + m_);
+    for (auto& entry : pattern) {
+      entry = Eigen::Triplet<double>(kkt_order_[entry.row()], kkt_order_[entry.col()], 0.0);
+    }
   }
   kkt_.resize(n_ + m_, n_ + m_);
   kkt_.setFromTriplets(pattern.begin(), pattern.end());
@@ -244,7 +260,6 @@ void ArmDynamics::BuildStructure() {
       for (int b = 3; b < 7; ++b) link_index_.push_back(Index(o + a, o + b));
   }
   for (PairKernel& k : pair_kernels_) {
-    if (k.kind != ConnectingKind::kLargeS) continue;
     for (int a : pair_cols(k))
       for (int b : pair_cols(k)) k.block_index.push_back(Index(a, b));
   }
@@ -262,10 +277,14 @@ void ArmDynamics::BuildStructure() {
   }
   lu_.analyzePattern(kkt_);
   rhs_.resize(n_ + m_);
+  kkt_rhs_.resize(n_ + m_);
+  kkt_solution_.resize(n_ + m_);
+  solution_.resize(n_ + m_);
   force_.resize(n_);
 }
 
-int ArmDynamics::Index(int row, int col) const {
+int ArmDynamics::Index(int model_row, int model_col) const {
+  const int row = kkt_order_[model_row], col = kkt_order_[model_col];
   const int* inner = kkt_.innerIndexPtr();
   const int begin = kkt_.outerIndexPtr()[col];
   const int end = kkt_.outerIndexPtr()[col + 1];
@@ -518,18 +537,28 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
   smoothing_power_.clear();
   for (const PairKernel& pair : pair_kernels_) {
     const int i = pair.joint_i - 1, j = pair.joint_i;
+    const int links = static_cast<int>(pair.links.size());
+    const int width = 4 * links;
     for (int axis = 0; axis < 2; ++axis) {
       const double th_i = theta_[i][axis], th_j = theta_[j][axis];
       const double rt_i = theta_dot_[i][axis], rt_j = theta_dot_[j][axis];
       ConnectingMoments m;
-      double k_conservative = 0.0;
+      double k_conservative = 0.0;  // N·m/rad, of the spring between the joints
+      double damping = 0.0;         // N·m·s/rad
+      // (h/2) C on (theta_dot_i, theta_dot_j): smoothing of the conduit friction.
+      Eigen::Matrix2d friction_smoothing = Eigen::Matrix2d::Zero();
       if (pair.kind == ConnectingKind::kSmallS) {
         m = SmallSMoments(pair.small, th_i, th_j, rt_i, rt_j);
         k_conservative = SmallSStiffness(pair.small);
+        damping = pair.small.damping_nmsprad;
       } else {
-        m = LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j).moments;
+        const LargeSResult large = LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j);
+        m = large.moments;
+        // Elastic energy bookkeeping uses the frictionless couple; the
+        // smoothing below uses the stiffness the couple has right now.
         k_conservative = SmallSStiffness({pair.large.axial_stiffness_n, pair.large.pulley_radius_m,
                                           pair.large.cable_length_m, 0.0});
+        damping = pair.large.damping_nmsprad;
         if (smooth_connecting_friction_) {
           // Model smoothing of the conduit friction (interpretation beyond the
           // paper, as eqs. 14-16 do for strain): the moments see the rates
@@ -549,25 +578,53 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
           Eigen::Matrix2d d;
           d << pi.on_i - mi.on_i, pj.on_i - mj.on_i, pi.on_j - mi.on_j, pj.on_j - mj.on_j;
           d /= 2.0 * delta;
-          const Eigen::Matrix2d c = -0.5 * (d + d.transpose());
-          const int links = static_cast<int>(pair.links.size());
-          Eigen::Matrix<double, 2, 12> jac = Eigen::Matrix<double, 2, 12>::Zero();
-          for (int l = 0; l < links; ++l) {
-            jac.block<1, 4>(0, 4 * l) = rate_row(pair.joint_i, pair.links[l], axis);
-            jac.block<1, 4>(1, 4 * l) = rate_row(pair.joint_i + 1, pair.links[l], axis);
-          }
-          const Eigen::Matrix<double, 12, 12> added = (0.5 * h) * jac.transpose() * c * jac;
-          const int width = 4 * links;
-          for (int a = 0; a < width; ++a)
-            for (int b = 0; b < width; ++b) values[pair.block_index[width * a + b]] += added(a, b);
-          SmoothingPower power;
-          power.weights = (0.5 * h) * (Eigen::RowVector2d(rt_i, rt_j) * c * jac).transpose();
-          for (int l = 0; l < links; ++l)
-            for (int a = 0; a < 4; ++a)
-              power.cols[4 * l + a] = model_.link_offset(pair.links[l]) + 3 + a;
-          power.count = width;
-          smoothing_power_.push_back(power);
+          // Only the dissipative part is kept: the rate dependence of the
+          // capstan stiffness (through mu_m) makes -sym(d) indefinite once
+          // the two joints differ (det = -g^2), and a negative added mass of
+          // order (h/2) g^2 / F dwarfs the link inertia. Clipping the
+          // eigenvalues at zero keeps the smoothing positive semidefinite.
+          Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(-0.5 * (d + d.transpose()));
+          friction_smoothing = (0.5 * h) * eig.eigenvectors() *
+                               eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
+                               eig.eigenvectors().transpose();
         }
+        if (smooth_connecting_elasticity_) k_conservative = large.stiffness_i;
+      }
+      // Model smoothing of the connecting spring and damper (interpretation
+      // beyond the paper, after eqs. 14-20): the moments see the
+      // acceleration part of the average over h, k (h^2/6) d_dd + c (h/2)
+      // d_dd (d = theta_j - theta_i), which adds mu J_d^T J_d to the mass and
+      // caps the couple's torsional modes near sqrt(6)/h. The (h/2) d_dot
+      // part is left out: it would add a damper of k h/2 (0.8 N·m·s/rad, 16x
+      // c) and change the arm's slow transients by ~10 %. The bias of d_dd
+      // (quadratic in the rates, ~1e-7 N·m here) is left out too.
+      const double smoothing_mass =
+          smooth_connecting_elasticity_ ? k_conservative * h * h / 6.0 + damping * h / 2.0 : 0.0;
+      if (pair.kind == ConnectingKind::kLargeS) {
+        k_conservative = SmallSStiffness({pair.large.axial_stiffness_n, pair.large.pulley_radius_m,
+                                          pair.large.cable_length_m, 0.0});
+      }
+      if (smoothing_mass > 0.0 || !friction_smoothing.isZero(0.0)) {
+        Eigen::Matrix<double, 2, 12> jac = Eigen::Matrix<double, 2, 12>::Zero();
+        for (int l = 0; l < links; ++l) {
+          jac.block<1, 4>(0, 4 * l) = rate_row(pair.joint_i, pair.links[l], axis);
+          jac.block<1, 4>(1, 4 * l) = rate_row(pair.joint_i + 1, pair.links[l], axis);
+        }
+        // Both smoothings in one 2x2 form on (theta_dot_i, theta_dot_j).
+        Eigen::Matrix2d form = friction_smoothing;
+        form += smoothing_mass * (Eigen::Matrix2d() << 1.0, -1.0, -1.0, 1.0).finished();
+        const Eigen::Matrix<double, 12, 12> added = jac.transpose() * form * jac;
+        for (int a = 0; a < width; ++a)
+          for (int b = 0; b < width; ++b) values[pair.block_index[width * a + b]] += added(a, b);
+        // The smoothing moments -form * theta_dd do work on the rates; it is
+        // booked as dissipation once q_dd is known.
+        SmoothingPower power;
+        power.weights = (Eigen::RowVector2d(rt_i, rt_j) * form * jac).transpose();
+        for (int l = 0; l < links; ++l)
+          for (int a = 0; a < 4; ++a)
+            power.cols[4 * l + a] = model_.link_offset(pair.links[l]) + 3 + a;
+        power.count = width;
+        smoothing_power_.push_back(power);
       }
       joint_moment[i][axis] += m.on_i;
       joint_moment[j][axis] += m.on_j;
@@ -643,7 +700,10 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
     failure_ = "augmented mass matrix is singular";
     return false;
   }
-  const Eigen::VectorXd solution = lu_.solve(rhs_);
+  for (int k = 0; k < n_ + m_; ++k) kkt_rhs_[kkt_order_[k]] = rhs_[k];
+  kkt_solution_ = lu_.solve(kkt_rhs_);
+  for (int k = 0; k < n_ + m_; ++k) solution_[k] = kkt_solution_[kkt_order_[k]];
+  const Eigen::VectorXd& solution = solution_;
   for (int k = 0; k < n_; ++k) {
     ydot[k] = qd[k];
     ydot[n_ + k] = solution[k];

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <memory>
 #include <sstream>
 
@@ -29,25 +30,24 @@ int RightHandSide(double t, const double y[], double dydt[], void* params) {
   return dynamics->Evaluate(t, y, dydt) ? GSL_SUCCESS : GSL_FAILURE;
 }
 
-// Owns the GSL objects of one run.
-struct GslIntegrator {
+// Owns the GSL stepper and step-size control of one run. The step loop is
+// ours rather than gsl_odeiv2_evolve_apply: evolve evaluates the derivative at
+// the start of every step although RKF45 already computed it at the end of
+// the previous one, and the hole reports of that end-of-step evaluation are
+// what the stick-slip scan needs (6 evaluations per step instead of 8).
+struct GslStepper {
   gsl_odeiv2_step* step = nullptr;
   gsl_odeiv2_control* control = nullptr;
-  gsl_odeiv2_evolve* evolve = nullptr;
-  GslIntegrator(std::size_t dim, double atol, double rtol) {
+  GslStepper(std::size_t dim, double atol, double rtol) {
     step = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rkf45, dim);
     control = gsl_odeiv2_control_standard_new(atol, rtol, 1.0, 0.0);
-    evolve = gsl_odeiv2_evolve_alloc(dim);
   }
-  ~GslIntegrator() {
-    gsl_odeiv2_evolve_free(evolve);
+  ~GslStepper() {
     gsl_odeiv2_control_free(control);
     gsl_odeiv2_step_free(step);
   }
-  void Reset() {
-    gsl_odeiv2_step_reset(step);
-    gsl_odeiv2_evolve_reset(evolve);
-  }
+  GslStepper(const GslStepper&) = delete;
+  GslStepper& operator=(const GslStepper&) = delete;
 };
 
 // Stick-slip switching of the hole nodes at (t, y) (paper section 2.3,
@@ -74,12 +74,14 @@ class SwitchDetector {
   // with no speed left for the stick constraint to take out at once.
   // `only`, when given, restricts the scan to those nodes (the ones whose
   // switch is being located).
+  // With `evaluate` false the reports of the dynamics' last evaluation are
+  // used; the caller guarantees it was at (t, y) with the current modes.
   bool Scan(double t, const double* y, Switches* out, bool locating = false,
-            const std::vector<int>* only = nullptr) {
+            const std::vector<int>* only = nullptr, bool evaluate = true) {
     out->located.clear();
     out->flips.clear();
     if (!dynamics_->has_stick_slip()) return true;
-    if (!dynamics_->Evaluate(t, y, scratch_.data())) return false;
+    if (evaluate && !dynamics_->Evaluate(t, y, scratch_.data())) return false;
     const auto& modes = dynamics_->hole_modes();
     const auto& reports = dynamics_->hole_reports();
     const double f_tol = solver_.stick_force_tolerance_n;
@@ -100,6 +102,19 @@ class SwitchDetector {
       }
     }
     return true;
+  }
+
+  // The switching function of hole h at the dynamics' last evaluation,
+  // positive once the node must switch and crossing zero where it does: for a
+  // stuck node the excess of required friction over f_max (+ tolerance) [N],
+  // for a slipping node its slip speed against its friction direction [m/s].
+  double SwitchFunction(int h) const {
+    const HoleReport& r = dynamics_->hole_reports()[h];
+    const HoleMode mode = dynamics_->hole_modes()[h];
+    if (mode == HoleMode::kStuck) {
+      return std::abs(r.required_friction) - (r.friction_limit + solver_.stick_force_tolerance_n);
+    }
+    return mode == HoleMode::kSlipUp ? -r.s_dot : r.s_dot;
   }
 
   // Applies the switches found by the last Scan at (t, y); returns how many
@@ -303,9 +318,13 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
   ArmDynamics dynamics(model, inputs);
   const std::size_t dim = dynamics.state_size();
   Eigen::VectorXd y = dynamics.InitialState();
-  std::vector<double> y_saved(dim), y_mid(dim), y_err(dim);
+  // dydt_in: derivative at (t, y) under the current modes (valid when
+  // have_dydt_in); dydt_out: at the end of the step being tried.
+  std::vector<double> y_try(dim), y_err(dim), dydt_in(dim), dydt_out(dim);
+  std::vector<double> y_prev(dim), dydt_prev(dim);
+  bool have_dydt_in = false;
   gsl_odeiv2_system system{RightHandSide, nullptr, dim, &dynamics};
-  GslIntegrator gsl(dim, solver.absolute_tolerance, solver.relative_tolerance);
+  GslStepper gsl(dim, solver.absolute_tolerance, solver.relative_tolerance);
   SwitchDetector switches(model, &dynamics, solver);
 
   SimulationSummary summary;
@@ -323,28 +342,73 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
     summary.completed = false;
     summary.message = cause + " at t = " + FormatTime(t);
   };
+  // One RKF45 step of size dt from (t0, y0) with derivative dydt0 into y1 and
+  // dydt1 (the last evaluation, so the hole reports are those of the end).
+  auto try_step = [&](double t0, const double* y0, const double* dydt0, double dt, double* y1,
+                      double* dydt1) {
+    std::copy(y0, y0 + dim, y1);
+    gsl_odeiv2_step_reset(gsl.step);
+    return gsl_odeiv2_step_apply(gsl.step, t0, dt, y1, y_err.data(), dydt0, dydt1, &system);
+  };
+  // Switches nodes at (t, y) until no node needs to (a node that has just
+  // stuck may at once need more friction than it can hold, and so on).
+  auto settle_modes = [&]() {
+    for (int pass = 0; pass < 8 && switches.Scan(t, y.data(), &found) && found.any(); ++pass) {
+      summary.stick_slip_switches += switches.Apply(t, y.data(), found);
+    }
+    have_dydt_in = false;
+  };
 
   // Consistent initial modes: nothing may need to switch at t = 0.
-  for (int pass = 0; pass < 8 && switches.Scan(t, y.data(), &found) && found.any(); ++pass) {
-    summary.stick_slip_switches += switches.Apply(t, y.data(), found);
-  }
+  settle_modes();
   dynamics.Observe(t, y.data(), &observation);
   AppendFrame(observation, t, &time, &frames);
   summary.max_constraint_violation = observation.constraint_violation;
   summary.completed = true;
+  std::int64_t rejected = 0;
 
   for (long frame = 1; frame < frames_total && summary.completed; ++frame) {
     const double t_out = std::min(options.duration_s, frame * dt_out);
     while (t < t_out && summary.completed) {
-      const double t0 = t;
-      std::copy(y.data(), y.data() + dim, y_saved.begin());
-      h = std::min(h, solver.max_step_s);
-      const int status = gsl_odeiv2_evolve_apply(gsl.evolve, gsl.control, gsl.step, &system, &t,
-                                                 t_out, &h, y.data());
-      if (status != GSL_SUCCESS) {
-        diverge(dynamics.failure().empty() ? "integrator failure" : dynamics.failure());
-        break;
+      if (!have_dydt_in) {
+        if (!dynamics.Evaluate(t, y.data(), dydt_in.data())) {
+          diverge(dynamics.failure());
+          break;
+        }
+        have_dydt_in = true;
       }
+      const double h_proposed = std::min(h, solver.max_step_s);
+      double dt = h_proposed;
+      // Land on the output time exactly; stretch rather than leave a sliver.
+      const bool last = t + 1.01 * dt >= t_out;
+      if (last) dt = t_out - t;
+      if (try_step(t, y.data(), dydt_in.data(), dt, y_try.data(), dydt_out.data()) != GSL_SUCCESS) {
+        // A trial that went too far can collapse an element: retry shorter.
+        h = 0.5 * dt;
+        ++rejected;
+        if (h < solver.min_step_s) {
+          diverge("step size collapsed to " + FormatTime(h) +
+                  (dynamics.failure().empty() ? "" : " (" + dynamics.failure() + ")"));
+        }
+        continue;
+      }
+      double h_next = dt;
+      if (gsl_odeiv2_control_hadjust(gsl.control, gsl.step, y_try.data(), y_err.data(),
+                                     dydt_out.data(), &h_next) == GSL_ODEIV_HADJ_DEC) {
+        h = h_next;
+        ++rejected;
+        if (h < solver.min_step_s) diverge("step size collapsed to " + FormatTime(h));
+        continue;
+      }
+      // Accepted. A step shortened to land on t_out says nothing against the
+      // longer step that was proposed.
+      h = last ? std::max(h_proposed, h_next) : h_next;
+      const double t0 = t;
+      std::copy(y.data(), y.data() + dim, y_prev.begin());
+      std::swap(dydt_prev, dydt_in);
+      std::copy(y_try.begin(), y_try.end(), y.data());
+      std::swap(dydt_in, dydt_out);
+      t = last ? t_out : t0 + dt;
       ++summary.steps;
       if (options.progress && (summary.steps & 255) == 0 && wall_seconds() >= next_progress) {
         next_progress = wall_seconds() + options.progress_interval_s;
@@ -356,53 +420,76 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
                              summary.stick_slip_switches};
         options.progress(p);
       }
-      if (h < solver.min_step_s) {
-        diverge("step size collapsed to " + FormatTime(h) +
-                (dynamics.failure().empty() ? "" : " (" + dynamics.failure() + ")"));
-        break;
+      // The last evaluation of the step was at (t, y): scan its reports.
+      switches.Scan(t, y.data(), &found, false, nullptr, /*evaluate=*/false);
+      if (found.located.empty()) {
+        if (!found.flips.empty()) {
+          switches.Apply(t, y.data(), found);  // direction flips only: not stick-slip switches
+          have_dydt_in = false;
+        }
+        continue;
       }
-      if (!switches.Scan(t, y.data(), &found)) {
+      // A switch happened inside [t0, t]: locate it within
+      // switch_time_tolerance_s by the Illinois method on the candidates'
+      // switching functions, normalised and combined by their maximum (the
+      // first node to switch decides). Trials restart single steps from the
+      // last point known to need no switch.
+      const std::vector<int> candidates = found.located;
+      std::vector<double> scale(candidates.size());
+      auto combined = [&](bool set_scale) {
+        double g = -std::numeric_limits<double>::infinity();
+        for (std::size_t k = 0; k < candidates.size(); ++k) {
+          const double value = switches.SwitchFunction(candidates[k]);
+          if (set_scale) scale[k] = std::max(std::abs(value), 1e-300);
+          g = std::max(g, value / scale[k]);
+        }
+        return g;
+      };
+      double gb = combined(true);
+      double ta = t0, tb = t;
+      std::vector<double> ya(y_prev), yb(y.data(), y.data() + dim), dydt_a(dydt_prev);
+      std::vector<double> y_mid(dim), dydt_mid(dim);
+      // g at t0 from the dynamics at (t0, y0); one evaluation per switch.
+      if (!dynamics.Evaluate(ta, ya.data(), dydt_mid.data())) {
         diverge(dynamics.failure());
         break;
       }
-      if (found.located.empty()) {
-        switches.Apply(t, y.data(), found);  // direction flips only: not stick-slip switches
-        continue;
+      double ga = combined(false);
+      if (ga >= 0.0) {
+        tb = ta;  // already crossed (within the detection hysteresis) at t0
+        yb = ya;
       }
-      // A switch happened inside [t0, t]: bisect to locate it within
-      // switch_time_tolerance_s, restarting single steps from the last
-      // point known to need no switch.
-      const std::vector<int> candidates = found.located;
-      double ta = t0, tb = t;
-      std::vector<double> ya(y_saved), yb(y.data(), y.data() + dim);
+      int side = 0;  // which end the last two trials kept (Illinois)
       while (tb - ta > solver.switch_time_tolerance_s) {
-        const double tm = 0.5 * (ta + tb);
-        y_mid = ya;
-        gsl_odeiv2_step_reset(gsl.step);
-        if (gsl_odeiv2_step_apply(gsl.step, ta, tm - ta, y_mid.data(), y_err.data(), nullptr,
-                                  nullptr, &system) != GSL_SUCCESS) {
+        double tm = ta + (tb - ta) * ga / (ga - gb);
+        const double margin = 0.25 * solver.switch_time_tolerance_s;
+        if (!(tm > ta + margin && tm < tb - margin)) tm = 0.5 * (ta + tb);
+        if (try_step(ta, ya.data(), dydt_a.data(), tm - ta, y_mid.data(), dydt_mid.data()) !=
+            GSL_SUCCESS) {
           break;
         }
-        if (switches.Scan(tm, y_mid.data(), &found, /*locating=*/true, &candidates) &&
-            !found.located.empty()) {
+        const double gm = combined(false);
+        if (gm >= 0.0) {
           tb = tm;
           yb = y_mid;
+          gb = gm;
+          if (side == +1) ga *= 0.5;
+          side = +1;
         } else {
           ta = tm;
           ya = y_mid;
+          std::swap(dydt_a, dydt_mid);
+          ga = gm;
+          if (side == -1) gb *= 0.5;
+          side = -1;
         }
       }
       t = tb;
       std::copy(yb.begin(), yb.end(), y.data());
-      // Switch the located nodes, then re-check: a node that has just stuck
-      // may at once need more friction than it can hold (a reversal), and so on.
       if (switches.Scan(t, y.data(), &found, /*locating=*/true, &candidates)) {
         summary.stick_slip_switches += switches.Apply(t, y.data(), found);
       }
-      for (int pass = 0; pass < 8 && switches.Scan(t, y.data(), &found) && found.any(); ++pass) {
-        summary.stick_slip_switches += switches.Apply(t, y.data(), found);
-      }
-      gsl.Reset();
+      settle_modes();
     }
     if (!summary.completed) break;
     if (!y.allFinite()) {
@@ -427,7 +514,7 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
   summary.simulated_s = t;
   summary.wall_time_s = wall_seconds();
   summary.real_time_factor = summary.wall_time_s > 0 ? t / summary.wall_time_s : 0.0;
-  summary.rejected_steps = static_cast<std::int64_t>(gsl.evolve->failed_steps);
+  summary.rejected_steps = rejected;
   summary.rhs_evaluations = dynamics.evaluations();
 
   SimulationResult result;
