@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "ccsrm/common/atomic_file.h"
@@ -42,6 +43,9 @@ void RefuseToOverwrite(const std::string& input, const std::string& output) {
 struct Layout {
   mocap::MarkerLayout layout;
   std::string config_yaml;  // the configuration text, when --config was given
+  // Joint positions of the arm, from --config or else the experiment's
+  // nominal configuration; none when neither is there.
+  std::optional<mocap::JointChain> chain;
 };
 
 // The rigid bodies: --rigid-bodies, else the default layout of --config, else
@@ -54,7 +58,11 @@ Layout ResolveLayout(const std::string& rigid_bodies, const std::string& config,
   if (!config.empty()) {
     out.config_yaml = ReadTextFile(config);
     model = std::make_unique<sim::ArmModel>(sim::ParseConfig(out.config_yaml, config));
+  } else if (experiment != nullptr && !experiment->config_yaml.empty()) {
+    model = std::make_unique<sim::ArmModel>(
+        sim::ParseConfig(experiment->config_yaml, input + ": attribute 'config_yaml'"));
   }
+  if (model) out.chain = mocap::JointChain::FromModel(*model);
   if (!rigid_bodies.empty()) {
     out.layout = mocap::ReadRigidBodiesFile(rigid_bodies);
   } else if (model) {
@@ -136,8 +144,8 @@ void RunProcess(const ProcessArgs& a) {
 
   const Layout layout = ResolveLayout(a.rigid_bodies, a.config, a.static_trial,
                                       from_experiment ? &experiment : nullptr, a.in);
-  const mocap::ProcessingResult result =
-      mocap::ProcessMarkers(table, time, layout.layout, a.options, a.in);
+  const mocap::ProcessingResult result = mocap::ProcessMarkers(
+      table, time, layout.layout, a.options, a.in, layout.chain ? &*layout.chain : nullptr);
 
   if (!from_experiment) {
     experiment.name = fs::path(a.out).stem().string();

@@ -12,6 +12,7 @@
 #include "ccsrm/mocap/rigid_bodies.h"
 #include "ccsrm/mocap/signal.h"
 #include "ccsrm/sim/kinematics.h"
+#include "chain_fit.h"
 
 namespace ccsrm::mocap {
 namespace {
@@ -190,9 +191,89 @@ Eigen::Isometry3d FitRigidTransform(const std::vector<Eigen::Vector3d>& from,
   return X;
 }
 
+JointChain JointChain::FromModel(const sim::ArmModel& model) {
+  JointChain chain;
+  for (int link = 1; link <= model.num_links(); ++link) {
+    chain.p_BJ_proximal.push_back(model.p_child_joint(link));
+    // The last link has no joint beyond it: its distal point is only a
+    // lever for nothing, kept for a uniform table.
+    chain.p_BJ_distal.push_back(link < model.num_links()
+                                    ? model.p_parent_joint(link + 1)
+                                    : Eigen::Vector3d(0, 0, 0.5 * model.link(link).length_m));
+  }
+  return chain;
+}
+
+namespace internal {
+
+void FitChain(std::vector<ChainLink>* links) {
+  std::vector<ChainLink>& c = *links;
+  const std::size_t n = c.size();
+  const Eigen::Index unknowns = static_cast<Eigen::Index>(3 + 3 * n);
+  // Joint 1 of the segment, and the rotations, from the per-link fits.
+  Eigen::Vector3d t = *c[0].X_WB * c[0].p_BJ_proximal;
+  std::vector<Eigen::Matrix3d> R(n);
+  for (std::size_t i = 0; i < n; ++i) R[i] = c[i].X_WB->rotation();
+  auto skew = [](const Eigen::Vector3d& v) {
+    Eigen::Matrix3d m;
+    m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+    return m;
+  };
+  Eigen::MatrixXd JtJ(unknowns, unknowns);
+  Eigen::VectorXd Jtr(unknowns);
+  Eigen::MatrixXd Jm(3, unknowns);
+  std::vector<Eigen::Vector3d> joint(n);  // p_WJ of every link's proximal joint
+  // Gauss–Newton on t and a rotation increment per link (R ← R·exp([δ]×));
+  // the per-link fits start it within the noise, so it converges in 2–3 steps.
+  for (int iteration = 0; iteration < 10; ++iteration) {
+    JtJ.setZero();
+    Jtr.setZero();
+    joint[0] = t;
+    for (std::size_t i = 1; i < n; ++i) {
+      joint[i] = joint[i - 1] + R[i - 1] * (c[i - 1].p_BJ_distal - c[i - 1].p_BJ_proximal);
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Index columns = static_cast<Eigen::Index>(3 + 3 * (i + 1));
+      for (std::size_t m = 0; m < c[i].p_BM.size(); ++m) {
+        const Eigen::Vector3d v = c[i].p_BM[m] - c[i].p_BJ_proximal;
+        const Eigen::Vector3d r = joint[i] + R[i] * v - c[i].p_WM[m];
+        Jm.leftCols(columns).setZero();
+        Jm.leftCols<3>().setIdentity();
+        for (std::size_t k = 0; k < i; ++k) {
+          Jm.block<3, 3>(0, static_cast<Eigen::Index>(3 + 3 * k)) =
+              -R[k] * skew(c[k].p_BJ_distal - c[k].p_BJ_proximal);
+        }
+        Jm.block<3, 3>(0, static_cast<Eigen::Index>(3 + 3 * i)) = -R[i] * skew(v);
+        JtJ.topLeftCorner(columns, columns).noalias() +=
+            Jm.leftCols(columns).transpose() * Jm.leftCols(columns);
+        Jtr.head(columns).noalias() += Jm.leftCols(columns).transpose() * r;
+      }
+    }
+    const Eigen::VectorXd step = -JtJ.ldlt().solve(Jtr);
+    if (!step.allFinite()) return;  // keep the per-link fits
+    t += step.head<3>();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d delta = step.segment<3>(static_cast<Eigen::Index>(3 + 3 * i));
+      const double angle = delta.norm();
+      if (angle > 0.0) R[i] = R[i] * Eigen::AngleAxisd(angle, delta / angle).toRotationMatrix();
+    }
+    if (step.lpNorm<Eigen::Infinity>() < 1e-12) break;
+  }
+  Eigen::Vector3d p_WJ = t;
+  for (std::size_t i = 0; i < n; ++i) {
+    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+    X.linear() = R[i];
+    X.translation() = p_WJ - R[i] * c[i].p_BJ_proximal;
+    *c[i].X_WB = X;
+    p_WJ += R[i] * (c[i].p_BJ_distal - c[i].p_BJ_proximal);
+  }
+}
+
+}  // namespace internal
+
 ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<double>& time,
                                 const MarkerLayout& layout, const ProcessingOptions& options,
-                                const std::string& source) {
+                                const std::string& source, const JointChain* chain) {
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError(source, "processing options", error);
   ValidateMarkerLayout(layout, source);
@@ -328,18 +409,6 @@ ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<doub
     summary.markers[k].longest_gap_after_fill = LongestGap(gaps);
   }
 
-  // ---- Zero-lag low-pass ------------------------------------------------------
-  if (options.cutoff_hz > 0.0) {
-    const std::vector<BiquadSection> sections =
-        DesignButterworthLowPass(options.filter_order, options.cutoff_hz, rate_hz);
-    for (std::size_t k = 0; k < K; ++k) {
-      for (int axis = 0; axis < 3; ++axis) {
-        ZeroLagLowPass(sections, options.cutoff_hz, rate_hz, work.column(k, axis), F, work.stride(),
-                       static_cast<std::size_t>(options.min_filter_run_frames));
-      }
-    }
-  }
-
   // ---- World frame from the ground cluster --------------------------------------
   // The ground does not move: one transform from the markers' mean positions
   // over the whole trial averages their noise away.
@@ -383,6 +452,63 @@ ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<doub
 
   // ---- Rigid fit of every body in every frame -------------------------------------
   const std::size_t L = static_cast<std::size_t>(num_links);
+  if (chain != nullptr && options.joint_constrained_fit &&
+      (chain->p_BJ_proximal.size() < L || chain->p_BJ_distal.size() < L)) {
+    ThrowInputError(source, "joint chain",
+                    "has " + std::to_string(chain->p_BJ_proximal.size()) +
+                        " links, the rigid bodies need " + std::to_string(L));
+  }
+  // X_WB of every body in every frame where it has at least 3 markers.
+  std::vector<std::vector<std::optional<Eigen::Isometry3d>>> X_WB(
+      B, std::vector<std::optional<Eigen::Isometry3d>>(F));
+  std::vector<std::ptrdiff_t> body_of_link(L + 1, -1);
+  {
+    std::vector<Eigen::Vector3d> from, to;
+    for (std::size_t b = 0; b < B; ++b) {
+      const RigidBody& body = layout.bodies[b];
+      body_of_link[static_cast<std::size_t>(body.link)] = static_cast<std::ptrdiff_t>(b);
+      for (std::size_t f = 0; f < F; ++f) {
+        from.clear();
+        to.clear();
+        for (std::size_t m = 0; m < body.marker_names.size(); ++m) {
+          if (work.finite(f, offset[b] + m)) {
+            from.push_back(body.p_BM[m]);
+            to.push_back(work.get(f, offset[b] + m));
+          }
+        }
+        if (from.size() >= 3) X_WB[b][f] = FitRigidTransform(from, to);
+      }
+    }
+  }
+  if (chain != nullptr && options.joint_constrained_fit) {
+    summary.joint_constrained = true;
+    std::vector<internal::ChainLink> segment;
+    for (std::size_t f = 0; f < F; ++f) {
+      // Runs of consecutive links that all have a pose in this frame.
+      std::size_t link = 1;
+      while (link <= L) {
+        segment.clear();
+        while (link <= L && body_of_link[link] >= 0 &&
+               X_WB[static_cast<std::size_t>(body_of_link[link])][f]) {
+          const std::size_t b = static_cast<std::size_t>(body_of_link[link]);
+          internal::ChainLink c;
+          c.p_BJ_proximal = chain->p_BJ_proximal[link - 1];
+          c.p_BJ_distal = chain->p_BJ_distal[link - 1];
+          c.X_WB = &*X_WB[b][f];
+          for (std::size_t m = 0; m < layout.bodies[b].marker_names.size(); ++m) {
+            if (work.finite(f, offset[b] + m)) {
+              c.p_BM.push_back(layout.bodies[b].p_BM[m]);
+              c.p_WM.push_back(work.get(f, offset[b] + m));
+            }
+          }
+          segment.push_back(std::move(c));
+          ++link;
+        }
+        if (segment.size() >= 2) internal::FitChain(&segment);
+        if (segment.empty()) ++link;
+      }
+    }
+  }
   result.link_pose = datasets::Array({F, L, 7}, kNaN);
   result.marker_residual = datasets::Array({F, K}, kNaN);
   // R_WB of every link in every frame (identity for the ground, link 0), valid where fitted.
@@ -392,55 +518,43 @@ ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<doub
   summary.bodies.resize(B);
   std::vector<double> marker_sum_sq(K, 0.0);
   std::vector<std::size_t> marker_count(K, 0);
-  {
-    std::vector<Eigen::Vector3d> from, to;
-    std::vector<std::size_t> which;
-    for (std::size_t b = 0; b < B; ++b) {
-      const RigidBody& body = layout.bodies[b];
-      BodyQuality& q = summary.bodies[b];
-      q.name = body.name;
-      q.link = body.link;
-      double sum_sq = 0.0;
-      std::size_t count = 0;
-      for (std::size_t f = 0; f < F; ++f) {
-        if (whole_loss[b][f]) {
-          ++q.whole_loss_frames;
-          if (f == 0 || !whole_loss[b][f - 1]) ++q.whole_loss_runs;
-        }
-        from.clear();
-        to.clear();
-        which.clear();
-        for (std::size_t m = 0; m < body.marker_names.size(); ++m) {
-          if (work.finite(f, offset[b] + m)) {
-            from.push_back(body.p_BM[m]);
-            to.push_back(work.get(f, offset[b] + m));
-            which.push_back(offset[b] + m);
-          }
-        }
-        if (from.size() < 3) {
-          ++q.frames_lost;
-          continue;
-        }
-        const Eigen::Isometry3d X_WB = FitRigidTransform(from, to);
-        for (std::size_t i = 0; i < from.size(); ++i) {
-          const double residual = (X_WB * from[i] - to[i]).norm();
-          result.marker_residual.at(f, which[i]) = residual;
-          if (raw.finite(f, which[i])) {  // only seen samples: filled ones fit by construction
-            sum_sq += residual * residual;
-            ++count;
-            marker_sum_sq[which[i]] += residual * residual;
-            ++marker_count[which[i]];
-          }
-        }
-        if (body.link == 0) continue;  // the ground's frame is W by construction
-        const std::size_t l = static_cast<std::size_t>(body.link - 1);
-        R_WB[l + 1][f] = X_WB.rotation();
-        const Eigen::Vector3d p_WB = X_WB.translation();
-        for (int axis = 0; axis < 3; ++axis) result.link_pose.at(f, l, axis) = p_WB[axis];
-        StoreQuaternion(X_WB.rotation(), &result.link_pose.values[(f * L + l) * 7 + 3]);
+  for (std::size_t b = 0; b < B; ++b) {
+    const RigidBody& body = layout.bodies[b];
+    BodyQuality& q = summary.bodies[b];
+    q.name = body.name;
+    q.link = body.link;
+    double sum_sq = 0.0;
+    std::size_t count = 0;
+    for (std::size_t f = 0; f < F; ++f) {
+      if (whole_loss[b][f]) {
+        ++q.whole_loss_frames;
+        if (f == 0 || !whole_loss[b][f - 1]) ++q.whole_loss_runs;
       }
-      q.fit_rms_m = count > 0 ? std::sqrt(sum_sq / static_cast<double>(count)) : kNaN;
+      if (!X_WB[b][f]) {
+        ++q.frames_lost;
+        continue;
+      }
+      const Eigen::Isometry3d& X = *X_WB[b][f];
+      for (std::size_t m = 0; m < body.marker_names.size(); ++m) {
+        const std::size_t k = offset[b] + m;
+        if (!work.finite(f, k)) continue;
+        const double residual = (X * body.p_BM[m] - work.get(f, k)).norm();
+        result.marker_residual.at(f, k) = residual;
+        if (raw.finite(f, k)) {  // only seen samples: filled ones fit by construction
+          sum_sq += residual * residual;
+          ++count;
+          marker_sum_sq[k] += residual * residual;
+          ++marker_count[k];
+        }
+      }
+      if (body.link == 0) continue;  // the ground's frame is W by construction
+      const std::size_t l = static_cast<std::size_t>(body.link - 1);
+      R_WB[l + 1][f] = X.rotation();
+      const Eigen::Vector3d p_WB = X.translation();
+      for (int axis = 0; axis < 3; ++axis) result.link_pose.at(f, l, axis) = p_WB[axis];
+      StoreQuaternion(X.rotation(), &result.link_pose.values[(f * L + l) * 7 + 3]);
     }
+    q.fit_rms_m = count > 0 ? std::sqrt(sum_sq / static_cast<double>(count)) : kNaN;
   }
   for (std::size_t k = 0; k < K; ++k) {
     summary.markers[k].fit_rms_m =
@@ -453,24 +567,68 @@ ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<doub
   result.joint_twist = datasets::Array({F, L}, kNaN);
   summary.joints.resize(L);
   for (std::size_t j = 0; j < L; ++j) {
-    JointQuality& q = summary.joints[j];
-    q.joint = static_cast<int>(j + 1);
-    double max_twist = kNaN;
+    summary.joints[j].joint = static_cast<int>(j + 1);
     for (std::size_t f = 0; f < F; ++f) {
       const auto& parent = R_WB[j][f];
       const auto& child = R_WB[j + 1][f];
       if (!parent || !child) {
-        ++q.frames_lost;
+        ++summary.joints[j].frames_lost;
         continue;
       }
       const Eigen::Vector3d angles = sim::CardanXyzAngles(parent->transpose() * *child);
       result.joint_angles.at(f, j, 0) = angles[0];
       result.joint_angles.at(f, j, 1) = angles[1];
       result.joint_twist.at(f, j) = angles[2];
-      max_twist =
-          std::isnan(max_twist) ? std::abs(angles[2]) : std::max(max_twist, std::abs(angles[2]));
     }
-    q.max_abs_twist_rad = max_twist;
+  }
+
+  // ---- Zero-lag low-pass of the fitted motion ------------------------------------
+  // After the fit, not before: smoothing the markers of a swinging link pulls
+  // them inside their arcs, which a rigid (and joint-constrained) fit can
+  // only absorb by turning the link. The joint angles stay small, so
+  // filtering them is filtering the markers' information linearly.
+  if (options.cutoff_hz > 0.0) {
+    const std::vector<BiquadSection> sections =
+        DesignButterworthLowPass(options.filter_order, options.cutoff_hz, rate_hz);
+    const auto min_run = static_cast<std::size_t>(options.min_filter_run_frames);
+    auto filter_columns = [&](datasets::Array* array) {
+      const std::size_t columns = array->size() / F;
+      for (std::size_t c = 0; c < columns; ++c) {
+        ZeroLagLowPass(sections, options.cutoff_hz, rate_hz, array->values.data() + c, F, columns,
+                       min_run);
+      }
+    };
+    filter_columns(&result.joint_angles);
+    filter_columns(&result.joint_twist);
+    // Poses: positions, and quaternion components (one hemisphere along time,
+    // renormalised after), which is exact to first order for smooth motion.
+    for (std::size_t l = 0; l < L; ++l) {
+      for (std::size_t f = 1; f < F; ++f) {
+        double* q = &result.link_pose.values[(f * L + l) * 7 + 3];
+        const double* previous = q - L * 7;
+        if (!std::isfinite(q[0]) || !std::isfinite(previous[0])) continue;
+        if (q[0] * previous[0] + q[1] * previous[1] + q[2] * previous[2] + q[3] * previous[3] < 0) {
+          for (int i = 0; i < 4; ++i) q[i] = -q[i];
+        }
+      }
+    }
+    filter_columns(&result.link_pose);
+    for (std::size_t f = 0; f < F; ++f) {
+      for (std::size_t l = 0; l < L; ++l) {
+        double* q = &result.link_pose.values[(f * L + l) * 7 + 3];
+        const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        for (int i = 0; i < 4; ++i) q[i] /= norm;
+      }
+    }
+  }
+  for (std::size_t j = 0; j < L; ++j) {
+    double max_twist = kNaN;
+    for (std::size_t f = 0; f < F; ++f) {
+      const double twist = std::abs(result.joint_twist.at(f, j));
+      if (std::isfinite(twist))
+        max_twist = std::isnan(max_twist) ? twist : std::max(max_twist, twist);
+    }
+    summary.joints[j].max_abs_twist_rad = max_twist;
   }
 
   result.markers = datasets::Array({F, K, 3});
@@ -515,6 +673,10 @@ std::string ProcessingSummary::FullReport() const {
   std::ostringstream out;
   char line[256];
   out << "mocap processing: " << BriefReport() << "\n";
+  out << "  link fits: "
+      << (joint_constrained ? "joint-constrained chain (joint centres shared)"
+                            : "each link on its own (no arm configuration given)")
+      << "\n";
   out << "  world frame: "
       << (world_from_ground ? "from the ground cluster (fit RMS " + Mm(ground_fit_rms_m) + " mm)"
                             : std::string("the file's frame"))

@@ -35,6 +35,24 @@ void FilterPass(const std::vector<BiquadSection>& sections, double* y, std::size
   }
 }
 
+// Value at x[0] of the least-squares line through x[0], x[step], ...,
+// x[(m-1)·step] (step = ±1): the end of a run with its noise averaged.
+double EndPivot(const double* x, std::size_t m, int step) {
+  if (m < 2) return x[0];
+  double sum_i = 0.0, sum_ii = 0.0, sum_x = 0.0, sum_ix = 0.0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const double v = x[static_cast<std::ptrdiff_t>(i) * step];
+    const double di = static_cast<double>(i);
+    sum_i += di;
+    sum_ii += di * di;
+    sum_x += v;
+    sum_ix += di * v;
+  }
+  const double count = static_cast<double>(m);
+  const double slope = (count * sum_ix - sum_i * sum_x) / (count * sum_ii - sum_i * sum_i);
+  return (sum_x - slope * sum_i) / count;
+}
+
 // GSL's default error handler aborts; the callers here check every input, so
 // a GSL error is a bug, but it must never take a user's program down silently.
 struct GslHandlerOff {
@@ -130,15 +148,23 @@ std::size_t FiltFiltPadding(double cutoff_hz, double sample_rate_hz, std::size_t
   return n == 0 ? 0 : std::min(pad, n - 1);
 }
 
-void FiltFilt(const std::vector<BiquadSection>& sections, double* x, std::size_t n,
-              std::size_t pad) {
+std::size_t FiltFiltEndWindow(double cutoff_hz, double sample_rate_hz, std::size_t n) {
+  const auto window = static_cast<std::size_t>(std::ceil(0.5 * sample_rate_hz / cutoff_hz));
+  return std::max<std::size_t>(1, std::min(window, n));
+}
+
+void FiltFilt(const std::vector<BiquadSection>& sections, double* x, std::size_t n, std::size_t pad,
+              std::size_t end_window) {
   if (n < 2) return;
   pad = std::min(pad, n - 1);
-  // Odd reflection: x[-i] = 2·x[0] - x[i], x[n-1+i] = 2·x[n-1] - x[n-1-i].
+  end_window = std::clamp<std::size_t>(end_window, 1, n);
+  const double first = EndPivot(x, end_window, 1);
+  const double last = EndPivot(x + n - 1, end_window, -1);
+  // Odd reflection: x[-i] = 2·first - x[i], x[n-1+i] = 2·last - x[n-1-i].
   std::vector<double> y(n + 2 * pad);
   for (std::size_t i = 0; i < pad; ++i) {
-    y[i] = 2.0 * x[0] - x[pad - i];
-    y[pad + n + i] = 2.0 * x[n - 1] - x[n - 2 - i];
+    y[i] = 2.0 * first - x[pad - i];
+    y[pad + n + i] = 2.0 * last - x[n - 2 - i];
   }
   std::copy(x, x + n, y.begin() + static_cast<std::ptrdiff_t>(pad));
   FilterPass(sections, y.data(), y.size());
@@ -168,7 +194,8 @@ void ZeroLagLowPass(const std::vector<BiquadSection>& sections, double cutoff_hz
     run.resize(end - i);
     for (std::size_t j = i; j < end; ++j) run[j - i] = x[j * stride];
     FiltFilt(sections, run.data(), run.size(),
-             FiltFiltPadding(cutoff_hz, sample_rate_hz, run.size()));
+             FiltFiltPadding(cutoff_hz, sample_rate_hz, run.size()),
+             FiltFiltEndWindow(cutoff_hz, sample_rate_hz, run.size()));
     for (std::size_t j = i; j < end; ++j) x[j * stride] = run[j - i];
     i = end;
   }

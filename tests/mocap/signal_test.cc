@@ -62,8 +62,9 @@ TEST(ZeroLagLowPass, SineWellBelowTheCutoffPassesWithNoPhaseLag) {
   const auto sections = DesignButterworthLowPass(2, 2.0, kRate);
   ZeroLagLowPass(sections, 2.0, kRate, x.data(), n);
   // Gain² of order 2 at 0.25 Hz of 2 Hz: 1 / (1 + 0.125⁴) = 0.99976, so
-  // away from the ends the error is that loss; at the ends the odd reflection
-  // continues level and slope but not curvature (≈ x''/ωc² ≈ 0.2 %).
+  // away from the ends the error is that loss; at the ends the pivot (a line
+  // through half a cutoff period) and the odd reflection carry level and
+  // slope but not curvature: about x''·(0.25 s)²/12 ≈ 0.5 % here.
   double worst_middle = 0.0, worst = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     const double error = std::abs(x[i] - original[i]);
@@ -71,7 +72,7 @@ TEST(ZeroLagLowPass, SineWellBelowTheCutoffPassesWithNoPhaseLag) {
     if (i >= 100 && i + 100 < n) worst_middle = std::max(worst_middle, error);
   }
   EXPECT_LT(worst_middle, 5e-4);
-  EXPECT_LT(worst, 0.003);
+  EXPECT_LT(worst, 0.008);
   // In-phase and quadrature parts over three whole periods: any lag shows
   // as a quadrature part.
   double in_phase = 0.0, quadrature = 0.0;

@@ -19,6 +19,7 @@
 #include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/mocap/marker_layout.h"
 #include "ccsrm/mocap/marker_table.h"
+#include "ccsrm/sim/model.h"
 
 namespace ccsrm::mocap {
 
@@ -32,19 +33,30 @@ struct ProcessingOptions {
   // Fill what the spline cannot (longer gaps, gaps at either end) from the
   // body's other markers in the same frame (at least 3 of them).
   bool rigid_fill = true;
-  // Zero-lag Butterworth low-pass applied to every marker coordinate
-  // (forward–backward, so -6 dB at the cutoff); cutoff_hz = 0 turns it off.
-  // Default 2 Hz, order 2: with the 6 cm plates of the default layout a
-  // 0.2 mm marker noise gives 0.2–0.3 deg per frame on θx and θy, and the
-  // forward–backward pass keeps about 1.1·fc of the 50 Hz noise band, so
-  // the noise falls to ~0.05 deg and below; the paper's protocol (quintic
-  // ramps of 20 s) has no content near 2 Hz, and even a 2 s ramp loses only
-  // a few thousandths of a degree (tests/mocap/round_trip_test.cc).
-  double cutoff_hz = 2.0;
+  // Zero-lag Butterworth low-pass (forward–backward, so -6 dB at the cutoff)
+  // of the fitted motion: joint angles, twists and link poses; cutoff_hz = 0
+  // turns it off. Default 1 Hz, order 2. With the 6 cm plates of the default
+  // layout a 0.2 mm marker noise leaves about 0.25 deg per frame on θx, θy
+  // after the joint-constrained fit (0.4 deg with independent link fits);
+  // the forward–backward pass keeps about 1.1·fc of the 50 Hz noise band,
+  // so at 1 Hz the noise falls below 0.05 deg RMS. The paper's protocol
+  // (quintic ramps of 20 s) has almost nothing above 0.2 Hz; ramps of 6 s
+  // lose about 0.02 deg RMS of the arm's own small oscillations
+  // (tests/mocap/round_trip_test.cc). Faster motions need a higher cutoff
+  // and accept more noise.
+  double cutoff_hz = 1.0;
   int filter_order = 2;  // per pass, 1..8
   // Finite runs shorter than this (frames) are not filtered: too short for
   // a meaningful low-pass.
   int min_filter_run_frames = 4;
+  // When the joint positions are known (a JointChain is given), fit each
+  // frame's consecutive links together with their joint centres shared
+  // (spherical joints: every link keeps three rotations, so the twist stays
+  // a check), by Gauss–Newton from the per-link fits. A plate alone fixes a
+  // link's rotation about y' poorly (its markers spread 6 cm along z' but
+  // under 1 cm along x'); the joints 8.5–10 cm apart add that lever and
+  // roughly halve the joint-angle noise.
+  bool joint_constrained_fit = true;
 
   // Checks ranges; on failure returns false with the reason in *error.
   bool IsValid(std::string* error) const;
@@ -90,6 +102,8 @@ struct JointQuality {
 struct ProcessingSummary {
   std::size_t frames = 0;
   double rate_hz = 0.0;
+  // True when the links were fitted as a chain with shared joint centres.
+  bool joint_constrained = false;
   // True when the ground cluster fixed the world frame W; false: the file
   // frame is W (no ground body, or fewer than 3 of its markers seen).
   bool world_from_ground = false;
@@ -112,8 +126,8 @@ struct ProcessingResult {
   datasets::Array link_pose;     // F × L × 7: x, y, z [m], e0..e3 (body to world)
   datasets::Array joint_angles;  // F × J × 2: θx, θy [rad]
   datasets::Array joint_twist;   // F × J: third angle of Rx·Ry·Rz [rad]
-  // The markers as used for the fits: filled, filtered, in W (F × K × 3, m),
-  // and the fit residual of each (F × K, m; NaN where not fitted).
+  // The markers as used for the fits: filled, in W (F × K × 3, m), and the
+  // fit residual of each (F × K, m; NaN where not fitted), before filtering.
   datasets::Array markers;
   datasets::Array marker_residual;
   // The raw input markers of the layout (unfilled, unfiltered) mapped into W
@@ -121,6 +135,15 @@ struct ProcessingResult {
   datasets::Array raw_markers;
   std::vector<std::string> marker_names;  // K, layout order
   ProcessingSummary summary;
+};
+
+// Where the joints sit on the links: joint i (1-based) at p_BJ_proximal[i-1]
+// in link i's frame and joint i+1 at p_BJ_distal[i-1] (SPEC 2: z' = ∓L/2).
+struct JointChain {
+  std::vector<Eigen::Vector3d> p_BJ_proximal;
+  std::vector<Eigen::Vector3d> p_BJ_distal;
+
+  static JointChain FromModel(const sim::ArmModel& model);
 };
 
 // Column of `table` for each name: the label equal to it, else the one label
@@ -138,13 +161,16 @@ Eigen::Isometry3d FitRigidTransform(const std::vector<Eigen::Vector3d>& from,
 
 // Processes a table of F frames at the times `time` (F values, strictly
 // increasing and uniformly spaced within 1 %: the filter needs a fixed rate;
-// empty = frame i at i / table.rate_hz). `source` names the input in errors.
-// Throws InputError for invalid options, a bad time base, a layout that does
-// not validate or no layout marker in the table. Lost frames and missing
-// markers are numerical outcomes: NaN in the result, counted in the summary.
+// empty = frame i at i / table.rate_hz). `chain` (may be null: every link is
+// then fitted on its own) gives the joint positions for the joint-constrained
+// fit; it must cover every link of the layout. `source` names the input in
+// errors. Throws InputError for invalid options, a bad time base, a layout
+// that does not validate, a chain shorter than the layout's links, or no
+// layout marker in the table. Lost frames and missing markers are numerical
+// outcomes: NaN in the result, counted in the summary.
 ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<double>& time,
                                 const MarkerLayout& layout, const ProcessingOptions& options,
-                                const std::string& source);
+                                const std::string& source, const JointChain* chain = nullptr);
 
 // Records the result in an experiment file: /measured/joint_angles,
 // /measured/link_pose, /measured/joint_twist and the quality figures under

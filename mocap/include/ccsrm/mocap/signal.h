@@ -28,20 +28,28 @@ std::vector<BiquadSection> DesignButterworthLowPass(int order, double cutoff_hz,
 // three cutoff periods, so the start-up transient dies out in the padding.
 std::size_t FiltFiltPadding(double cutoff_hz, double sample_rate_hz, std::size_t n);
 
+// Samples of the straight-line fit that fixes each end's pivot: half a
+// cutoff period (at most n), short enough for the signal to be nearly linear
+// there, long enough to average the noise of the end sample away.
+std::size_t FiltFiltEndWindow(double cutoff_hz, double sample_rate_hz, std::size_t n);
+
 // Zero-lag filtering of x[0..n) in place: the cascade forward, then backward
 // (so the phase cancels and the gain is squared: -6 dB at the cutoff). Each
-// end is padded with `pad` samples (capped at n - 1) reflected oddly about the
-// end sample, which continues the signal's level and slope, and every pass
-// starts from the steady state of its first sample: a constant passes
+// end is padded with `pad` samples (capped at n - 1) reflected oddly about a
+// pivot: the value at the end of a least-squares line through the first (or
+// last) `end_window` samples. Reflecting about the raw end sample instead
+// (end_window = 1, scipy's filtfilt) pins the output to that sample's noise
+// there. The reflection continues the signal's level and slope, and every
+// pass starts from the steady state of its first sample: a constant passes
 // unchanged, a ramp with a start-up error that decays inside the padding.
 // Requires finite samples; n < 2 leaves x as it is.
-void FiltFilt(const std::vector<BiquadSection>& sections, double* x, std::size_t n,
-              std::size_t pad);
+void FiltFilt(const std::vector<BiquadSection>& sections, double* x, std::size_t n, std::size_t pad,
+              std::size_t end_window = 1);
 
 // Zero-lag low-pass of a signal with NaN gaps: every run of at least min_run
-// finite samples is filtered on its own (FiltFilt, padding from
-// FiltFiltPadding); shorter runs stay as they are, NaN stays NaN. `stride` is
-// the distance between consecutive samples in `x`.
+// finite samples is filtered on its own (FiltFilt, padding and end window
+// from FiltFiltPadding and FiltFiltEndWindow); shorter runs stay as they are, NaN stays NaN.
+// `stride` is the distance between consecutive samples in `x`.
 void ZeroLagLowPass(const std::vector<BiquadSection>& sections, double cutoff_hz,
                     double sample_rate_hz, double* x, std::size_t n, std::size_t stride = 1,
                     std::size_t min_run = 2);
