@@ -58,6 +58,7 @@ std::string TruthYaml(const GenerateArgs& a, const sim::Config& truth, double du
                       const mocap::VirtualRecordingOptions& recording,
                       const mocap::VirtualExperiment& generated) {
   YAML::Emitter out;
+  out.SetDoublePrecision(12);  // 0.05, not 0.050000000000000003
   out << YAML::Comment(
       "Ground truth of a generated experiment (ccsrm generate). No fitting code reads this.");
   out << YAML::BeginMap;
