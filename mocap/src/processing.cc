@@ -221,10 +221,14 @@ void FitChain(std::vector<ChainLink>* links) {
   };
   Eigen::MatrixXd JtJ(unknowns, unknowns);
   Eigen::VectorXd Jtr(unknowns);
-  Eigen::MatrixXd Jm(3, unknowns);
+  Eigen::MatrixXd A(3, unknowns);         // the Jacobian columns every marker of a link shares
   std::vector<Eigen::Vector3d> joint(n);  // p_WJ of every link's proximal joint
   // Gauss–Newton on t and a rotation increment per link (R ← R·exp([δ]×));
   // the per-link fits start it within the noise, so it converges in 2–3 steps.
+  // A marker m on link i predicts p_WJi + R_i·v_m (v_m = p_BM - p_BJ): its
+  // Jacobian row block is [A_i | H_m] with A_i = [I, -R_0[d_0]×, ...,
+  // -R_(i-1)[d_(i-1)]×] (d = distal - proximal joint) shared by the link's
+  // markers, and H_m = -R_i[v_m]×, so the normal equations take per-link sums.
   for (int iteration = 0; iteration < 10; ++iteration) {
     JtJ.setZero();
     Jtr.setZero();
@@ -232,22 +236,33 @@ void FitChain(std::vector<ChainLink>* links) {
     for (std::size_t i = 1; i < n; ++i) {
       joint[i] = joint[i - 1] + R[i - 1] * (c[i - 1].p_BJ_distal - c[i - 1].p_BJ_proximal);
     }
+    A.leftCols<3>().setIdentity();
     for (std::size_t i = 0; i < n; ++i) {
-      const Eigen::Index columns = static_cast<Eigen::Index>(3 + 3 * (i + 1));
+      const Eigen::Index shared = static_cast<Eigen::Index>(3 + 3 * i);
+      if (i > 0) {
+        A.block<3, 3>(0, shared - 3) =
+            -R[i - 1] * skew(c[i - 1].p_BJ_distal - c[i - 1].p_BJ_proximal);
+      }
+      Eigen::Vector3d sum_r = Eigen::Vector3d::Zero(), sum_Hr = Eigen::Vector3d::Zero();
+      Eigen::Matrix3d sum_H = Eigen::Matrix3d::Zero(), sum_HH = Eigen::Matrix3d::Zero();
       for (std::size_t m = 0; m < c[i].p_BM.size(); ++m) {
         const Eigen::Vector3d v = c[i].p_BM[m] - c[i].p_BJ_proximal;
         const Eigen::Vector3d r = joint[i] + R[i] * v - c[i].p_WM[m];
-        Jm.leftCols(columns).setZero();
-        Jm.leftCols<3>().setIdentity();
-        for (std::size_t k = 0; k < i; ++k) {
-          Jm.block<3, 3>(0, static_cast<Eigen::Index>(3 + 3 * k)) =
-              -R[k] * skew(c[k].p_BJ_distal - c[k].p_BJ_proximal);
-        }
-        Jm.block<3, 3>(0, static_cast<Eigen::Index>(3 + 3 * i)) = -R[i] * skew(v);
-        JtJ.topLeftCorner(columns, columns).noalias() +=
-            Jm.leftCols(columns).transpose() * Jm.leftCols(columns);
-        Jtr.head(columns).noalias() += Jm.leftCols(columns).transpose() * r;
+        const Eigen::Matrix3d H = -R[i] * skew(v);
+        sum_r += r;
+        sum_H += H;
+        sum_HH.noalias() += H.transpose() * H;
+        sum_Hr.noalias() += H.transpose() * r;
       }
+      const double count = static_cast<double>(c[i].p_BM.size());
+      const auto Ai = A.leftCols(shared);
+      JtJ.topLeftCorner(shared, shared).noalias() += count * Ai.transpose() * Ai;
+      const Eigen::MatrixXd cross = Ai.transpose() * sum_H;
+      JtJ.block(0, shared, shared, 3) += cross;
+      JtJ.block(shared, 0, 3, shared) += cross.transpose();
+      JtJ.block<3, 3>(shared, shared) += sum_HH;
+      Jtr.head(shared).noalias() += Ai.transpose() * sum_r;
+      Jtr.segment<3>(shared) += sum_Hr;
     }
     const Eigen::VectorXd step = -JtJ.ldlt().solve(Jtr);
     if (!step.allFinite()) return;  // keep the per-link fits
@@ -257,7 +272,7 @@ void FitChain(std::vector<ChainLink>* links) {
       const double angle = delta.norm();
       if (angle > 0.0) R[i] = R[i] * Eigen::AngleAxisd(angle, delta / angle).toRotationMatrix();
     }
-    if (step.lpNorm<Eigen::Infinity>() < 1e-12) break;
+    if (step.lpNorm<Eigen::Infinity>() < 1e-10) break;  // rad and m: far below the noise
   }
   Eigen::Vector3d p_WJ = t;
   for (std::size_t i = 0; i < n; ++i) {
