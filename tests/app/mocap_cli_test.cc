@@ -13,6 +13,8 @@
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/datasets/run_file.h"
+#include "ccsrm/mocap/c3d.h"
+#include "ccsrm/mocap/marker_io.h"
 
 namespace {
 namespace fs = std::filesystem;
@@ -246,6 +248,36 @@ TEST(MocapProcess, ConfigOrRigidBodiesFileGiveTheSimulatedAngles) {
                (dir / "x.h5").string());
   EXPECT_EQ(o.status, 2);
   EXPECT_THAT(o.err, HasSubstr("give --rigid-bodies FILE or --config FILE"));
+}
+
+TEST(MocapProcess, C3dFileBecomesANewExperimentWithOrWithoutInputs) {
+  const fs::path dir = FreshDir("c3d_new");
+  const std::string exp = (Generated() / "exp.h5").string();
+  const std::string c3d = (dir / "recording.c3d").string();
+  ccsrm::mocap::WriteC3d(c3d, ccsrm::mocap::ReadMarkerFile(exp));
+  const std::string bare = (dir / "bare.h5").string();
+  Outcome o =
+      RunCcsrm("mocap process --quiet --in " + c3d + " --config " + Paper() + " --out " + bare);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const auto a = ccsrm::datasets::ReadExperimentFile(bare);
+  EXPECT_EQ(a.source, ccsrm::datasets::ExperimentSource::kRecorded);
+  EXPECT_EQ(a.config_yaml, ccsrm::ReadTextFile(Paper()));
+  EXPECT_EQ(a.input_length_change.shape, (std::vector<std::size_t>{1, 0}));  // no actuator record
+  EXPECT_EQ(a.marker_names.size(), 52u);
+  EXPECT_EQ(a.measured_joint_angles->shape, (std::vector<std::size_t>{31, 12, 2}));
+  const std::string with_inputs = (dir / "with_inputs.h5").string();
+  o = RunCcsrm("mocap process --quiet --in " + c3d + " --config " + Paper() + " --inputs " + exp +
+               " --out " + with_inputs);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_EQ(ccsrm::datasets::ReadExperimentFile(with_inputs).input_length_change.shape,
+            (std::vector<std::size_t>{31, 6}));
+  // A static trial: the first 0.3 s of the protocol barely move the arm, so
+  // the refined positions stay within a fraction of a millimetre.
+  const std::string rb = (dir / "refined.yaml").string();
+  o = RunCcsrm("mocap rigid-bodies --config " + Paper() + " --static-trial " +
+               (Generated() / "exp.truth.h5").string() + " --out " + rb);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_THAT(o.out, HasSubstr("marker positions refined (largest change 0.0"));
 }
 
 TEST(MocapProcess, BadRigidBodiesFileIsOneLineNamingLineAndKey) {
