@@ -98,6 +98,7 @@ struct ProcessArgs {
   std::string inputs;
   std::string out;
   mocap::ProcessingOptions options;
+  bool no_rigid_fill = false;
   bool quiet = false;
 };
 
@@ -115,7 +116,8 @@ void CopyInputs(const std::string& path, datasets::ExperimentFile* experiment) {
   }
 }
 
-void RunProcess(const ProcessArgs& a) {
+void RunProcess(ProcessArgs a) {
+  a.options.rigid_fill = !a.no_rigid_fill;
   RefuseToOverwrite(a.in, a.out);
   { const AtomicOutputFile probe(a.out); }  // fail on a bad output path before working
 
@@ -216,7 +218,9 @@ void AddMocapCommands(CLI::App& root) {
                       "Rigid bodies (ccsrm-rigid-bodies/1 YAML, mocap/README.md)");
   process->add_option("--config", a->config,
                       "Arm configuration: its default marker layout when --rigid-bodies is not "
-                      "given; stored as the experiment's config_yaml");
+                      "given, its joint positions for the joint-constrained fit (an "
+                      "experiment's own config_yaml otherwise); stored as the experiment's "
+                      "config_yaml");
   process->add_option("--static-trial", a->static_trial,
                       "Marker file of a static trial with the arm straight: refines the marker "
                       "positions (needs --config)");
@@ -232,7 +236,7 @@ void AddMocapCommands(CLI::App& root) {
                    "Longest gap filled by a spline [frames]; longer gaps are filled from the "
                    "link's other markers")
       ->default_val(defaults.max_spline_gap_frames);
-  process->add_flag("--no-rigid-fill{false}", a->options.rigid_fill,
+  process->add_flag("--no-rigid-fill", a->no_rigid_fill,
                     "Do not fill gaps from the link's other markers");
   process->add_option("--out", a->out, "Output experiment (.h5)")->required();
   process->add_flag("--quiet", a->quiet, "One summary line instead of the quality tables");
