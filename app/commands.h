@@ -9,4 +9,6 @@ void AddConfigCommands(CLI::App& root);
 void AddDatasetCommands(CLI::App& root);
 void AddSimulateCommand(CLI::App& root);
 void AddBenchCommand(CLI::App& root);
+void AddMocapCommands(CLI::App& root);
+void AddGenerateCommand(CLI::App& root);
 }  // namespace ccsrm::app

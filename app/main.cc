@@ -13,6 +13,8 @@ int main(int argc, char** argv) {
   ccsrm::app::AddDatasetCommands(root);
   ccsrm::app::AddSimulateCommand(root);
   ccsrm::app::AddBenchCommand(root);
+  ccsrm::app::AddMocapCommands(root);
+  ccsrm::app::AddGenerateCommand(root);
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

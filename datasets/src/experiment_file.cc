@@ -58,6 +58,12 @@ void VisitArrays(Experiment& experiment, Visit&& visit) {
   if (experiment.measured_input_tension) {
     visit("/measured/input_tension", "N", *experiment.measured_input_tension);
   }
+  if (experiment.measured_link_pose) {
+    visit("/measured/link_pose", "m, 1", *experiment.measured_link_pose);
+  }
+  if (experiment.measured_joint_twist) {
+    visit("/measured/joint_twist", "rad", *experiment.measured_joint_twist);
+  }
 }
 
 ExperimentSource ParseSource(const internal::FileReader& reader, const std::string& text) {
@@ -148,6 +154,21 @@ void ValidateExperimentFile(const ExperimentFile& experiment, const std::string&
   if (experiment.measured_input_tension) {
     ExpectShape(file, "/measured/input_tension", *experiment.measured_input_tension, {n, c});
   }
+  if (experiment.measured_link_pose) {
+    ExpectShape(file, "/measured/link_pose", *experiment.measured_link_pose,
+                {f, Free("L"), Fixed(7)});
+  }
+  if (experiment.measured_joint_twist) {
+    const auto twist = ExpectShape(file, "/measured/joint_twist", *experiment.measured_joint_twist,
+                                   {f, Free("J")});
+    if (experiment.measured_joint_angles &&
+        experiment.measured_joint_angles->shape[1] != twist[1]) {
+      ThrowInputError(file, "/measured/joint_twist",
+                      "expected J=" + std::to_string(experiment.measured_joint_angles->shape[1]) +
+                          " joints (from /measured/joint_angles), found " +
+                          std::to_string(twist[1]));
+    }
+  }
 }
 
 void WriteExperimentFile(const std::string& path, const ExperimentFile& experiment) {
@@ -200,6 +221,8 @@ ExperimentFile ReadExperimentFile(const std::string& path) {
   }
   if (reader.Exists("/measured/joint_angles")) experiment.measured_joint_angles.emplace();
   if (reader.Exists("/measured/input_tension")) experiment.measured_input_tension.emplace();
+  if (reader.Exists("/measured/link_pose")) experiment.measured_link_pose.emplace();
+  if (reader.Exists("/measured/joint_twist")) experiment.measured_joint_twist.emplace();
   VisitArrays(experiment, [&](const std::string& dataset, const char* units, Array& array) {
     array = reader.ReadArray(dataset, units);
   });

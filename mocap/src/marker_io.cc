@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/datasets/inspect.h"
+#include "ccsrm/datasets/run_file.h"
 #include "ccsrm/mocap/c3d.h"
 #include "ccsrm/mocap/text_formats.h"
 #include "utf8.h"
@@ -51,7 +54,42 @@ std::string FormatNumber(double value, int precision) {
   return buffer;
 }
 
+// A table from F × M × 3 positions [m] at the given times.
+MarkerTable TableFromArray(const datasets::Array& markers, const std::vector<std::string>& names,
+                           const std::vector<double>& time, const std::string& format) {
+  MarkerTable table;
+  table.Reset(markers.rows(), names, false);
+  table.positions_m = markers.values;
+  table.format = format;
+  table.units_in_file = "m";
+  table.rate_hz =
+      time.size() >= 2 ? static_cast<double>(time.size() - 1) / (time.back() - time.front()) : 0.0;
+  // A sample is seen only when all three coordinates are (the table's rule).
+  for (std::size_t i = 0; i + 2 < table.positions_m.size(); i += 3) {
+    double* p = &table.positions_m[i];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      p[0] = p[1] = p[2] = std::nan("");
+    }
+  }
+  return table;
+}
+
 }  // namespace
+
+MarkerTable MarkerTableFromExperiment(const datasets::ExperimentFile& experiment) {
+  return TableFromArray(experiment.mocap_markers, experiment.marker_names,
+                        experiment.mocap_time.values, "ccsrm-dataset");
+}
+
+MarkerTable ReadHdf5Markers(const std::string& path) {
+  const datasets::FileSummary summary = datasets::InspectFile(path);
+  if (summary.kind == datasets::FileKind::kExperiment) {
+    return MarkerTableFromExperiment(datasets::ReadExperimentFile(path));
+  }
+  const datasets::RunFile run = datasets::ReadRunFile(path);
+  if (!run.markers) ThrowInputError(path, "/markers", "missing: this run has no virtual markers");
+  return TableFromArray(*run.markers, run.marker_names, run.time.values, "ccsrm-run");
+}
 
 MarkerTable ReadMarkerFile(const std::string& path) {
   const std::string ext = LowerExtension(path);
@@ -66,8 +104,10 @@ MarkerTable ReadMarkerFile(const std::string& path) {
                     "or a Vicon Nexus export ('Trajectories' or 'Devices'), found '" +
                         first + "'");
   }
-  ThrowInputError(path, "",
-                  "unknown marker file extension '" + ext + "': expected .c3d, .trc or .csv");
+  if (ext == ".h5" || ext == ".hdf5") return ReadHdf5Markers(path);
+  ThrowInputError(
+      path, "",
+      "unknown marker file extension '" + ext + "': expected .c3d, .trc, .csv, .h5 or .hdf5");
 }
 
 nlohmann::json InspectJson(const MarkerTable& table) {

@@ -157,6 +157,24 @@ TEST(ExperimentFileWrite, QualityFigureWithoutUnitsIsRejected) {
   EXPECT_TRUE(DirectoryEntries(dir).empty());
 }
 
+TEST(ExperimentFileRoundTrip, MeasuredLinkPoseAndTwistExtensionsRoundTrip) {
+  const fs::path dir = FreshDir("exp_measured_pose");
+  const std::string path = (dir / "exp.h5").string();
+  ExperimentFile experiment = MakeExperimentFile();
+  const std::size_t f = experiment.mocap_time.rows();
+  experiment.measured_link_pose = Ramp({f, 2, 7}, 0.01);
+  experiment.measured_joint_twist = Ramp({f, 2}, 1e-4);
+  WriteExperimentFile(path, experiment);
+  const ExperimentFile back = ReadExperimentFile(path);
+  ASSERT_TRUE(back.measured_link_pose && back.measured_joint_twist);
+  EXPECT_TRUE(Identical(*back.measured_link_pose, *experiment.measured_link_pose));
+  EXPECT_TRUE(Identical(*back.measured_joint_twist, *experiment.measured_joint_twist));
+  // A twist for another number of joints than the joint angles is refused.
+  experiment.measured_joint_twist = Ramp({f, 3}, 1e-4);
+  EXPECT_THAT(InputErrorMessage([&] { WriteExperimentFile(path, experiment); }),
+              AllOf(StartsWith(path + ": /measured/joint_twist: "), HasSubstr("expected J=2")));
+}
+
 // --- Rejection of bad files ------------------------------------------------------
 
 TEST(ExperimentFileRead, RejectsMissingMarkers) {

@@ -40,7 +40,7 @@ TEST(ReadMarkerFile, UnknownExtensionOrCsvFlavourIsAnInputError) {
   WriteFile(dir / "markers.xyz", "1 2 3\n");
   const std::string unknown = InputErrorOf([&] { ReadMarkerFile((dir / "markers.xyz").string()); });
   EXPECT_NE(unknown.find("markers.xyz"), std::string::npos);
-  EXPECT_NE(unknown.find(".c3d, .trc or .csv"), std::string::npos);
+  EXPECT_NE(unknown.find(".c3d, .trc, .csv, .h5 or .hdf5"), std::string::npos);
 
   WriteFile(dir / "table.csv", "time,x,y,z\n0,1,2,3\n");
   const std::string csv = InputErrorOf([&] { ReadMarkerFile((dir / "table.csv").string()); });

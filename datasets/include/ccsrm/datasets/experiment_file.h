@@ -62,6 +62,13 @@ struct ExperimentFile {
   // the mocap pipeline; /measured/input_tension, N × C, N, from load cells.
   std::optional<Array> measured_joint_angles;
   std::optional<Array> measured_input_tension;
+  // Extensions, written by `ccsrm mocap process` beside measured_joint_angles:
+  // /measured/link_pose, F × L × 7 (x, y, z of the mass centre in W, m;
+  // quaternion e0..e3 body to world, 1), NaN in frames where a link was lost;
+  // /measured/joint_twist, F × J, rad, the third angle of Rx·Ry·Rz of every
+  // joint (a true universal joint keeps it near zero).
+  std::optional<Array> measured_link_pose;
+  std::optional<Array> measured_joint_twist;
 };
 
 // Checks that `experiment` is a consistent ccsrm-dataset/1 record (shapes

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/mocap/marker_table.h"
 
 namespace ccsrm::mocap {
@@ -12,8 +13,20 @@ namespace ccsrm::mocap {
 // Reads a marker file, choosing the reader by extension (case-insensitive):
 // .c3d → ReadC3d, .trc → ReadTrc, .csv → ReadNexusCsv or ReadMotiveCsv by the
 // first line ("Format Version,..." is Motive; "Trajectories" or "Devices" is
-// Nexus). Throws InputError for an unknown extension or an unrecognised CSV.
+// Nexus), .h5/.hdf5 → our HDF5 files: a ccsrm-dataset/1 experiment's
+// /mocap/markers, or a ccsrm-run/1 run's /markers (ReadHdf5Markers). Throws
+// InputError for an unknown extension or an unrecognised CSV.
 MarkerTable ReadMarkerFile(const std::string& path);
+
+// The markers of a ccsrm-dataset/1 experiment (/mocap/markers, format
+// "ccsrm-dataset") or of a ccsrm-run/1 run with /markers (format "ccsrm-run"),
+// in metres; the rate is the mean rate of the file's time base. The file is
+// validated by the datasets readers. Throws InputError for a bad file or a
+// run without markers.
+MarkerTable ReadHdf5Markers(const std::string& path);
+
+// An experiment's markers as a table (the rate as in ReadHdf5Markers).
+MarkerTable MarkerTableFromExperiment(const datasets::ExperimentFile& experiment);
 
 // A JSON summary with the keys: format, frames, markers, rate_hz,
 // first_frame_number, duration_s, labels, units_in_file, up_axis,

@@ -1,0 +1,224 @@
+// ccsrm generate: a virtual experiment from a simulation — markers on the
+// simulated links with noise and occlusions, the inputs that drove the arm,
+// and the ground truth in two side files no fitting code reads.
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/common/error.h"
+#include "ccsrm/datasets/experiment_file.h"
+#include "ccsrm/datasets/run_file.h"
+#include "ccsrm/mocap/marker_layout.h"
+#include "ccsrm/mocap/virtual_experiment.h"
+#include "ccsrm/sim/config.h"
+#include "ccsrm/sim/model.h"
+#include "ccsrm/sim/parameters.h"
+#include "ccsrm/sim/protocol.h"
+#include "ccsrm/sim/simulator.h"
+#include "commands.h"
+
+namespace ccsrm::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct GenerateArgs {
+  std::string config_path = "configs/paper.yaml";
+  int case_number = 0;         // 0: friction as configured
+  double amplitude_deg = NAN;  // NaN: protocol.amplitude_deg
+  double duration_s = NAN;     // NaN: the whole protocol
+  std::vector<std::string> sets;
+  std::string params_path;
+  double noise_mm = 0.2;
+  std::uint64_t seed = 1;
+  bool no_occlusions = false;
+  std::string out;
+  bool quiet = false;
+};
+
+// "<dir>/exp.h5" -> "<dir>/exp": the stem the side files share.
+std::string OutputStem(const std::string& out) {
+  const std::string suffix = ".h5";
+  if (out.size() <= suffix.size() ||
+      out.compare(out.size() - suffix.size(), suffix.size(), suffix) != 0) {
+    ThrowInputError(out, "--out",
+                    "must end in .h5 (the truth files are named <name>.truth.h5/.yaml)");
+  }
+  return out.substr(0, out.size() - suffix.size());
+}
+
+std::string TruthYaml(const GenerateArgs& a, const sim::Config& truth, double duration_s,
+                      const mocap::VirtualRecordingOptions& recording,
+                      const mocap::VirtualExperiment& generated) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(12);  // 0.05, not 0.050000000000000003
+  out << YAML::Comment(
+      "Ground truth of a generated experiment (ccsrm generate). No fitting code reads this.");
+  out << YAML::BeginMap;
+  out << YAML::Key << "schema" << YAML::Value << "ccsrm-truth/1";
+  out << YAML::Key << "experiment" << YAML::Value << fs::path(a.out).filename().string();
+  out << YAML::Key << "config" << YAML::Value << a.config_path;
+  out << YAML::Key << "case" << YAML::Value
+      << (a.case_number != 0 ? std::to_string(a.case_number) : std::string("as configured"));
+  out << YAML::Key << "amplitude_deg" << YAML::Value << truth.protocol.amplitude_rad * 180.0 / M_PI;
+  out << YAML::Key << "duration_s" << YAML::Value << duration_s;
+  out << YAML::Key << "seed" << YAML::Value << a.seed;
+  out << YAML::Key << "parameters" << YAML::Comment("true values, SPEC 6 names");
+  out << YAML::Value << YAML::BeginMap;
+  for (const sim::ParameterInfo& p : sim::Parameters()) {
+    out << YAML::Key << p.name << YAML::Value << sim::GetParameter(truth, p.name);
+  }
+  out << YAML::EndMap;
+  out << YAML::Key << "effects" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::EndMap;
+  out << YAML::Key << "noise" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "sigma_mm" << YAML::Value << recording.noise_sigma_m * 1e3;
+  out << YAML::EndMap;
+  const mocap::OcclusionOptions& o = recording.occlusions;
+  out << YAML::Key << "occlusions" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "enabled" << YAML::Value << o.enabled;
+  out << YAML::Key << "marker_gap_rate_per_s" << YAML::Value << o.marker_gap_rate_per_s;
+  out << YAML::Key << "gap_frames" << YAML::Value << YAML::Flow << YAML::BeginSeq
+      << o.min_gap_frames << o.max_gap_frames << YAML::EndSeq;
+  out << YAML::Key << "link_loss_rate_per_s" << YAML::Value << o.link_loss_rate_per_s;
+  out << YAML::Key << "link_loss_frames" << YAML::Value << YAML::Flow << YAML::BeginSeq
+      << o.min_link_loss_frames << o.max_link_loss_frames << YAML::EndSeq;
+  out << YAML::Key << "marker_gaps" << YAML::Value << generated.recording.marker_gaps;
+  out << YAML::Key << "link_losses" << YAML::Value << generated.recording.link_losses;
+  out << YAML::Key << "hidden_fraction" << YAML::Value << generated.recording.hidden_fraction;
+  out << YAML::EndMap;
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+int RunGenerate(const GenerateArgs& a) {
+  const std::string stem = OutputStem(a.out);
+  const std::string truth_yaml_path = stem + ".truth.yaml";
+  const std::string truth_h5_path = stem + ".truth.h5";
+  // Check the output paths before spending minutes on the run.
+  { const AtomicOutputFile probe(a.out); }
+  if (!(a.noise_mm >= 0.0) || !std::isfinite(a.noise_mm)) {
+    ThrowInputError("--noise-mm", "", "must be >= 0");
+  }
+
+  // The nominal configuration goes into the experiment as given; the truth
+  // is that configuration with the case, amplitude and parameters applied.
+  const std::string nominal_yaml = ReadTextFile(a.config_path);
+  sim::Config truth = sim::ParseConfig(nominal_yaml, a.config_path);
+  if (a.case_number != 0) sim::ApplyPaperCase(a.case_number, &truth);
+  if (!std::isnan(a.amplitude_deg)) truth.protocol.amplitude_rad = a.amplitude_deg * M_PI / 180.0;
+  if (!a.params_path.empty()) {
+    sim::ApplyParameterYaml(ReadTextFile(a.params_path), a.params_path, &truth);
+  }
+  for (const std::string& assignment : a.sets) {
+    const auto [name, value] = sim::ParseParameterAssignment(assignment, "--set");
+    sim::SetParameter(name, value, "--set", &truth);
+  }
+  sim::Validate(truth);
+  const double duration = std::isnan(a.duration_s) ? truth.protocol.duration_s() : a.duration_s;
+  if (!(duration > 0.0)) ThrowInputError("--duration", "", "must be > 0 s");
+
+  mocap::VirtualExperimentOptions options;
+  options.name = fs::path(stem).filename().string();
+  options.nominal_config_yaml = nominal_yaml;
+  options.recording.noise_sigma_m = a.noise_mm * 1e-3;
+  options.recording.seed = a.seed;
+  options.recording.occlusions.enabled = !a.no_occlusions;
+  std::string error;
+  if (!options.recording.IsValid(&error)) ThrowInputError("generate", "recording", error);
+
+  const sim::ArmModel model(truth);
+  const sim::CableInputs inputs =
+      sim::PlanCableInputs(model, sim::PaperTrajectory(model, truth.protocol), duration);
+  sim::SimulationOptions sim_options;
+  sim_options.duration_s = duration;
+  sim_options.case_name = a.case_number != 0 ? std::to_string(a.case_number) : "custom";
+  if (!a.quiet) {
+    sim_options.progress = [](const sim::SimulationProgress& p) {
+      std::fprintf(stderr, "  t = %6.2f / %.2f s   real-time factor %.2f\n", p.simulated_s,
+                   p.duration_s, p.real_time_factor);
+    };
+  }
+  sim::SimulationResult result = sim::Simulate(model, inputs, sim_options);
+  if (!result.summary.completed) {
+    std::fprintf(stderr, "ccsrm: simulation diverged: %s (nothing written)\n",
+                 result.summary.message.c_str());
+    return 3;
+  }
+  // Wall time is the one thing a rerun changes: keep it out of the truth file
+  // so that the same seed gives the same files (it is printed below).
+  const double wall_time_s = result.run.wall_time_s;
+  result.run.wall_time_s = 0.0;
+
+  char description[512];
+  std::snprintf(description, sizeof(description),
+                "generated by ccsrm generate: case %s, amplitude %.4g deg, %.4g s, marker noise "
+                "%.3g mm, occlusions %s, seed %llu",
+                sim_options.case_name.c_str(), truth.protocol.amplitude_rad * 180.0 / M_PI,
+                duration, a.noise_mm, a.no_occlusions ? "off" : "on",
+                static_cast<unsigned long long>(a.seed));
+  options.description = description;
+  const mocap::VirtualExperiment generated =
+      mocap::MakeVirtualExperiment(result.run, mocap::DefaultMarkerLayout(model), options);
+
+  datasets::WriteExperimentFile(a.out, generated.experiment);
+  datasets::WriteRunFile(truth_h5_path, generated.truth);
+  WriteTextFileAtomically(truth_yaml_path,
+                          TruthYaml(a, truth, duration, options.recording, generated));
+
+  std::printf("simulated %.4g s (case %s) in %.2f s wall\n", duration,
+              sim_options.case_name.c_str(), wall_time_s);
+  std::printf(
+      "recorded %zu frames of %zu markers: noise %.3g mm, %zu marker gaps, %zu whole-link "
+      "losses, %.2f %% of samples hidden\n",
+      generated.experiment.mocap_time.rows(), generated.experiment.marker_names.size(), a.noise_mm,
+      generated.recording.marker_gaps, generated.recording.link_losses,
+      100.0 * generated.recording.hidden_fraction);
+  std::printf("  experiment: %s\n  truth:      %s, %s\n", a.out.c_str(), truth_yaml_path.c_str(),
+              truth_h5_path.c_str());
+  return 0;
+}
+
+}  // namespace
+
+void AddGenerateCommand(CLI::App& root) {
+  CLI::App* cmd = root.add_subcommand(
+      "generate",
+      "Simulate the arm and record it with virtual motion capture (noise, occlusions): a "
+      "ccsrm-dataset/1 experiment plus <name>.truth.yaml and <name>.truth.h5");
+  auto a = std::make_shared<GenerateArgs>();
+  cmd->add_option("--config", a->config_path, "Nominal arm configuration (YAML)")
+      ->capture_default_str();
+  cmd->add_option("--case", a->case_number,
+                  "Paper case: 1 no friction, 2 all friction, 3 driving cables only, 4 connecting "
+                  "cables only (default: friction as configured)")
+      ->check(CLI::Range(1, 4));
+  cmd->add_option("--amplitude", a->amplitude_deg,
+                  "Planned joint amplitude [deg] (default: protocol.amplitude_deg)");
+  cmd->add_option("--duration", a->duration_s, "Simulated time [s] (default: the whole protocol)");
+  cmd->add_option("--set", a->sets,
+                  "True parameter value, name=value (mu, mu_s, mu_c, mu_c_s, beta, c_sc, c_lc, "
+                  "T_p, T_d0); repeatable, applied after --params");
+  cmd->add_option("--params", a->params_path,
+                  "YAML file of true parameter values (name: value, or a truth file's "
+                  "'parameters:')");
+  cmd->add_option("--noise-mm", a->noise_mm, "Marker noise, standard deviation [mm]")
+      ->capture_default_str();
+  cmd->add_option("--seed", a->seed, "Seed of the noise and occlusion generator")
+      ->capture_default_str();
+  cmd->add_flag("--no-occlusions", a->no_occlusions, "Every marker seen in every frame");
+  cmd->add_option("--out", a->out, "Output experiment (.h5)")->required();
+  cmd->add_flag("--quiet", a->quiet, "No progress lines");
+  cmd->callback([a] {
+    const int code = RunGenerate(*a);
+    if (code != 0) throw CLI::RuntimeError(code);
+  });
+}
+
+}  // namespace ccsrm::app

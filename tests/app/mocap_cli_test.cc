@@ -1,0 +1,301 @@
+// `ccsrm mocap ...` and `ccsrm generate` as a user runs them: outputs, exit
+// codes and one-line errors.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/datasets/experiment_file.h"
+#include "ccsrm/datasets/run_file.h"
+#include "ccsrm/mocap/c3d.h"
+#include "ccsrm/mocap/marker_io.h"
+
+namespace {
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+struct Outcome {
+  int status = -1;
+  std::string out;
+  std::string err;
+};
+
+Outcome RunCcsrm(const std::string& args) {
+  const fs::path err_file = fs::temp_directory_path() / "ccsrm_mocap_cli_test_stderr.txt";
+  const std::string command = std::string(CCSRM_PROGRAM) + " " + args + " 2>" + err_file.string();
+  Outcome outcome;
+  FILE* pipe = popen(command.c_str(), "r");
+  std::array<char, 4096> buffer;
+  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) outcome.out += buffer.data();
+  const int raw = pclose(pipe);
+  outcome.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  outcome.err = ccsrm::ReadTextFile(err_file.string());
+  return outcome;
+}
+
+std::string Paper() { return std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml"; }
+std::string SharedC3d(const std::string& name) {
+  return std::string(CCSRM_SHARED_DIR) + "/data/mocap/c3d/" + name;
+}
+
+fs::path FreshDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("ccsrm_mocap_cli_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+int Lines(const std::string& text) {
+  int n = 0;
+  for (char c : text) n += c == '\n';
+  return n;
+}
+
+// A short generated experiment (0.3 s of case 1), made once (the suite runs
+// as one process).
+const fs::path& Generated() {
+  static const fs::path dir = [] {
+    const fs::path d = FreshDir("generated");
+    const Outcome o =
+        RunCcsrm("generate --config " + Paper() +
+                 " --case 1 --duration 0.3 --quiet --seed 7 --out " + (d / "exp.h5").string());
+    EXPECT_EQ(o.status, 0) << o.err;
+    return d;
+  }();
+  return dir;
+}
+
+TEST(MocapInspect, JsonOfAC3dFileHasTheDocumentedKeys) {
+  const Outcome o = RunCcsrm("mocap inspect --json " + SharedC3d("pc_real.c3d"));
+  ASSERT_EQ(o.status, 0) << o.err;
+  const nlohmann::json j = nlohmann::json::parse(o.out);
+  for (const char* key : {"format", "frames", "rate_hz", "labels", "units_in_file",
+                          "invalid_points", "longest_gap_frames", "first_frame"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_EQ(j["format"], "c3d");
+  EXPECT_GT(j["frames"].get<int>(), 0);
+  const std::string text = RunCcsrm("mocap inspect " + SharedC3d("pc_real.c3d")).out;
+  EXPECT_THAT(text, HasSubstr("longest gap"));
+}
+
+TEST(MocapInspect, ReadsOurHdf5ExperimentAndRun) {
+  const Outcome exp = RunCcsrm("mocap inspect --json " + (Generated() / "exp.h5").string());
+  ASSERT_EQ(exp.status, 0) << exp.err;
+  const nlohmann::json j = nlohmann::json::parse(exp.out);
+  EXPECT_EQ(j["format"], "ccsrm-dataset");
+  EXPECT_EQ(j["frames"], 31);
+  EXPECT_NEAR(j["rate_hz"].get<double>(), 100.0, 1e-9);
+  EXPECT_EQ(j["labels"].size(), 52u);
+  EXPECT_EQ(j["units_in_file"], "m");
+  const Outcome run = RunCcsrm("mocap inspect --json " + (Generated() / "exp.truth.h5").string());
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_EQ(nlohmann::json::parse(run.out)["invalid_points"], 0);  // noise-free, never hidden
+}
+
+TEST(Generate, WritesTheExperimentAndBothTruthFiles) {
+  const fs::path& dir = Generated();
+  const ccsrm::datasets::ExperimentFile e =
+      ccsrm::datasets::ReadExperimentFile((dir / "exp.h5").string());
+  EXPECT_EQ(e.source, ccsrm::datasets::ExperimentSource::kGenerated);
+  EXPECT_EQ(e.config_yaml, ccsrm::ReadTextFile(Paper()));  // the nominal text, never the truth
+  EXPECT_EQ(e.mocap_time.rows(), 31u);
+  EXPECT_EQ(e.input_length_change.shape, (std::vector<std::size_t>{31, 6}));
+  EXPECT_EQ(e.marker_names.size(), 52u);
+  EXPECT_EQ(e.rigid_bodies.size(), 13u);
+  const ccsrm::datasets::RunFile truth =
+      ccsrm::datasets::ReadRunFile((dir / "exp.truth.h5").string());
+  ASSERT_TRUE(truth.markers.has_value());
+  EXPECT_EQ(truth.marker_names, e.marker_names);
+  EXPECT_EQ(truth.case_name, "1");
+  // Noise: the recorded markers differ from the truth by about 0.2 mm.
+  double sum_sq = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < e.mocap_markers.size(); ++i) {
+    const double d = e.mocap_markers.values[i] - truth.markers->values[i];
+    if (std::isfinite(d)) {
+      sum_sq += d * d;
+      ++n;
+    }
+  }
+  EXPECT_NEAR(std::sqrt(sum_sq / n), 0.2e-3, 0.02e-3);
+  const std::string yaml = ccsrm::ReadTextFile((dir / "exp.truth.yaml").string());
+  EXPECT_THAT(yaml, HasSubstr("schema: ccsrm-truth/1"));
+  EXPECT_THAT(yaml, HasSubstr("mu: 0\n"));  // case 1: no friction
+  EXPECT_THAT(yaml, HasSubstr("T_d0: 100"));
+  EXPECT_THAT(yaml, HasSubstr("seed: 7"));
+  EXPECT_THAT(yaml, HasSubstr("sigma_mm: 0.2"));
+}
+
+TEST(Generate, SameSeedGivesTheSameFilesAndParametersReachTheTruth) {
+  const fs::path dir = FreshDir("reproducible");
+  const std::string common = "generate --config " + Paper() + " --duration 0.1 --quiet ";
+  ASSERT_EQ(
+      RunCcsrm(common + "--seed 3 --set mu=0.15 --set T_d0=80 --out " + (dir / "a.h5").string())
+          .status,
+      0);
+  // The truth file as --params reproduces the same truth.
+  const Outcome b = RunCcsrm(common + "--seed 3 --params " + (dir / "a.truth.yaml").string() +
+                             " --out " + (dir / "b.h5").string());
+  ASSERT_EQ(b.status, 0) << b.err;
+  const auto a_exp = ccsrm::datasets::ReadExperimentFile((dir / "a.h5").string());
+  const auto b_exp = ccsrm::datasets::ReadExperimentFile((dir / "b.h5").string());
+  EXPECT_EQ(a_exp.mocap_markers.values.size(), b_exp.mocap_markers.values.size());
+  for (std::size_t i = 0; i < a_exp.mocap_markers.size(); ++i) {
+    const double x = a_exp.mocap_markers.values[i], y = b_exp.mocap_markers.values[i];
+    ASSERT_TRUE((std::isnan(x) && std::isnan(y)) || x == y) << i;
+  }
+  EXPECT_EQ(a_exp.input_length_change.values, b_exp.input_length_change.values);
+  const auto a_truth = ccsrm::datasets::ReadRunFile((dir / "a.truth.h5").string());
+  const auto b_truth = ccsrm::datasets::ReadRunFile((dir / "b.truth.h5").string());
+  EXPECT_EQ(a_truth.joint_angles.values, b_truth.joint_angles.values);
+  EXPECT_EQ(a_truth.wall_time_s, b_truth.wall_time_s);
+  const std::string a_yaml = ccsrm::ReadTextFile((dir / "a.truth.yaml").string());
+  EXPECT_THAT(a_yaml, HasSubstr("mu: 0.15"));
+  EXPECT_THAT(a_yaml, HasSubstr("T_d0: 80"));
+  // Another seed, other noise.
+  ASSERT_EQ(
+      RunCcsrm(common + "--seed 4 --set mu=0.15 --set T_d0=80 --out " + (dir / "c.h5").string())
+          .status,
+      0);
+  const auto c_exp = ccsrm::datasets::ReadExperimentFile((dir / "c.h5").string());
+  EXPECT_NE(c_exp.mocap_markers.values[0], a_exp.mocap_markers.values[0]);
+}
+
+TEST(Generate, RejectsUnknownParametersAndBadValuesWithOneLine) {
+  const Outcome unknown =
+      RunCcsrm("generate --config " + Paper() + " --set mu_x=0.1 --out /tmp/ccsrm_never.h5");
+  EXPECT_EQ(unknown.status, 2);
+  EXPECT_EQ(Lines(unknown.err), 1) << unknown.err;
+  EXPECT_THAT(unknown.err, HasSubstr("unknown parameter 'mu_x' (known: mu, mu_s, mu_c, mu_c_s, "
+                                     "beta, c_sc, c_lc, T_p, T_d0)"));
+  const Outcome bounds =
+      RunCcsrm("generate --config " + Paper() + " --set mu=3 --out /tmp/ccsrm_never.h5");
+  EXPECT_EQ(bounds.status, 2);
+  EXPECT_THAT(bounds.err, HasSubstr("parameter 'mu': 3 is outside [0, 2]"));
+  const Outcome not_h5 = RunCcsrm("generate --config " + Paper() + " --out /tmp/ccsrm_never.dat");
+  EXPECT_EQ(not_h5.status, 2);
+  EXPECT_THAT(not_h5.err, HasSubstr("must end in .h5"));
+  const fs::path dir = FreshDir("params");
+  ccsrm::WriteTextFileAtomically((dir / "p.yaml").string(), "mu: 0.1\nbeta: fast\n");
+  const Outcome params = RunCcsrm("generate --config " + Paper() + " --params " +
+                                  (dir / "p.yaml").string() + " --out /tmp/ccsrm_never.h5");
+  EXPECT_EQ(params.status, 2);
+  EXPECT_THAT(params.err, HasSubstr("p.yaml: line 2, key 'beta': expected a number"));
+  EXPECT_FALSE(fs::exists("/tmp/ccsrm_never.h5"));
+}
+
+TEST(MocapProcess, ProcessesAGeneratedExperimentAndKeepsTheInput) {
+  const fs::path& dir = Generated();
+  const std::string in = (dir / "exp.h5").string();
+  const auto before = fs::last_write_time(in);
+  const std::string out = (FreshDir("process") / "processed.h5").string();
+  const Outcome o = RunCcsrm("mocap process --in " + in + " --cutoff-hz 3 --out " + out);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_THAT(o.out, HasSubstr("joint-constrained chain"));
+  EXPECT_THAT(o.out, HasSubstr("world frame: from the ground cluster"));
+  EXPECT_THAT(o.out, HasSubstr("max |twist|"));
+  EXPECT_EQ(fs::last_write_time(in), before);
+  const auto processed = ccsrm::datasets::ReadExperimentFile(out);
+  ASSERT_TRUE(processed.measured_joint_angles.has_value());
+  EXPECT_EQ(processed.measured_joint_angles->shape, (std::vector<std::size_t>{31, 12, 2}));
+  EXPECT_EQ(processed.measured_link_pose->shape, (std::vector<std::size_t>{31, 12, 7}));
+  EXPECT_EQ(processed.measured_joint_twist->shape, (std::vector<std::size_t>{31, 12}));
+  EXPECT_EQ(processed.mocap_quality_units.at("marker_fit_rms"), "m");
+  const Outcome same = RunCcsrm("mocap process --in " + in + " --out " + in);
+  EXPECT_EQ(same.status, 2);
+  EXPECT_THAT(same.err, HasSubstr("is the input file"));
+}
+
+TEST(MocapProcess, ConfigOrRigidBodiesFileGiveTheSimulatedAngles) {
+  const fs::path dir = FreshDir("c3d");
+  // The rigid-bodies command writes the default layout; processing the
+  // noise-free truth run with it or with the configuration is the same.
+  const std::string rb = (dir / "rb.yaml").string();
+  const Outcome written = RunCcsrm("mocap rigid-bodies --config " + Paper() + " --out " + rb);
+  ASSERT_EQ(written.status, 0) << written.err;
+  EXPECT_THAT(ccsrm::ReadTextFile(rb), HasSubstr("schema: ccsrm-rigid-bodies/1"));
+  const std::string run = (Generated() / "exp.truth.h5").string();
+  const std::string out1 = (dir / "from_config.h5").string();
+  Outcome o =
+      RunCcsrm("mocap process --quiet --in " + run + " --config " + Paper() + " --out " + out1);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const std::string out2 = (dir / "from_rb.h5").string();
+  o = RunCcsrm("mocap process --quiet --in " + run + " --rigid-bodies " + rb + " --out " + out2);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const auto a = ccsrm::datasets::ReadExperimentFile(out1);
+  const auto b = ccsrm::datasets::ReadExperimentFile(out2);
+  // Noise-free markers: both ways give the simulated angles.
+  const auto truth = ccsrm::datasets::ReadRunFile(run);
+  for (std::size_t i = 0; i < truth.joint_angles.size(); ++i) {
+    EXPECT_NEAR(a.measured_joint_angles->values[i], truth.joint_angles.values[i], 2e-4) << i;
+    EXPECT_NEAR(b.measured_joint_angles->values[i], truth.joint_angles.values[i], 2e-4) << i;
+  }
+  // A real vendor file whose labels are not the arm's: one line, exit 2.
+  o = RunCcsrm("mocap process --in " + SharedC3d("pc_real.c3d") + " --config " + Paper() +
+               " --out " + (dir / "x.h5").string());
+  EXPECT_EQ(o.status, 2);
+  EXPECT_EQ(Lines(o.err), 1) << o.err;
+  EXPECT_THAT(o.err, HasSubstr("no marker of the rigid bodies"));
+  // Neither rigid bodies nor a configuration for a C3D file.
+  o = RunCcsrm("mocap process --in " + SharedC3d("pc_real.c3d") + " --out " +
+               (dir / "x.h5").string());
+  EXPECT_EQ(o.status, 2);
+  EXPECT_THAT(o.err, HasSubstr("give --rigid-bodies FILE or --config FILE"));
+}
+
+TEST(MocapProcess, C3dFileBecomesANewExperimentWithOrWithoutInputs) {
+  const fs::path dir = FreshDir("c3d_new");
+  const std::string exp = (Generated() / "exp.h5").string();
+  const std::string c3d = (dir / "recording.c3d").string();
+  ccsrm::mocap::WriteC3d(c3d, ccsrm::mocap::ReadMarkerFile(exp));
+  const std::string bare = (dir / "bare.h5").string();
+  Outcome o =
+      RunCcsrm("mocap process --quiet --in " + c3d + " --config " + Paper() + " --out " + bare);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const auto a = ccsrm::datasets::ReadExperimentFile(bare);
+  EXPECT_EQ(a.source, ccsrm::datasets::ExperimentSource::kRecorded);
+  EXPECT_EQ(a.config_yaml, ccsrm::ReadTextFile(Paper()));
+  EXPECT_EQ(a.input_length_change.shape, (std::vector<std::size_t>{1, 0}));  // no actuator record
+  EXPECT_EQ(a.marker_names.size(), 52u);
+  EXPECT_EQ(a.measured_joint_angles->shape, (std::vector<std::size_t>{31, 12, 2}));
+  const std::string with_inputs = (dir / "with_inputs.h5").string();
+  o = RunCcsrm("mocap process --quiet --in " + c3d + " --config " + Paper() + " --inputs " + exp +
+               " --out " + with_inputs);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_EQ(ccsrm::datasets::ReadExperimentFile(with_inputs).input_length_change.shape,
+            (std::vector<std::size_t>{31, 6}));
+  // A static trial: the first 0.3 s of the protocol barely move the arm, so
+  // the refined positions stay within a fraction of a millimetre.
+  const std::string rb = (dir / "refined.yaml").string();
+  o = RunCcsrm("mocap rigid-bodies --config " + Paper() + " --static-trial " +
+               (Generated() / "exp.truth.h5").string() + " --out " + rb);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_THAT(o.out, HasSubstr("marker positions refined (largest change 0.0"));
+}
+
+TEST(MocapProcess, BadRigidBodiesFileIsOneLineNamingLineAndKey) {
+  const fs::path dir = FreshDir("bad_rb");
+  const std::string rb = (dir / "rb.yaml").string();
+  ccsrm::WriteTextFileAtomically(rb,
+                                 "schema: ccsrm-rigid-bodies/1\n"
+                                 "bodies:\n"
+                                 "  - name: link1\n"
+                                 "    link: 1\n"
+                                 "    colour: red\n"
+                                 "    markers: []\n");
+  const Outcome o = RunCcsrm("mocap process --in " + (Generated() / "exp.h5").string() +
+                             " --rigid-bodies " + rb + " --out " + (dir / "x.h5").string());
+  EXPECT_EQ(o.status, 2);
+  EXPECT_EQ(Lines(o.err), 1) << o.err;
+  EXPECT_THAT(o.err, HasSubstr(rb + ": line 5, key 'bodies[0].colour': unknown key"));
+  EXPECT_FALSE(fs::exists(dir / "x.h5"));
+}
+
+}  // namespace
