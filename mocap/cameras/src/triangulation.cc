@@ -31,7 +31,9 @@ struct Candidate {
   std::vector<View> views;  // sorted by camera
   Eigen::Vector3d p_W = Eigen::Vector3d::Zero();
   double rms_px = 0.0;
-  bool available = true;
+  // Cameras that should have seen the point (in front, inside the image,
+  // delivering detections this frame) but are not among its views.
+  int unexplained_misses = 0;
 };
 
 class FrameMatcher {
@@ -145,6 +147,7 @@ class FrameMatcher {
             Candidate candidate;
             candidate.views = {View{i, a}, View{j, b}};
             if (!Grow(&candidate)) continue;
+            candidate.unexplained_misses = UnexplainedMisses(candidate);
             std::vector<std::pair<int, int>> key;
             for (const View& v : candidate.views) key.emplace_back(v.camera, v.blob);
             if (seen.count(key) > 0) continue;
@@ -154,6 +157,36 @@ class FrameMatcher {
         }
       }
     }
+  }
+
+  int UnexplainedMisses(const Candidate& candidate) const {
+    constexpr double kMarginPx = 10.0;
+    int misses = 0;
+    for (int c = 0; c < static_cast<int>(xy_.size()); ++c) {
+      if (xy_[c].empty()) continue;  // a dropped frame explains itself
+      bool viewed = false;
+      for (const View& v : candidate.views) viewed = viewed || v.camera == c;
+      if (viewed) continue;
+      const Camera& camera = rig_.cameras[c];
+      std::vector<bool> in_front;
+      const Eigen::Vector2d uv = ProjectPoints(camera, {candidate.p_W}, &in_front)[0];
+      if (in_front[0] && uv.x() > kMarginPx && uv.y() > kMarginPx &&
+          uv.x() < camera.image_width_px - kMarginPx &&
+          uv.y() < camera.image_height_px - kMarginPx) {
+        ++misses;
+      }
+    }
+    return misses;
+  }
+
+  // True when candidate a wins its conflict with b: both are the same point
+  // seen through different views (a fits better), or a explains every
+  // camera's silence and b does not (a ghost from a wrong pairing lands where
+  // other cameras should have seen it).
+  bool Wins(const Candidate& a, const Candidate& b) const {
+    constexpr double kSamePointM = 1e-3;
+    if ((a.p_W - b.p_W).norm() < kSamePointM) return a.rms_px < b.rms_px;
+    return a.unexplained_misses == 0 && b.unexplained_misses > 0;
   }
 
   bool Shares(const Candidate& a, const Candidate& b) const {
@@ -166,8 +199,9 @@ class FrameMatcher {
   }
 
   // Accepts candidates from the most views down. Within one view count a
-  // candidate that shares a detection with another still-available one is
-  // ambiguous: both are dropped rather than guessed.
+  // candidate that shares a detection with another still-available one must
+  // win every such conflict (Wins); otherwise the match is ambiguous and
+  // dropped rather than guessed.
   std::vector<TriangulatedPoint> Select() {
     std::vector<std::vector<bool>> used(xy_.size());
     for (std::size_t c = 0; c < xy_.size(); ++c) used[c].assign(xy_[c].size(), false);
@@ -190,7 +224,8 @@ class FrameMatcher {
       for (std::size_t a : level) {
         bool ambiguous = false;
         for (std::size_t b : level) {
-          if (a != b && Shares(candidates_[a], candidates_[b])) {
+          if (a != b && Shares(candidates_[a], candidates_[b]) &&
+              !Wins(candidates_[a], candidates_[b])) {
             ambiguous = true;
             break;
           }

@@ -315,7 +315,7 @@ std::pair<Eigen::Matrix3d, Eigen::Vector3d> DefaultWorldBoardPose(const Checkerb
   // link axes.
   const Eigen::Vector3d centre_G((board.inner_corners_x - 1) * 0.5 * board.square_m,
                                  (board.inner_corners_y - 1) * 0.5 * board.square_m, 0.0);
-  const Eigen::Vector3d p_W_centre(-0.03, 0.0, 0.45);
+  const Eigen::Vector3d p_W_centre(-0.03, 0.0, 0.50);
   return {R_WG, p_W_centre - R_WG * centre_G};
 }
 

@@ -38,7 +38,7 @@ struct BlobDetectionOptions {
   int border_margin_px = 3;
   // Blobs whose principal standard deviations differ by more than this
   // ratio are dropped: two spots merged into one would give a wrong point.
-  double max_elongation = 1.5;
+  double max_elongation = 1.25;
 
   bool IsValid(std::string* error) const;
 };
@@ -58,9 +58,9 @@ std::vector<Blob> DetectBlobs(const cv::Mat& gray, const BlobDetectionOptions& o
 struct TriangulationOptions {
   // Largest distance of an observation from the epipolar line of its partner
   // [px, undistorted, in the partner camera's focal length].
-  double epipolar_tolerance_px = 2.0;
+  double epipolar_tolerance_px = 1.5;
   // Largest reprojection error of any view of an accepted point [px].
-  double reprojection_tolerance_px = 2.0;
+  double reprojection_tolerance_px = 1.5;
   // A point needs at least this many views (>= 2).
   int min_views = 2;
   // Gauss-Newton iterations after the DLT.
@@ -101,8 +101,11 @@ Eigen::Vector3d RefineTriangulation(const std::vector<const Camera*>& cameras,
 
 // Every 3D point of one frame: detections per camera (pixels) are
 // undistorted, matched across views by epipolar constraints and verified in
-// the other views, then triangulated. Each detection is used at most once; a
-// two-view match is kept only when neither detection has another candidate.
+// the other views, then triangulated. Each detection is used at most once.
+// Points with more views are accepted first; two candidates that share a
+// detection are both dropped unless one is clearly right (the same point
+// through other views, or the only one that no other camera should have
+// seen).
 std::vector<TriangulatedPoint> TriangulateFrame(
     const CameraRig& rig, const std::vector<std::vector<Eigen::Vector2d>>& uv_px,
     const TriangulationOptions& options = {});

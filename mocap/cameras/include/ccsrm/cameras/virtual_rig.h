@@ -18,24 +18,24 @@ namespace ccsrm::cameras {
 // cover about y in [-0.75, 0.75] m and z in [-0.15, 1.15] m. The cameras stand
 // at the four diagonal directions around the aim point, tilted from the table
 // normal (+x) by tilt_deg, far enough that each sees the whole workspace.
-// With the defaults every marker of the paper arm is in view of at least two
-// cameras (mostly all four) over the +-6 deg protocol, and 0.2 px of
-// detection noise gives about 0.25 mm RMS of 3D error.
+// With the defaults every marker of the paper arm is in view of all four
+// cameras over the +-6 deg protocol (of three or more up to +-7.5 deg per
+// joint), and 0.2 px of detection noise gives about 0.25 mm RMS of 3D error.
 struct VirtualRigOptions {
   int image_width_px = 1280;
   int image_height_px = 1024;
-  // Focal length [px] (fx = fy); 1600 px gives a 44 x 35 deg field of view.
-  double focal_length_px = 1600.0;
+  // Focal length [px] (fx = fy); 1700 px gives a 41 x 33 deg field of view.
+  double focal_length_px = 1700.0;
   // Lens distortion of every camera (k1, k2, p1, p2, k3): mild barrel
   // distortion as of a wide-angle machine-vision lens.
   std::vector<double> distortion = {-0.08, 0.04, 3e-4, -2e-4, 0.0};
   // Point every optical axis goes through [m, in W].
-  Eigen::Vector3d p_W_aim = Eigen::Vector3d(0.035, 0.0, 0.45);
+  Eigen::Vector3d p_W_aim = Eigen::Vector3d(0.035, 0.0, 0.50);
   // Distance from each camera's centre to the aim point [m].
-  double aim_distance_m = 1.6;
+  double aim_distance_m = 2.0;
   // Angle between each optical axis and the table normal -x [deg]; steep
   // views triangulate the height above the table better.
-  double tilt_deg = 45.0;
+  double tilt_deg = 50.0;
   // Directions of the cameras around the table normal, measured in the
   // table plane from +z toward +y [deg]; one camera per entry.
   std::vector<double> azimuths_deg = {45.0, 135.0, 225.0, 315.0};
