@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <future>
 #include <limits>
 #include <sstream>
 
@@ -207,7 +208,6 @@ ReconstructionResult ReconstructMarkers(const CameraRig& rig,
   std::vector<std::size_t> frames_of(cameras, 0);
   std::vector<std::vector<Eigen::Vector2d>> detections(cameras);
   std::vector<bool> frame_read(cameras, false);
-  cv::Mat gray;
   std::size_t index = 0;
   std::size_t processed = 0;
   const std::size_t to_process = expected > static_cast<long>(options.first_frame)
@@ -215,22 +215,35 @@ ReconstructionResult ReconstructMarkers(const CameraRig& rig,
                                      : 0;
   for (;; ++index) {
     if (options.max_frames > 0 && processed >= options.max_frames) break;
-    bool any = false;
+    // Decoding dominates the cost of a frame: each camera reads and detects
+    // on its own thread (the readers are independent).
+    std::vector<std::future<bool>> reads;
     for (std::size_t c = 0; c < cameras; ++c) {
       detections[c].clear();
       frame_read[c] = false;
       if (ended[c]) continue;
-      if (!readers[c].Read(&gray)) {
+      reads.push_back(std::async(std::launch::async, [&, c] {
+        cv::Mat gray;
+        if (!readers[c].Read(&gray)) return false;
+        if (index >= options.first_frame) {
+          for (const Blob& blob : DetectBlobs(gray, options.detection)) {
+            detections[c].push_back(blob.uv_px);
+          }
+        }
+        return true;
+      }));
+    }
+    bool any = false;
+    std::size_t next = 0;
+    for (std::size_t c = 0; c < cameras; ++c) {
+      if (ended[c]) continue;
+      if (!reads[next++].get()) {
         ended[c] = true;
         continue;
       }
       any = true;
       frame_read[c] = true;
       ++frames_of[c];
-      if (index < options.first_frame) continue;
-      for (const Blob& blob : DetectBlobs(gray, options.detection)) {
-        detections[c].push_back(blob.uv_px);
-      }
     }
     if (!any) break;
     if (index < options.first_frame) continue;
