@@ -113,11 +113,16 @@ bool IntrinsicCalibrationOptions::IsValid(std::string* error) const {
   return true;
 }
 
-IntrinsicCalibration CalibrateIntrinsics(const std::vector<cv::Mat>& images,
-                                         const std::vector<std::string>& names,
-                                         const CheckerboardTarget& board,
-                                         const std::string& camera_name,
-                                         const IntrinsicCalibrationOptions& options) {
+namespace {
+
+// Detects `board` in every image and calibrates; with `world` its board is
+// the last view and its pose is returned in *world_pose.
+IntrinsicCalibration Calibrate(const std::vector<cv::Mat>& images,
+                               const std::vector<std::string>& names,
+                               const CheckerboardTarget& board, const WorldBoardView* world,
+                               const std::string& camera_name,
+                               const IntrinsicCalibrationOptions& options,
+                               ExtrinsicCalibration* world_pose) {
   CCSRM_CHECK(images.size() == names.size());
   std::string reason;
   if (!board.IsValid(&reason)) ThrowInputError("(checkerboard)", "", reason);
@@ -125,17 +130,20 @@ IntrinsicCalibration CalibrateIntrinsics(const std::vector<cv::Mat>& images,
   if (images.empty()) ThrowInputError("(calibration images)", "", "no image");
   IntrinsicCalibration result;
   const cv::Size size = images[0].size();
+  auto check_image = [&](const cv::Mat& image, const std::string& name) {
+    if (image.type() != CV_8UC1) ThrowInputError(name, "", "expected an 8-bit gray image");
+    if (image.size() != size) {
+      ThrowInputError(name, "",
+                      "image size " + std::to_string(image.cols) + "x" +
+                          std::to_string(image.rows) + " differs from the first image's " +
+                          std::to_string(size.width) + "x" + std::to_string(size.height));
+    }
+  };
   std::vector<std::vector<cv::Point3f>> object_points;
   std::vector<std::vector<cv::Point2f>> image_points;
   const std::vector<cv::Point3f> corners_G = ToCv3f(board.CornerPositions());
   for (std::size_t i = 0; i < images.size(); ++i) {
-    if (images[i].type() != CV_8UC1) ThrowInputError(names[i], "", "expected an 8-bit gray image");
-    if (images[i].size() != size) {
-      ThrowInputError(names[i], "",
-                      "image size " + std::to_string(images[i].cols) + "x" +
-                          std::to_string(images[i].rows) + " differs from the first image's " +
-                          std::to_string(size.width) + "x" + std::to_string(size.height));
-    }
+    check_image(images[i], names[i]);
     const auto corners = DetectCheckerboard(images[i], board);
     if (!corners) {
       result.rejected_images.push_back(names[i]);
@@ -153,6 +161,18 @@ IntrinsicCalibration CalibrateIntrinsics(const std::vector<cv::Mat>& images,
                         std::to_string(images.size()) + " images (need " +
                         std::to_string(options.min_views) + ")");
   }
+  if (world != nullptr) {
+    if (!world->board.IsValid(&reason)) ThrowInputError(world->name, "", reason);
+    check_image(world->image, world->name);
+    const auto corners = DetectCheckerboard(world->image, world->board);
+    if (!corners) {
+      ThrowInputError(world->name, "",
+                      "checkerboard " + std::to_string(world->board.inner_corners_x) + "x" +
+                          std::to_string(world->board.inner_corners_y) + " not found");
+    }
+    object_points.push_back(ToCv3f(world->board.CornerPositions()));
+    image_points.push_back(ToCv2f(*corners));
+  }
   cv::Mat K, distortion;
   std::vector<cv::Mat> rvecs, tvecs;
   cv::Mat std_intrinsics, std_extrinsics, per_view_errors;
@@ -161,7 +181,8 @@ IntrinsicCalibration CalibrateIntrinsics(const std::vector<cv::Mat>& images,
       object_points, image_points, size, K, distortion, rvecs, tvecs, std_intrinsics,
       std_extrinsics, per_view_errors, flags,
       cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12));
-  for (int i = 0; i < per_view_errors.rows; ++i) {
+  const int board_views = static_cast<int>(result.used_images.size());
+  for (int i = 0; i < board_views; ++i) {
     result.per_view_rms_px.push_back(per_view_errors.at<double>(i, 0));
   }
   Camera& camera = result.camera;
@@ -174,7 +195,42 @@ IntrinsicCalibration CalibrateIntrinsics(const std::vector<cv::Mat>& images,
   distortion = distortion.reshape(1, 1);
   for (int i = 0; i < distortion.cols; ++i)
     camera.distortion.push_back(distortion.at<double>(0, i));
+  if (world != nullptr) {
+    cv::Mat R;
+    cv::Rodrigues(rvecs.back(), R);
+    Eigen::Matrix3d R_CG;
+    Eigen::Vector3d p_CG;
+    cv::cv2eigen(R, R_CG);
+    cv::cv2eigen(tvecs.back(), p_CG);
+    // p_C = R_CG (R_WG^T (p_W - p_WG)) + p_CG
+    world_pose->R_CW = R_CG * world->R_WG.transpose();
+    world_pose->p_CW = p_CG - world_pose->R_CW * world->p_WG;
+    world_pose->rms_reprojection_px = per_view_errors.at<double>(board_views, 0);
+    world_pose->correspondences = image_points.back().size();
+    camera.R_CW = world_pose->R_CW;
+    camera.p_CW = world_pose->p_CW;
+  }
   return result;
+}
+
+}  // namespace
+
+IntrinsicCalibration CalibrateIntrinsics(const std::vector<cv::Mat>& images,
+                                         const std::vector<std::string>& names,
+                                         const CheckerboardTarget& board,
+                                         const std::string& camera_name,
+                                         const IntrinsicCalibrationOptions& options) {
+  return Calibrate(images, names, board, nullptr, camera_name, options, nullptr);
+}
+
+std::pair<IntrinsicCalibration, ExtrinsicCalibration> CalibrateCameraInWorld(
+    const std::vector<cv::Mat>& images, const std::vector<std::string>& names,
+    const CheckerboardTarget& board, const WorldBoardView& world, const std::string& camera_name,
+    const IntrinsicCalibrationOptions& options) {
+  ExtrinsicCalibration pose;
+  IntrinsicCalibration intrinsics =
+      Calibrate(images, names, board, &world, camera_name, options, &pose);
+  return {std::move(intrinsics), pose};
 }
 
 ExtrinsicCalibration CalibrateExtrinsicsFromBoard(const Camera& camera, const cv::Mat& image,
@@ -209,9 +265,46 @@ ExtrinsicCalibration CalibrateExtrinsicsFromMarkers(
   ExtrinsicCalibration result;
   result.R_CW = camera.R_CW;
   result.p_CW = camera.p_CW;
-  for (double gate : options.match_gates_px) {
+  // A rough pose mostly shifts the whole image: first find the shift that
+  // lines up the most detections of the first frame with projected markers
+  // (a vote over every projection-detection pair).
+  Eigen::Vector2d shift = Eigen::Vector2d::Zero();
+  {
     std::vector<bool> in_front;
     const std::vector<Eigen::Vector2d> uv = ProjectPoints(estimate, reference, &in_front);
+    const std::vector<Eigen::Vector2d>& blobs =
+        detections_px.empty() ? std::vector<Eigen::Vector2d>() : detections_px[0];
+    constexpr double kVoteRadiusPx = 2.0;
+    int best_votes = 0;
+    for (std::size_t r = 0; r < reference.size(); ++r) {
+      if (!in_front[r]) continue;
+      for (const Eigen::Vector2d& blob : blobs) {
+        const Eigen::Vector2d candidate = blob - uv[r];
+        if (candidate.norm() > options.max_shift_px) continue;
+        int votes = 0;
+        for (std::size_t q = 0; q < reference.size(); ++q) {
+          if (!in_front[q]) continue;
+          for (const Eigen::Vector2d& other : blobs) {
+            if ((other - uv[q] - candidate).squaredNorm() < kVoteRadiusPx * kVoteRadiusPx) {
+              ++votes;
+              break;
+            }
+          }
+        }
+        if (votes > best_votes) {
+          best_votes = votes;
+          shift = candidate;
+        }
+      }
+    }
+  }
+  for (std::size_t round = 0; round < options.match_gates_px.size(); ++round) {
+    const double gate = options.match_gates_px[round];
+    std::vector<bool> in_front;
+    std::vector<Eigen::Vector2d> uv = ProjectPoints(estimate, reference, &in_front);
+    if (round == 0) {
+      for (Eigen::Vector2d& p : uv) p += shift;
+    }
     std::vector<cv::Point3f> object;
     std::vector<cv::Point2f> image;
     for (const std::vector<Eigen::Vector2d>& blobs : detections_px) {

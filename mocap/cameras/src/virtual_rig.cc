@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <mutex>
 
 #include "ccsrm/common/error.h"
 
@@ -184,23 +186,46 @@ cv::Mat RenderCheckerboard(const Camera& camera, const CheckerboardTarget& board
                            const CheckerboardRenderOptions& options) {
   const int width = camera.image_width_px;
   const int height = camera.image_height_px;
-  // Where each pixel of the distorted image looks in the ideal pinhole image.
-  std::vector<Eigen::Vector2d> pixels;
-  pixels.reserve(static_cast<std::size_t>(width) * height);
-  for (int r = 0; r < height; ++r) {
-    for (int c = 0; c < width; ++c) pixels.emplace_back(c, r);
+  // Where each pixel of the distorted image looks in the ideal pinhole
+  // image: the costly part (an iterative undistortion of every pixel), kept
+  // for the last camera rendered since calibration renders many views of one.
+  static std::mutex cache_mutex;
+  static Camera cached_camera;
+  static std::shared_ptr<const std::vector<Eigen::Vector2d>> cached_ideal;
+  std::shared_ptr<const std::vector<Eigen::Vector2d>> ideal_ptr;
+  {
+    std::lock_guard<std::mutex> lock(cache_mutex);
+    if (cached_ideal && cached_camera.K == camera.K &&
+        cached_camera.distortion == camera.distortion && cached_camera.image_width_px == width &&
+        cached_camera.image_height_px == height) {
+      ideal_ptr = cached_ideal;
+    }
   }
-  const std::vector<Eigen::Vector2d> normalized = UndistortToNormalized(camera, pixels);
+  if (!ideal_ptr) {
+    std::vector<Eigen::Vector2d> pixels;
+    pixels.reserve(static_cast<std::size_t>(width) * height);
+    for (int r = 0; r < height; ++r) {
+      for (int c = 0; c < width; ++c) pixels.emplace_back(c, r);
+    }
+    const std::vector<Eigen::Vector2d> normalized = UndistortToNormalized(camera, pixels);
+    auto ideal_new = std::make_shared<std::vector<Eigen::Vector2d>>(normalized.size());
+    for (std::size_t i = 0; i < normalized.size(); ++i) {
+      (*ideal_new)[i] = Eigen::Vector2d(
+          camera.fx() * normalized[i].x() + camera.K(0, 1) * normalized[i].y() + camera.K(0, 2),
+          camera.fy() * normalized[i].y() + camera.K(1, 2));
+    }
+    ideal_ptr = ideal_new;
+    std::lock_guard<std::mutex> lock(cache_mutex);
+    cached_camera = camera;
+    cached_ideal = ideal_ptr;
+  }
+  const std::vector<Eigen::Vector2d>& ideal = *ideal_ptr;
   double min_u = 0, min_v = 0, max_u = width - 1, max_v = height - 1;
-  std::vector<Eigen::Vector2d> ideal(normalized.size());
-  for (std::size_t i = 0; i < normalized.size(); ++i) {
-    ideal[i] = Eigen::Vector2d(
-        camera.fx() * normalized[i].x() + camera.K(0, 1) * normalized[i].y() + camera.K(0, 2),
-        camera.fy() * normalized[i].y() + camera.K(1, 2));
-    min_u = std::min(min_u, ideal[i].x());
-    min_v = std::min(min_v, ideal[i].y());
-    max_u = std::max(max_u, ideal[i].x());
-    max_v = std::max(max_v, ideal[i].y());
+  for (const Eigen::Vector2d& p : ideal) {
+    min_u = std::min(min_u, p.x());
+    min_v = std::min(min_v, p.y());
+    max_u = std::max(max_u, p.x());
+    max_v = std::max(max_v, p.y());
   }
   // The ideal image, rendered on a canvas that covers every lookup.
   const int offset_u = static_cast<int>(std::floor(min_u)) - 2;
@@ -273,7 +298,7 @@ std::vector<std::pair<Eigen::Matrix3d, Eigen::Vector3d>> CalibrationBoardPoses(
     const Eigen::Vector3d centre_C =
         depth * Eigen::Vector3d((u - camera.K(0, 2)) / camera.fx(),
                                 (v - camera.K(1, 2)) / camera.fy(), 1.0);
-    const double tilt = Deg(rng.uniform(10.0, 40.0));
+    const double tilt = Deg(rng.uniform(20.0, 50.0));
     const double tilt_axis = rng.uniform(0.0, 2.0 * kPi);
     const double spin = Deg(rng.uniform(-30.0, 30.0));
     const Eigen::Matrix3d R_CG =

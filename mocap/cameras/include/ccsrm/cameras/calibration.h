@@ -62,6 +62,27 @@ struct ExtrinsicCalibration {
   std::size_t correspondences = 0;
 };
 
+// A checkerboard at a known pose in W, seen in one image.
+struct WorldBoardView {
+  cv::Mat image;  // 8-bit gray
+  std::string name;
+  CheckerboardTarget board;
+  Eigen::Matrix3d R_WG = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p_WG = Eigen::Vector3d::Zero();
+};
+
+// Intrinsics and pose in W together: the world board is one more view of
+// cv::calibrateCamera, so the focal length and the pose agree (a focal
+// length 0.05 % off moves a camera 2 m away by 1 mm along its axis when the
+// two are fitted apart). The camera of the result carries the pose; the
+// extrinsic result gives the world board's reprojection error. Throws
+// InputError when the world board is not found (naming its image) or as
+// CalibrateIntrinsics does.
+std::pair<IntrinsicCalibration, ExtrinsicCalibration> CalibrateCameraInWorld(
+    const std::vector<cv::Mat>& images, const std::vector<std::string>& names,
+    const CheckerboardTarget& board, const WorldBoardView& world, const std::string& camera_name,
+    const IntrinsicCalibrationOptions& options = {});
+
 // Pose of `camera` (intrinsics known) from one image of `board` lying at the
 // known pose R_WG, p_WG. Throws InputError (naming `image_name`) when the
 // board is not found.
@@ -72,9 +93,13 @@ ExtrinsicCalibration CalibrateExtrinsicsFromBoard(const Camera& camera, const cv
                                                   const Eigen::Vector3d& p_WG);
 
 struct MarkerExtrinsicsOptions {
+  // Largest image shift between the starting pose and the truth [px]: the
+  // shift that lines up the most markers is found first (a vote).
+  double max_shift_px = 300.0;
   // Gates of the successive matching rounds [px]: detections are matched to
-  // the reference points projected with the current pose estimate.
-  std::vector<double> match_gates_px = {25.0, 6.0, 2.0};
+  // the reference points projected with the current pose estimate (the
+  // first round after the shift).
+  std::vector<double> match_gates_px = {4.0, 3.0, 2.0};
   // Fewest matched reference points (solvePnP needs 4; more is safer).
   int min_points = 6;
 };
@@ -83,7 +108,8 @@ struct MarkerExtrinsicsOptions {
 // positions are known (p_W_reference; NaN entries are skipped), over one or
 // more frames: detections_px[frame] are the blob centroids of one frame.
 // The camera's current extrinsics are the starting guess (a tape-measure
-// placement is enough: within a few centimetres and degrees). Throws
+// placement: a few centimetres and degrees off, which mostly shifts the
+// image; the roll about the optical axis should be within about 0.5 deg). Throws
 // InputError naming `camera.name` when too few points match.
 ExtrinsicCalibration CalibrateExtrinsicsFromMarkers(
     const Camera& camera, const std::vector<Eigen::Vector3d>& p_W_reference,

@@ -157,7 +157,7 @@ cv::Mat RenderCheckerboard(const Camera& camera, const CheckerboardTarget& board
                            const CheckerboardRenderOptions& options);
 
 // `views` board poses (R_CG, p_CG) in front of `camera` for intrinsic
-// calibration: tilted by up to 40 deg, spread over the image so lens
+// calibration: tilted by 20-50 deg, spread over the image so lens
 // distortion is seen, every corner inside the image. Deterministic in seed.
 std::vector<std::pair<Eigen::Matrix3d, Eigen::Vector3d>> CalibrationBoardPoses(
     const Camera& camera, const CheckerboardTarget& board, int views, std::uint64_t seed);
