@@ -9,4 +9,5 @@ void AddConfigCommands(CLI::App& root);
 void AddDatasetCommands(CLI::App& root);
 void AddSimulateCommand(CLI::App& root);
 void AddBenchCommand(CLI::App& root);
+void AddCamerasCommands(CLI::App& root);
 }  // namespace ccsrm::app

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   ccsrm::app::AddDatasetCommands(root);
   ccsrm::app::AddSimulateCommand(root);
   ccsrm::app::AddBenchCommand(root);
+  ccsrm::app::AddCamerasCommands(root);
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
