@@ -2,6 +2,7 @@
 // Shared set-up of the camera tests: the paper arm, planned motions whose
 // markers are known exactly, and scratch directories.
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <Eigen/Core>
 
 #include <cmath>
@@ -70,11 +71,13 @@ inline std::vector<double> EvenTimes(double first, double last, int count) {
   return times;
 }
 
-// A fresh directory under the build tree, removed with its contents.
+// A fresh directory under the build tree, removed with its contents; the
+// process id keeps tests that run in parallel apart.
 class ScratchDir {
  public:
   explicit ScratchDir(const std::string& name)
-      : path_(std::filesystem::path(CCSRM_BINARY_DIR) / "test-scratch" / name) {
+      : path_(std::filesystem::path(CCSRM_BINARY_DIR) / "test-scratch" /
+              (name + "-" + std::to_string(::getpid()))) {
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }
