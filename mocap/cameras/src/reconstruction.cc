@@ -79,7 +79,8 @@ class FrameProcessor {
       views_[marker] += point.views.size();
       residual_[marker] += point.ray_residual_m;
       for (const View& view : point.views) {
-        if (view.camera < 8) mask_row[marker] |= static_cast<std::uint8_t>(1u << view.camera);
+        // The C3D residual word has room for 7 cameras.
+        if (view.camera < 7) mask_row[marker] |= static_cast<std::uint8_t>(1u << view.camera);
         const Camera& camera = rig_.cameras[view.camera];
         const Eigen::Vector2d uv = ProjectPoints(camera, {point.p_W})[0];
         squared_reprojection_[view.camera] +=

@@ -228,7 +228,7 @@ struct ReconstructionQuality {
 struct ReconstructionResult {
   // As the file readers give: metres, NaN where not seen, labels in layout
   // order, rate from the rig; has_residual with the ray residual and the
-  // cameras that saw each sample (bit i = camera i + 1, first 8 cameras).
+  // cameras that saw each sample (bit i = camera i + 1, first 7 cameras, as in C3D).
   mocap::MarkerTable markers;
   ReconstructionQuality quality;
 };
