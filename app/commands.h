@@ -11,4 +11,5 @@ void AddSimulateCommand(CLI::App& root);
 void AddBenchCommand(CLI::App& root);
 void AddMocapCommands(CLI::App& root);
 void AddGenerateCommand(CLI::App& root);
+void AddCamerasCommands(CLI::App& root);
 }  // namespace ccsrm::app

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   ccsrm::app::AddBenchCommand(root);
   ccsrm::app::AddMocapCommands(root);
   ccsrm::app::AddGenerateCommand(root);
+  ccsrm::app::AddCamerasCommands(root);
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
