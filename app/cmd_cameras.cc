@@ -91,14 +91,7 @@ mocap::MarkerLayout LayoutFrom(const std::string& config, const std::string& exp
                                double* max_link_spacing_m) {
   if (!config.empty()) {
     const sim::ArmModel model(sim::LoadConfig(config));
-    // Between one link spacing and two: halfway between the longest link
-    // and twice the shortest.
-    double shortest = 1e9, longest = 0.0;
-    for (const sim::LinkModel& link : model.links()) {
-      shortest = std::min(shortest, link.length_m);
-      longest = std::max(longest, link.length_m);
-    }
-    *max_link_spacing_m = 0.5 * (longest + 2.0 * shortest);
+    *max_link_spacing_m = cameras::MaxLinkSpacing(model);
     return mocap::DefaultMarkerLayout(model);
   }
   const datasets::ExperimentFile file = datasets::ReadExperimentFile(experiment);

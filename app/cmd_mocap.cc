@@ -7,7 +7,10 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
+#include "ccsrm/cameras/camera_model.h"
+#include "ccsrm/cameras/reconstruction.h"
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/datasets/experiment_file.h"
@@ -46,6 +49,8 @@ struct Layout {
   // Joint positions of the arm, from --config or else the experiment's
   // nominal configuration; none when neither is there.
   std::optional<mocap::JointChain> chain;
+  // For labelling camera reconstructions; 0 without an arm configuration.
+  double max_link_spacing_m = 0.0;
 };
 
 // The rigid bodies: --rigid-bodies, else the default layout of --config, else
@@ -62,7 +67,10 @@ Layout ResolveLayout(const std::string& rigid_bodies, const std::string& config,
     model = std::make_unique<sim::ArmModel>(
         sim::ParseConfig(experiment->config_yaml, input + ": attribute 'config_yaml'"));
   }
-  if (model) out.chain = mocap::JointChain::FromModel(*model);
+  if (model) {
+    out.chain = mocap::JointChain::FromModel(*model);
+    out.max_link_spacing_m = cameras::MaxLinkSpacing(*model);
+  }
   if (!rigid_bodies.empty()) {
     out.layout = mocap::ReadRigidBodiesFile(rigid_bodies);
   } else if (model) {
@@ -92,6 +100,8 @@ Layout ResolveLayout(const std::string& rigid_bodies, const std::string& config,
 
 struct ProcessArgs {
   std::string in;
+  std::string cameras;
+  std::vector<std::string> videos;
   std::string rigid_bodies;
   std::string config;
   std::string static_trial;
@@ -118,7 +128,16 @@ void CopyInputs(const std::string& path, datasets::ExperimentFile* experiment) {
 
 void RunProcess(ProcessArgs a) {
   a.options.rigid_fill = !a.no_rigid_fill;
-  RefuseToOverwrite(a.in, a.out);
+  if (a.in.empty() && a.cameras.empty()) {
+    ThrowInputError("mocap process", "--in", "give --in FILE or --cameras FILE --video ...");
+  }
+  if (!a.cameras.empty() && a.config.empty() && a.rigid_bodies.empty()) {
+    ThrowInputError(a.cameras, "--config",
+                    "videos need --config or --rigid-bodies (the markers to label)");
+  }
+  if (!a.in.empty()) RefuseToOverwrite(a.in, a.out);
+  if (!a.cameras.empty()) RefuseToOverwrite(a.cameras, a.out);
+  for (const std::string& video : a.videos) RefuseToOverwrite(video, a.out);
   { const AtomicOutputFile probe(a.out); }  // fail on a bad output path before working
 
   // What is read, and the experiment the result goes into.
@@ -140,18 +159,38 @@ void RunProcess(ProcessArgs a) {
     experiment.input_length_change = run.input_length_change;
     experiment.source = datasets::ExperimentSource::kGenerated;
     run_config_yaml = run.config_yaml;
-  } else {
+  } else if (a.cameras.empty()) {
     table = mocap::ReadMarkerFile(a.in);
   }
 
+  const std::string& source = a.cameras.empty() ? a.in : a.cameras;
   const Layout layout = ResolveLayout(a.rigid_bodies, a.config, a.static_trial,
-                                      from_experiment ? &experiment : nullptr, a.in);
+                                      from_experiment ? &experiment : nullptr, source);
+  if (!a.cameras.empty()) {
+    // Camera front end (mocap/cameras): the same marker table a file gives.
+    const cameras::CameraRig rig = cameras::LoadCameraRig(a.cameras);
+    cameras::ReconstructionOptions options;
+    if (layout.max_link_spacing_m > 0.0)
+      options.labelling.max_link_spacing_m = layout.max_link_spacing_m;
+    if (!a.quiet) {
+      options.progress = [](std::size_t done, std::size_t total) {
+        if (done % 25 == 0 || done == total) {
+          std::fprintf(stderr, "\rreconstructing frame %zu / %zu", done, total);
+          if (done == total) std::fprintf(stderr, "\n");
+        }
+      };
+    }
+    const cameras::ReconstructionResult reconstruction =
+        cameras::ReconstructMarkers(rig, a.videos, layout.layout, options);
+    std::printf("%s", reconstruction.quality.BriefReport().c_str());
+    table = reconstruction.markers;
+  }
   const mocap::ProcessingResult result = mocap::ProcessMarkers(
       table, time, layout.layout, a.options, a.in, layout.chain ? &*layout.chain : nullptr);
 
   if (!from_experiment) {
     experiment.name = fs::path(a.out).stem().string();
-    experiment.description = "markers of " + fs::path(a.in).filename().string() + " (" +
+    experiment.description = "markers of " + fs::path(source).filename().string() + " (" +
                              table.format + "), processed by ccsrm mocap process";
     experiment.config_yaml = !layout.config_yaml.empty() ? layout.config_yaml : run_config_yaml;
     experiment.mocap_time = datasets::Array({result.time.size()});
@@ -213,7 +252,14 @@ void AddMocapCommands(CLI::App& root) {
       "figures into a ccsrm-dataset/1 experiment");
   auto a = std::make_shared<ProcessArgs>();
   const mocap::ProcessingOptions defaults;
-  process->add_option("--in", a->in, "Marker file (any format mocap inspect reads)")->required();
+  auto* in = process->add_option("--in", a->in, "Marker file (any format mocap inspect reads)");
+  auto* cams = process->add_option(
+      "--cameras", a->cameras,
+      "Calibrated camera file (ccsrm-cameras/1) for videos instead of a marker file");
+  process->add_option("--video", a->videos, "With --cameras: one video per camera, in file order")
+      ->needs(cams);
+  in->excludes(cams);
+  cams->needs("--video");
   process->add_option("--rigid-bodies", a->rigid_bodies,
                       "Rigid bodies (ccsrm-rigid-bodies/1 YAML, mocap/README.md)");
   process->add_option("--config", a->config,

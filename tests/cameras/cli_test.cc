@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <limits>
@@ -12,6 +13,7 @@
 #include "ccsrm/cameras/reconstruction.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/datasets/experiment_file.h"
+#include "ccsrm/datasets/run_file.h"
 #include "ccsrm/mocap/c3d.h"
 
 namespace ccsrm::cameras {
@@ -123,6 +125,43 @@ TEST(CamerasCli, SimulatedRunRendersAndReconstructsIntoC3dNearTheTruth) {
     }
   }
   EXPECT_LT(std::sqrt(sum / valid), 0.3e-3);
+}
+
+TEST(CamerasCli, MocapProcessTakesVideosToJointAnglesNearTheSimulation) {
+  // The end-to-end check: case 2 motion, 4 cameras at 1280x1024,
+  // 0.2 px noise, through `ccsrm mocap process --cameras ... --video ...`.
+  const ScratchDir dir("cli_mocap_process");
+  const std::string run_file = dir / "run.h5";
+  CommandRun run = Ccsrm("simulate --config " CCSRM_SOURCE_DIR
+                         "/configs/paper.yaml --case 2 --duration 1 --quiet --out " +
+                         run_file);
+  ASSERT_EQ(run.status, 0) << run.output;
+  run = Ccsrm("cameras render --in " + run_file + " --noise-px 0.2 --seed 7 --out " + dir / "vids");
+  ASSERT_EQ(run.status, 0) << run.output;
+  const std::string videos = dir / "vids/cam1.avi" + " " + dir / "vids/cam2.avi" + " " +
+                             dir / "vids/cam3.avi" + " " + dir / "vids/cam4.avi";
+  run = Ccsrm("mocap process --quiet --cameras " + dir / "vids/cameras.yaml" + " --video " +
+              videos + " --config " CCSRM_SOURCE_DIR "/configs/paper.yaml --out " + dir / "exp.h5");
+  ASSERT_EQ(run.status, 0) << run.output;
+  const datasets::ExperimentFile experiment = datasets::ReadExperimentFile(dir / "exp.h5");
+  const datasets::RunFile truth = datasets::ReadRunFile(run_file);
+  ASSERT_TRUE(experiment.measured_joint_angles.has_value());
+  ASSERT_EQ(experiment.measured_joint_angles->values.size(), truth.joint_angles.values.size());
+  double worst_rms_deg = 0.0;
+  for (std::size_t j = 0; j < 12; ++j) {
+    for (std::size_t axis = 0; axis < 2; ++axis) {
+      double sum = 0.0;
+      for (std::size_t f = 0; f < truth.frames(); ++f) {
+        const double e =
+            experiment.measured_joint_angles->at(f, j, axis) - truth.joint_angles.at(f, j, axis);
+        ASSERT_TRUE(std::isfinite(e)) << "joint " << j + 1 << " frame " << f;
+        sum += e * e;
+      }
+      worst_rms_deg = std::max(worst_rms_deg, std::sqrt(sum / truth.frames()) * 180.0 / M_PI);
+    }
+  }
+  std::printf("videos -> mocap process: worst joint-angle RMS %.4f deg\n", worst_rms_deg);
+  EXPECT_LT(worst_rms_deg, 0.05);
 }
 
 TEST(ReadMarkerMotion, ExperimentMarkersAreRenderedAsRecorded) {

@@ -12,6 +12,15 @@
 #include "ccsrm/common/error.h"
 
 namespace ccsrm::cameras {
+
+double MaxLinkSpacing(const sim::ArmModel& model) {
+  double shortest = 1e9, longest = 0.0;
+  for (const sim::LinkModel& link : model.links()) {
+    shortest = std::min(shortest, link.length_m);
+    longest = std::max(longest, link.length_m);
+  }
+  return 0.5 * (longest + 2.0 * shortest);
+}
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();

@@ -18,6 +18,7 @@
 #include "ccsrm/cameras/camera_model.h"
 #include "ccsrm/mocap/marker_layout.h"
 #include "ccsrm/mocap/marker_table.h"
+#include "ccsrm/sim/model.h"
 
 namespace ccsrm::cameras {
 
@@ -175,6 +176,11 @@ class MarkerLabeller {
 };
 
 // ---- The whole pipeline ---------------------------------------------------------------
+
+// LabellingOptions::max_link_spacing_m for an arm: halfway between its
+// longest link and twice its shortest, so a plate is never looked for beyond
+// the next link.
+double MaxLinkSpacing(const sim::ArmModel& model);
 
 struct ReconstructionOptions {
   BlobDetectionOptions detection;
