@@ -746,9 +746,11 @@ double ArmDynamics::ConstraintViolation(double t, const double* y) {
   return std::sqrt(sum);
 }
 
-void ArmDynamics::Observe(double t, const double* y, Observation* out) {
-  std::vector<double> ydot(state_size());
-  Evaluate(t, y, ydot.data());
+void ArmDynamics::Observe(double t, const double* y, Observation* out, bool evaluate) {
+  if (evaluate) {
+    std::vector<double> ydot(state_size());
+    Evaluate(t, y, ydot.data());
+  }
   out->joint_angles = theta_;
   out->joint_rates = theta_dot_;
   out->link_pose.resize(model_.num_links());

@@ -82,7 +82,9 @@ class ArmDynamics {
   double ConstraintViolation(double t, const double* y);
 
   // Output quantities at (t, y); calls Evaluate for the tensions.
-  void Observe(double t, const double* y, Observation* out);
+  // With `evaluate` false the caller guarantees that the last Evaluate() was
+  // at (t, y) with the current hole modes, and its results are reused.
+  void Observe(double t, const double* y, Observation* out, bool evaluate = true);
 
   std::int64_t evaluations() const { return evaluations_; }
 

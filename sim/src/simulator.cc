@@ -369,7 +369,11 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
 
   for (long frame = 1; frame < frames_total && summary.completed; ++frame) {
     const double t_out = std::min(options.duration_s, frame * dt_out);
+    // True while the dynamics' last evaluation is at (t, y) under the
+    // current modes (the end of an accepted step): the frame reuses it.
+    bool last_evaluation_current = false;
     while (t < t_out && summary.completed) {
+      last_evaluation_current = false;
       if (!have_dydt_in) {
         if (!dynamics.Evaluate(t, y.data(), dydt_in.data())) {
           diverge(dynamics.failure());
@@ -426,6 +430,8 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
         if (!found.flips.empty()) {
           switches.Apply(t, y.data(), found);  // direction flips only: not stick-slip switches
           have_dydt_in = false;
+        } else {
+          last_evaluation_current = true;
         }
         continue;
       }
@@ -496,7 +502,7 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
       diverge("non-finite state");
       break;
     }
-    dynamics.Observe(t, y.data(), &observation);
+    dynamics.Observe(t, y.data(), &observation, !last_evaluation_current);
     summary.max_constraint_violation =
         std::max(summary.max_constraint_violation, observation.constraint_violation);
     if (observation.constraint_violation > solver.max_constraint_violation) {
