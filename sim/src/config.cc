@@ -298,6 +298,7 @@ void ValidateWithLines(const Config& c, const LineMap* lines) {
   }
   check.InRange("solver.relative_tolerance", s.relative_tolerance, 1e-14, 1e-1);
   check.InRange("solver.absolute_tolerance", s.absolute_tolerance, 1e-16, 1e-1);
+  check.InRange("solver.velocity_tolerance_time_s", s.velocity_tolerance_time_s, 1e-6, 1e3);
   check.Positive("solver.initial_step_s", s.initial_step_s);
   check.Positive("solver.max_step_s", s.max_step_s);
   check.Positive("solver.min_step_s", s.min_step_s);
@@ -429,6 +430,7 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
     sc.large_s_dynamic_velocity_mps = s.Number("large_s_dynamic_velocity_mps");
     sc.relative_tolerance = s.Number("relative_tolerance");
     sc.absolute_tolerance = s.Number("absolute_tolerance");
+    sc.velocity_tolerance_time_s = s.Number("velocity_tolerance_time_s");
     sc.initial_step_s = s.Number("initial_step_s");
     sc.max_step_s = s.Number("max_step_s");
     sc.min_step_s = s.Number("min_step_s");
@@ -556,6 +558,7 @@ std::string ToYaml(const Config& c) {
       << s.large_s_dynamic_velocity_mps;
   out << YAML::Key << "relative_tolerance" << YAML::Value << s.relative_tolerance;
   out << YAML::Key << "absolute_tolerance" << YAML::Value << s.absolute_tolerance;
+  out << YAML::Key << "velocity_tolerance_time_s" << YAML::Value << s.velocity_tolerance_time_s;
   out << YAML::Key << "initial_step_s" << YAML::Value << s.initial_step_s;
   out << YAML::Key << "max_step_s" << YAML::Value << s.max_step_s;
   out << YAML::Key << "min_step_s" << YAML::Value << s.min_step_s;

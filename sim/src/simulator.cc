@@ -10,6 +10,7 @@
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <vector>
 
 #include "ccsrm/common/error.h"
 #include "dynamics.h"
@@ -38,9 +39,14 @@ int RightHandSide(double t, const double y[], double dydt[], void* params) {
 struct GslStepper {
   gsl_odeiv2_step* step = nullptr;
   gsl_odeiv2_control* control = nullptr;
-  GslStepper(std::size_t dim, double atol, double rtol) {
+  // State layout: n coordinates, n velocities, dissipated energy.
+  GslStepper(std::size_t dim, const SolverConfig& solver) {
     step = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rkf45, dim);
-    control = gsl_odeiv2_control_standard_new(atol, rtol, 1.0, 0.0);
+    std::vector<double> scale(dim, 1.0);
+    const std::size_t n = (dim - 1) / 2;
+    for (std::size_t k = n; k < 2 * n; ++k) scale[k] = 1.0 / solver.velocity_tolerance_time_s;
+    control = gsl_odeiv2_control_scaled_new(solver.absolute_tolerance, solver.relative_tolerance,
+                                            1.0, 0.0, scale.data(), dim);
   }
   ~GslStepper() {
     gsl_odeiv2_control_free(control);
@@ -57,10 +63,24 @@ struct GslStepper {
 // below the force tolerance (a cable running nearly straight through the
 // hole) the dynamics leave friction out, so such a node never sticks and its
 // slip direction just follows the slip speed, without an event.
+//
+// A release that fails at once (the node sticks again within
+// kFailedReleaseWindow of being released, before it has moved) means that
+// neither slip direction is consistent with a load so close to f_max: trial
+// and error then keeps the node stuck, and it is not released again until the
+// friction it needs has grown by the force tolerance beyond what it needed at
+// that failed release. Without this, such a node switches back and forth at
+// one instant forever.
 class SwitchDetector {
  public:
   SwitchDetector(const ArmModel& model, ArmDynamics* dynamics, const SolverConfig& solver)
-      : model_(model), dynamics_(dynamics), solver_(solver), scratch_(dynamics->state_size()) {}
+      : model_(model),
+        dynamics_(dynamics),
+        solver_(solver),
+        scratch_(dynamics->state_size()),
+        release_time_(dynamics->hole_modes().size(), -1.0),
+        release_friction_(dynamics->hole_modes().size(), 0.0),
+        pinned_friction_(dynamics->hole_modes().size(), 0.0) {}
 
   struct Switches {
     std::vector<int> located;  // must be located in time, then switched
@@ -91,8 +111,7 @@ class SwitchDetector {
       const int h = only != nullptr ? (*only)[k] : k;
       const HoleReport& r = reports[h];
       if (modes[h] == HoleMode::kStuck) {
-        if (std::abs(r.required_friction) > r.friction_limit + f_tol)
-          out->located.push_back(static_cast<int>(h));
+        if (std::abs(r.required_friction) > ReleaseThreshold(h)) out->located.push_back(h);
       } else {
         const double sigma = modes[h] == HoleMode::kSlipUp ? 1.0 : -1.0;
         const double threshold = locating ? 0.0 : solver_.stick_velocity_tolerance_mps;
@@ -111,9 +130,7 @@ class SwitchDetector {
   double SwitchFunction(int h) const {
     const HoleReport& r = dynamics_->hole_reports()[h];
     const HoleMode mode = dynamics_->hole_modes()[h];
-    if (mode == HoleMode::kStuck) {
-      return std::abs(r.required_friction) - (r.friction_limit + solver_.stick_force_tolerance_n);
-    }
+    if (mode == HoleMode::kStuck) return std::abs(r.required_friction) - ReleaseThreshold(h);
     return mode == HoleMode::kSlipUp ? -r.s_dot : r.s_dot;
   }
 
@@ -130,16 +147,32 @@ class SwitchDetector {
       Trace(h, modes[h], reports[h]);
       if (modes[h] == HoleMode::kStuck) {
         modes[h] = SlipDirection(t, y, h, reports[h]);
+        release_time_[h] = t;
+        release_friction_[h] = std::abs(reports[h].required_friction);
+        pinned_friction_[h] = 0.0;
       } else {
         const auto& hole = dynamics_->holes()[h];
         modes[h] = HoleMode::kStuck;
         dynamics_->stuck_position()[h] = y[model_.node_offset(hole.cable, hole.node) + 3];
+        if (release_time_[h] >= 0.0 &&
+            t - release_time_[h] <= kFailedReleaseWindow * solver_.switch_time_tolerance_s) {
+          pinned_friction_[h] = release_friction_[h] + solver_.stick_force_tolerance_n;
+        }
       }
     }
     return static_cast<std::int64_t>(switches.located.size());  // flips are not stick-slip switches
   }
 
  private:
+  // A failed release is one undone within this many switch time tolerances.
+  static constexpr double kFailedReleaseWindow = 2.0;
+
+  // The required friction [N] above which stuck hole h slips.
+  double ReleaseThreshold(int h) const {
+    const HoleReport& r = dynamics_->hole_reports()[h];
+    return std::max(r.friction_limit + solver_.stick_force_tolerance_n, pinned_friction_[h]);
+  }
+
   // The direction a released node slips (trial and error, section 2.3). A
   // node still moving slips the way it moves. A node at rest is tried both
   // ways, starting against the friction its constraint was applying, and
@@ -177,6 +210,11 @@ class SwitchDetector {
   ArmDynamics* dynamics_;
   const SolverConfig& solver_;
   std::vector<double> scratch_;
+  // Per hole: when it was last released (-1: never), the friction it needed
+  // then [N], and the raised release threshold after a failed release (0: none).
+  std::vector<double> release_time_;
+  std::vector<double> release_friction_;
+  std::vector<double> pinned_friction_;
   // CCSRM_TRACE_SWITCHES=1 prints every stick-slip switch on stderr.
   std::FILE* trace_ = std::getenv("CCSRM_TRACE_SWITCHES") != nullptr ? stderr : nullptr;
 };
@@ -324,7 +362,7 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
   std::vector<double> y_prev(dim), dydt_prev(dim);
   bool have_dydt_in = false;
   gsl_odeiv2_system system{RightHandSide, nullptr, dim, &dynamics};
-  GslStepper gsl(dim, solver.absolute_tolerance, solver.relative_tolerance);
+  GslStepper gsl(dim, solver);
   SwitchDetector switches(model, &dynamics, solver);
 
   SimulationSummary summary;
@@ -366,6 +404,11 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
   summary.max_constraint_violation = observation.constraint_violation;
   summary.completed = true;
   std::int64_t rejected = 0;
+  // Switch events in a row that left time where it was: a guard against
+  // stick-slip chatter that the trial-and-error rules do not resolve.
+  int stalled_switch_events = 0;
+  double last_switch_event_t = -1.0;
+  constexpr int kMaxStalledSwitchEvents = 1000;
 
   for (long frame = 1; frame < frames_total && summary.completed; ++frame) {
     const double t_out = std::min(options.duration_s, frame * dt_out);
@@ -441,6 +484,15 @@ SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
       // first node to switch decides). Trials restart single steps from the
       // last point known to need no switch.
       const std::vector<int> candidates = found.located;
+      if (t0 - last_switch_event_t > solver.switch_time_tolerance_s) stalled_switch_events = 0;
+      if (++stalled_switch_events > kMaxStalledSwitchEvents) {
+        const auto& hole = dynamics.holes()[candidates.front()];
+        diverge("stick-slip chatter of cable " + std::to_string(hole.cable + 1) + " hole node " +
+                std::to_string(hole.node) + " (" + std::to_string(kMaxStalledSwitchEvents) +
+                " switch events without time advancing)");
+        break;
+      }
+      last_switch_event_t = t0;
       std::vector<double> scale(candidates.size());
       auto combined = [&](bool set_scale) {
         double g = -std::numeric_limits<double>::infinity();

@@ -148,6 +148,8 @@ double MaxJointAngleDifferenceDeg(const datasets::RunFile& a, const datasets::Ru
 TEST(ArmDynamics, DefaultTolerancesAreConvergedForJointAngles) {
   // The default RK45 tolerances must not be what the joint angles depend on:
   // ten times tighter moves them by far less than mocap resolves (~0.01 deg).
+  // Measured 8.5e-4 deg: with stick-slip, a switch a little earlier leaves
+  // the arm stuck a little elsewhere, so this is not an O(tol) difference.
   const Config paper = LoadConfig(kPaper);
   Config tight = paper;
   tight.solver.relative_tolerance /= 10.0;
@@ -159,7 +161,7 @@ TEST(ArmDynamics, DefaultTolerancesAreConvergedForJointAngles) {
   std::printf("case 2, 2 s: %lld vs %lld steps, joint angles differ by %.2e deg at most\n",
               static_cast<long long>(a.summary.steps), static_cast<long long>(b.summary.steps),
               difference);
-  EXPECT_LT(difference, 1e-3);
+  EXPECT_LT(difference, 5e-3);
 }
 
 TEST(ArmDynamics, ConnectingCableSmoothingChangesJointAnglesLittle) {

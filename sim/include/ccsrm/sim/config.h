@@ -95,6 +95,10 @@ struct SolverConfig {
   double large_s_dynamic_velocity_mps = 2e-4;
   double relative_tolerance = 1e-5;
   double absolute_tolerance = 1e-7;
+  // Velocities get the absolute tolerance absolute_tolerance / this time: a
+  // velocity error that small moves a position by absolute_tolerance over
+  // it. Without it the tip link's quaternion rate held the steps to ~4 ms.
+  double velocity_tolerance_time_s = 0.01;
   double initial_step_s = 1e-5;
   double max_step_s = 1e-2;
   double min_step_s = 1e-12;
