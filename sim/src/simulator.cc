@@ -68,7 +68,7 @@ struct GslStepper {
 // kFailedReleaseWindow of being released, before it has moved) means that
 // neither slip direction is consistent with a load so close to f_max: trial
 // and error then keeps the node stuck, and it is not released again until the
-// friction it needs has grown by the force tolerance beyond what it needed at
+// friction it needs exceeds f_max by the force tolerance more than it did at
 // that failed release. Without this, such a node switches back and forth at
 // one instant forever.
 class SwitchDetector {
@@ -79,8 +79,8 @@ class SwitchDetector {
         solver_(solver),
         scratch_(dynamics->state_size()),
         release_time_(dynamics->hole_modes().size(), -1.0),
-        release_friction_(dynamics->hole_modes().size(), 0.0),
-        pinned_friction_(dynamics->hole_modes().size(), 0.0) {}
+        release_excess_(dynamics->hole_modes().size(), 0.0),
+        pinned_excess_(dynamics->hole_modes().size(), 0.0) {}
 
   struct Switches {
     std::vector<int> located;  // must be located in time, then switched
@@ -148,15 +148,15 @@ class SwitchDetector {
       if (modes[h] == HoleMode::kStuck) {
         modes[h] = SlipDirection(t, y, h, reports[h]);
         release_time_[h] = t;
-        release_friction_[h] = std::abs(reports[h].required_friction);
-        pinned_friction_[h] = 0.0;
+        release_excess_[h] = std::abs(reports[h].required_friction) - reports[h].friction_limit;
+        pinned_excess_[h] = 0.0;
       } else {
         const auto& hole = dynamics_->holes()[h];
         modes[h] = HoleMode::kStuck;
         dynamics_->stuck_position()[h] = y[model_.node_offset(hole.cable, hole.node) + 3];
         if (release_time_[h] >= 0.0 &&
             t - release_time_[h] <= kFailedReleaseWindow * solver_.switch_time_tolerance_s) {
-          pinned_friction_[h] = release_friction_[h] + solver_.stick_force_tolerance_n;
+          pinned_excess_[h] = release_excess_[h] + solver_.stick_force_tolerance_n;
         }
       }
     }
@@ -170,7 +170,7 @@ class SwitchDetector {
   // The required friction [N] above which stuck hole h slips.
   double ReleaseThreshold(int h) const {
     const HoleReport& r = dynamics_->hole_reports()[h];
-    return std::max(r.friction_limit + solver_.stick_force_tolerance_n, pinned_friction_[h]);
+    return r.friction_limit + std::max(solver_.stick_force_tolerance_n, pinned_excess_[h]);
   }
 
   // The direction a released node slips (trial and error, section 2.3). A
@@ -210,11 +210,12 @@ class SwitchDetector {
   ArmDynamics* dynamics_;
   const SolverConfig& solver_;
   std::vector<double> scratch_;
-  // Per hole: when it was last released (-1: never), the friction it needed
-  // then [N], and the raised release threshold after a failed release (0: none).
+  // Per hole: when it was last released (-1: never), by how much the friction
+  // it needed then exceeded f_max [N], and the raised excess a release needs
+  // after a failed one (0: the force tolerance applies).
   std::vector<double> release_time_;
-  std::vector<double> release_friction_;
-  std::vector<double> pinned_friction_;
+  std::vector<double> release_excess_;
+  std::vector<double> pinned_excess_;
   // CCSRM_TRACE_SWITCHES=1 prints every stick-slip switch on stderr.
   std::FILE* trace_ = std::getenv("CCSRM_TRACE_SWITCHES") != nullptr ? stderr : nullptr;
 };
