@@ -543,21 +543,22 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
       const double th_i = theta_[i][axis], th_j = theta_[j][axis];
       const double rt_i = theta_dot_[i][axis], rt_j = theta_dot_[j][axis];
       ConnectingMoments m;
-      double k_conservative = 0.0;  // N·m/rad, of the spring between the joints
-      double damping = 0.0;         // N·m·s/rad
+      // N·m/rad: the frictionless couple (energy bookkeeping), and the
+      // stiffness it has right now (smoothing).
+      double k_conservative = 0.0, k_now = 0.0;
+      double damping = 0.0;  // N·m·s/rad
       // (h/2) C on (theta_dot_i, theta_dot_j): smoothing of the conduit friction.
       Eigen::Matrix2d friction_smoothing = Eigen::Matrix2d::Zero();
       if (pair.kind == ConnectingKind::kSmallS) {
         m = SmallSMoments(pair.small, th_i, th_j, rt_i, rt_j);
-        k_conservative = SmallSStiffness(pair.small);
+        k_conservative = k_now = SmallSStiffness(pair.small);
         damping = pair.small.damping_nmsprad;
       } else {
         const LargeSResult large = LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j);
         m = large.moments;
-        // Elastic energy bookkeeping uses the frictionless couple; the
-        // smoothing below uses the stiffness the couple has right now.
         k_conservative = SmallSStiffness({pair.large.axial_stiffness_n, pair.large.pulley_radius_m,
                                           pair.large.cable_length_m, 0.0});
+        k_now = large.stiffness_i;
         damping = pair.large.damping_nmsprad;
         if (smooth_connecting_friction_) {
           // Model smoothing of the conduit friction (interpretation beyond the
@@ -588,7 +589,6 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
                                eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
                                eig.eigenvectors().transpose();
         }
-        if (smooth_connecting_elasticity_) k_conservative = large.stiffness_i;
       }
       // Model smoothing of the connecting spring and damper (interpretation
       // beyond the paper, after eqs. 14-20): the moments see the
@@ -599,11 +599,7 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
       // c) and change the arm's slow transients by ~10 %. The bias of d_dd
       // (quadratic in the rates, ~1e-7 N·m here) is left out too.
       const double smoothing_mass =
-          smooth_connecting_elasticity_ ? k_conservative * h * h / 6.0 + damping * h / 2.0 : 0.0;
-      if (pair.kind == ConnectingKind::kLargeS) {
-        k_conservative = SmallSStiffness({pair.large.axial_stiffness_n, pair.large.pulley_radius_m,
-                                          pair.large.cable_length_m, 0.0});
-      }
+          smooth_connecting_elasticity_ ? k_now * h * h / 6.0 + damping * h / 2.0 : 0.0;
       if (smoothing_mass > 0.0 || !friction_smoothing.isZero(0.0)) {
         Eigen::Matrix<double, 2, 12> jac = Eigen::Matrix<double, 2, 12>::Zero();
         for (int l = 0; l < links; ++l) {
