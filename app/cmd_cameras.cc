@@ -17,6 +17,7 @@
 #include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/mocap/c3d.h"
 #include "ccsrm/mocap/marker_layout.h"
+#include "ccsrm/mocap/rigid_bodies.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/kinematics.h"
 #include "ccsrm/sim/model.h"
@@ -95,29 +96,9 @@ mocap::MarkerLayout LayoutFrom(const std::string& config, const std::string& exp
     return mocap::DefaultMarkerLayout(model);
   }
   const datasets::ExperimentFile file = datasets::ReadExperimentFile(experiment);
-  mocap::MarkerLayout layout;
-  for (const datasets::RigidBody& body : file.rigid_bodies) {
-    mocap::RigidBody out;
-    out.name = body.name;
-    if (body.name == "base") {
-      out.link = 0;
-    } else if (body.name.rfind("link", 0) == 0) {
-      out.link = std::atoi(body.name.c_str() + 4);
-    }
-    if (out.link < 0 || (out.link == 0 && body.name != "base")) {
-      ThrowInputError(experiment, "/mocap/rigid_bodies/" + body.name,
-                      "expected 'base' or 'link<N>' to know which body it is");
-    }
-    out.marker_names = body.marker_names;
-    for (std::size_t m = 0; m < body.marker_names.size(); ++m) {
-      out.p_BM.emplace_back(body.local_position.at(m, 0), body.local_position.at(m, 1),
-                            body.local_position.at(m, 2));
-    }
-    layout.bodies.push_back(std::move(out));
-  }
-  if (layout.marker_count() == 0)
+  if (file.rigid_bodies.empty())
     ThrowInputError(experiment, "/mocap/rigid_bodies", "no rigid body");
-  return layout;
+  return mocap::LayoutFromExperiment(file.rigid_bodies, experiment);
 }
 
 void AddRig(CLI::App& cameras) {
