@@ -32,6 +32,7 @@ function(ccsrm_add_test name)
   add_executable(${name} ${ARG_SOURCES})
   ccsrm_set_warnings(${name})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest_main GTest::gmock)
+  target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests/support)
   target_compile_definitions(${name} PRIVATE
     CCSRM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     CCSRM_SHARED_DIR="${CCSRM_SHARED_DIR}"

@@ -2,10 +2,8 @@
 // codes and one-line errors.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <nlohmann/json.hpp>
 
-#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -15,29 +13,13 @@
 #include "ccsrm/datasets/run_file.h"
 #include "ccsrm/mocap/c3d.h"
 #include "ccsrm/mocap/marker_io.h"
+#include "run_ccsrm.h"
 
 namespace {
 namespace fs = std::filesystem;
+using ccsrm::testing::RunCcsrm;
 using ::testing::HasSubstr;
-
-struct Outcome {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
-
-Outcome RunCcsrm(const std::string& args) {
-  const fs::path err_file = fs::temp_directory_path() / "ccsrm_mocap_cli_test_stderr.txt";
-  const std::string command = std::string(CCSRM_PROGRAM) + " " + args + " 2>" + err_file.string();
-  Outcome outcome;
-  FILE* pipe = popen(command.c_str(), "r");
-  std::array<char, 4096> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) outcome.out += buffer.data();
-  const int raw = pclose(pipe);
-  outcome.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  outcome.err = ccsrm::ReadTextFile(err_file.string());
-  return outcome;
-}
+using Outcome = ccsrm::testing::CommandOutcome;
 
 std::string Paper() { return std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml"; }
 std::string SharedC3d(const std::string& name) {

@@ -2,7 +2,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -15,33 +14,19 @@
 #include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/datasets/run_file.h"
 #include "ccsrm/mocap/c3d.h"
+#include "run_ccsrm.h"
 
 namespace ccsrm::cameras {
 namespace {
 
+using ccsrm::testing::CommandOutcome;
+using ccsrm::testing::RunCcsrm;
 using testing::ScratchDir;
-
-struct CommandRun {
-  int status = 0;
-  std::string output;  // stdout and stderr
-};
-
-CommandRun Ccsrm(const std::string& arguments) {
-  const std::string command = std::string(CCSRM_BINARY_DIR) + "/app/ccsrm " + arguments + " 2>&1";
-  CommandRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return {-1, "popen failed"};
-  std::array<char, 4096> buffer;
-  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) run.output += buffer.data();
-  const int status = pclose(pipe);
-  run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
 
 TEST(CamerasCli, RigWritesALoadableCameraFile) {
   const ScratchDir dir("cli_rig");
-  const CommandRun run = Ccsrm("cameras rig --out " + dir / "rig.yaml");
-  ASSERT_EQ(run.status, 0) << run.output;
+  const CommandOutcome run = RunCcsrm("cameras rig --out " + dir / "rig.yaml");
+  ASSERT_EQ(run.status, 0) << run.all();
   EXPECT_EQ(LoadCameraRig(dir / "rig.yaml").cameras.size(), 4u);
 }
 
@@ -49,41 +34,41 @@ TEST(CamerasCli, CorruptCameraFileExitsTwoWithOneLine) {
   const ScratchDir dir("cli_bad_cameras");
   std::ofstream(dir / "cams.yaml")
       << "%YAML:1.0\n---\nschema: \"ccsrm-cameras/1\"\nframe_rate_hz: 100.\n";
-  const CommandRun run =
-      Ccsrm("cameras reconstruct --cameras " + dir / "cams.yaml" + " --video a.avi --config " +
-            CCSRM_SOURCE_DIR "/configs/paper.yaml --out " + dir / "m.c3d");
+  const CommandOutcome run =
+      RunCcsrm("cameras reconstruct --cameras " + dir / "cams.yaml" + " --video a.avi --config " +
+               CCSRM_SOURCE_DIR "/configs/paper.yaml --out " + dir / "m.c3d");
   EXPECT_EQ(run.status, 2);
-  EXPECT_EQ(run.output, "ccsrm: " + dir / "cams.yaml" + ": cameras: missing\n");
+  EXPECT_EQ(run.all(), "ccsrm: " + dir / "cams.yaml" + ": cameras: missing\n");
   EXPECT_FALSE(std::filesystem::exists(dir / "m.c3d"));
 }
 
 TEST(CamerasCli, ReconstructWithoutALayoutIsRefused) {
   const ScratchDir dir("cli_no_layout");
-  ASSERT_EQ(Ccsrm("cameras rig --out " + dir / "rig.yaml").status, 0);
-  const CommandRun run = Ccsrm("cameras reconstruct --cameras " + dir / "rig.yaml" +
-                               " --video a.avi --out " + dir / "m.c3d");
+  ASSERT_EQ(RunCcsrm("cameras rig --out " + dir / "rig.yaml").status, 0);
+  const CommandOutcome run = RunCcsrm("cameras reconstruct --cameras " + dir / "rig.yaml" +
+                                      " --video a.avi --out " + dir / "m.c3d");
   EXPECT_EQ(run.status, 2);
-  EXPECT_NE(run.output.find("give --config or --rigid-bodies"), std::string::npos) << run.output;
+  EXPECT_NE(run.all().find("give --config or --rigid-bodies"), std::string::npos) << run.all();
 }
 
 TEST(CamerasCli, UnreadableVideoExitsTwoWithOneLine) {
   const ScratchDir dir("cli_bad_video");
-  ASSERT_EQ(Ccsrm("cameras rig --out " + dir / "rig.yaml").status, 0);
+  ASSERT_EQ(RunCcsrm("cameras rig --out " + dir / "rig.yaml").status, 0);
   std::ofstream(dir / "junk.avi") << "junk";
-  const CommandRun run = Ccsrm(
+  const CommandOutcome run = RunCcsrm(
       "cameras reconstruct --cameras " + dir / "rig.yaml" + " --video " + dir / "junk.avi" +
       " b.avi c.avi d.avi --config " CCSRM_SOURCE_DIR "/configs/paper.yaml --out " + dir / "m.c3d");
   EXPECT_EQ(run.status, 2);
-  EXPECT_EQ(run.output.rfind("ccsrm: " + dir / "junk.avi" + ": cannot open video", 0), 0u)
-      << run.output;
-  EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << run.output;
+  EXPECT_EQ(run.out, "");
+  EXPECT_EQ(run.err.rfind("ccsrm: " + dir / "junk.avi" + ": cannot open video", 0), 0u) << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
 }
 
 TEST(CamerasCli, BadBoardSizeIsNamed) {
   const ScratchDir dir("cli_bad_board");
-  const CommandRun run = Ccsrm("cameras render-board --board 9by6 --out " + dir / "boards");
+  const CommandOutcome run = RunCcsrm("cameras render-board --board 9by6 --out " + dir / "boards");
   EXPECT_EQ(run.status, 2);
-  EXPECT_EQ(run.output,
+  EXPECT_EQ(run.all(),
             "ccsrm: --board: expected inner corners as COLSxROWS (e.g. 9x6), got '9by6'\n");
 }
 
@@ -96,21 +81,21 @@ namespace {
 TEST(CamerasCli, SimulatedRunRendersAndReconstructsIntoC3dNearTheTruth) {
   const ScratchDir dir("cli_end_to_end");
   const std::string run_file = dir / "run.h5";
-  CommandRun run = Ccsrm("simulate --config " CCSRM_SOURCE_DIR
-                         "/configs/paper.yaml --case 1 --duration 0.05 --out " +
-                         run_file);
-  ASSERT_EQ(run.status, 0) << run.output;
-  run = Ccsrm("cameras render --in " + run_file + " --noise-px 0.2 --seed 4 --out " + dir / "vids");
-  ASSERT_EQ(run.status, 0) << run.output;
-  EXPECT_NE(run.output.find("seen by two or more cameras: 100.0 %"), std::string::npos)
-      << run.output;
+  CommandOutcome run = RunCcsrm("simulate --config " CCSRM_SOURCE_DIR
+                                "/configs/paper.yaml --case 1 --duration 0.05 --out " +
+                                run_file);
+  ASSERT_EQ(run.status, 0) << run.all();
+  run = RunCcsrm("cameras render --in " + run_file + " --noise-px 0.2 --seed 4 --out " +
+                 dir / "vids");
+  ASSERT_EQ(run.status, 0) << run.all();
+  EXPECT_NE(run.all().find("seen by two or more cameras: 100.0 %"), std::string::npos) << run.all();
   const std::string videos = dir / "vids/cam1.avi" + " " + dir / "vids/cam2.avi" + " " +
                              dir / "vids/cam3.avi" + " " + dir / "vids/cam4.avi";
-  run = Ccsrm("cameras reconstruct --quiet --cameras " + dir / "vids/cameras.yaml" + " --video " +
-              videos + " --config " CCSRM_SOURCE_DIR "/configs/paper.yaml --out " +
-              dir / "markers.c3d");
-  ASSERT_EQ(run.status, 0) << run.output;
-  EXPECT_NE(run.output.find("reprojection RMS"), std::string::npos) << run.output;
+  run = RunCcsrm("cameras reconstruct --quiet --cameras " + dir / "vids/cameras.yaml" +
+                 " --video " + videos + " --config " CCSRM_SOURCE_DIR "/configs/paper.yaml --out " +
+                 dir / "markers.c3d");
+  ASSERT_EQ(run.status, 0) << run.all();
+  EXPECT_NE(run.all().find("reprojection RMS"), std::string::npos) << run.all();
   const mocap::MarkerTable table = mocap::ReadC3d(dir / "markers.c3d");
   const MarkerMotion truth = ReadMarkerMotion(run_file);
   ASSERT_EQ(table.frames(), truth.p_WM.size());
@@ -132,17 +117,19 @@ TEST(CamerasCli, MocapProcessTakesVideosToJointAnglesNearTheSimulation) {
   // 0.2 px noise, through `ccsrm mocap process --cameras ... --video ...`.
   const ScratchDir dir("cli_mocap_process");
   const std::string run_file = dir / "run.h5";
-  CommandRun run = Ccsrm("simulate --config " CCSRM_SOURCE_DIR
-                         "/configs/paper.yaml --case 2 --duration 1 --quiet --out " +
-                         run_file);
-  ASSERT_EQ(run.status, 0) << run.output;
-  run = Ccsrm("cameras render --in " + run_file + " --noise-px 0.2 --seed 7 --out " + dir / "vids");
-  ASSERT_EQ(run.status, 0) << run.output;
+  CommandOutcome run = RunCcsrm("simulate --config " CCSRM_SOURCE_DIR
+                                "/configs/paper.yaml --case 2 --duration 1 --quiet --out " +
+                                run_file);
+  ASSERT_EQ(run.status, 0) << run.all();
+  run = RunCcsrm("cameras render --in " + run_file + " --noise-px 0.2 --seed 7 --out " +
+                 dir / "vids");
+  ASSERT_EQ(run.status, 0) << run.all();
   const std::string videos = dir / "vids/cam1.avi" + " " + dir / "vids/cam2.avi" + " " +
                              dir / "vids/cam3.avi" + " " + dir / "vids/cam4.avi";
-  run = Ccsrm("mocap process --quiet --cameras " + dir / "vids/cameras.yaml" + " --video " +
-              videos + " --config " CCSRM_SOURCE_DIR "/configs/paper.yaml --out " + dir / "exp.h5");
-  ASSERT_EQ(run.status, 0) << run.output;
+  run = RunCcsrm("mocap process --quiet --cameras " + dir / "vids/cameras.yaml" + " --video " +
+                 videos + " --config " CCSRM_SOURCE_DIR "/configs/paper.yaml --out " +
+                 dir / "exp.h5");
+  ASSERT_EQ(run.status, 0) << run.all();
   const datasets::ExperimentFile experiment = datasets::ReadExperimentFile(dir / "exp.h5");
   const datasets::RunFile truth = datasets::ReadRunFile(run_file);
   ASSERT_TRUE(experiment.measured_joint_angles.has_value());
