@@ -23,6 +23,7 @@
 #include "ccsrm/sim/protocol.h"
 #include "ccsrm/sim/simulator.h"
 #include "commands.h"
+#include "paper_run.h"
 
 namespace ccsrm::app {
 namespace {
@@ -30,12 +31,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct GenerateArgs {
-  std::string config_path = "configs/paper.yaml";
-  int case_number = 0;         // 0: friction as configured
-  double amplitude_deg = NAN;  // NaN: protocol.amplitude_deg
-  double duration_s = NAN;     // NaN: the whole protocol
-  std::vector<std::string> sets;
-  std::string params_path;
+  PaperRunArgs run;  // its named parameters are the truth
   double noise_mm = 0.2;
   std::uint64_t seed = 1;
   bool no_occlusions = false;
@@ -64,9 +60,10 @@ std::string TruthYaml(const GenerateArgs& a, const sim::Config& truth, double du
   out << YAML::BeginMap;
   out << YAML::Key << "schema" << YAML::Value << "ccsrm-truth/1";
   out << YAML::Key << "experiment" << YAML::Value << fs::path(a.out).filename().string();
-  out << YAML::Key << "config" << YAML::Value << a.config_path;
+  out << YAML::Key << "config" << YAML::Value << a.run.config_path;
   out << YAML::Key << "case" << YAML::Value
-      << (a.case_number != 0 ? std::to_string(a.case_number) : std::string("as configured"));
+      << (a.run.case_number != 0 ? std::to_string(a.run.case_number)
+                                 : std::string("as configured"));
   out << YAML::Key << "amplitude_deg" << YAML::Value << truth.protocol.amplitude_rad * 180.0 / M_PI;
   out << YAML::Key << "duration_s" << YAML::Value << duration_s;
   out << YAML::Key << "seed" << YAML::Value << a.seed;
@@ -109,43 +106,29 @@ int RunGenerate(const GenerateArgs& a) {
 
   // The nominal configuration goes into the experiment as given; the truth
   // is that configuration with the case, amplitude and parameters applied.
-  const std::string nominal_yaml = ReadTextFile(a.config_path);
-  sim::Config truth = sim::ParseConfig(nominal_yaml, a.config_path);
-  if (a.case_number != 0) sim::ApplyPaperCase(a.case_number, &truth);
-  if (!std::isnan(a.amplitude_deg)) truth.protocol.amplitude_rad = a.amplitude_deg * M_PI / 180.0;
-  if (!a.params_path.empty()) {
-    sim::ApplyParameterYaml(ReadTextFile(a.params_path), a.params_path, &truth);
-  }
-  for (const std::string& assignment : a.sets) {
-    const auto [name, value] = sim::ParseParameterAssignment(assignment, "--set");
-    sim::SetParameter(name, value, "--set", &truth);
-  }
-  sim::Validate(truth);
-  const double duration = std::isnan(a.duration_s) ? truth.protocol.duration_s() : a.duration_s;
-  if (!(duration > 0.0)) ThrowInputError("--duration", "", "must be > 0 s");
+  const PaperRun run = PreparePaperRun(a.run);
+  const sim::Config& truth = run.model.config();
+  const double duration = run.duration_s;
 
   mocap::VirtualExperimentOptions options;
   options.name = fs::path(stem).filename().string();
-  options.nominal_config_yaml = nominal_yaml;
+  options.nominal_config_yaml = run.config_text;
   options.recording.noise_sigma_m = a.noise_mm * 1e-3;
   options.recording.seed = a.seed;
   options.recording.occlusions.enabled = !a.no_occlusions;
   std::string error;
   if (!options.recording.IsValid(&error)) ThrowInputError("generate", "recording", error);
 
-  const sim::ArmModel model(truth);
-  const sim::CableInputs inputs =
-      sim::PlanCableInputs(model, sim::PaperTrajectory(model, truth.protocol), duration);
   sim::SimulationOptions sim_options;
   sim_options.duration_s = duration;
-  sim_options.case_name = a.case_number != 0 ? std::to_string(a.case_number) : "custom";
+  sim_options.case_name = a.run.case_number != 0 ? std::to_string(a.run.case_number) : "custom";
   if (!a.quiet) {
     sim_options.progress = [](const sim::SimulationProgress& p) {
       std::fprintf(stderr, "  t = %6.2f / %.2f s   real-time factor %.2f\n", p.simulated_s,
                    p.duration_s, p.real_time_factor);
     };
   }
-  sim::SimulationResult result = sim::Simulate(model, inputs, sim_options);
+  sim::SimulationResult result = sim::Simulate(run.model, run.inputs, sim_options);
   if (!result.summary.completed) {
     std::fprintf(stderr, "ccsrm: simulation diverged: %s (nothing written)\n",
                  result.summary.message.c_str());
@@ -165,7 +148,7 @@ int RunGenerate(const GenerateArgs& a) {
                 static_cast<unsigned long long>(a.seed));
   options.description = description;
   const mocap::VirtualExperiment generated =
-      mocap::MakeVirtualExperiment(result.run, mocap::DefaultMarkerLayout(model), options);
+      mocap::MakeVirtualExperiment(result.run, mocap::DefaultMarkerLayout(run.model), options);
 
   datasets::WriteExperimentFile(a.out, generated.experiment);
   datasets::WriteRunFile(truth_h5_path, generated.truth);
@@ -193,19 +176,11 @@ void AddGenerateCommand(CLI::App& root) {
       "Simulate the arm and record it with virtual motion capture (noise, occlusions): a "
       "ccsrm-dataset/1 experiment plus <name>.truth.yaml and <name>.truth.h5");
   auto a = std::make_shared<GenerateArgs>();
-  cmd->add_option("--config", a->config_path, "Nominal arm configuration (YAML)")
-      ->capture_default_str();
-  cmd->add_option("--case", a->case_number,
-                  "Paper case: 1 no friction, 2 all friction, 3 driving cables only, 4 connecting "
-                  "cables only (default: friction as configured)")
-      ->check(CLI::Range(1, 4));
-  cmd->add_option("--amplitude", a->amplitude_deg,
-                  "Planned joint amplitude [deg] (default: protocol.amplitude_deg)");
-  cmd->add_option("--duration", a->duration_s, "Simulated time [s] (default: the whole protocol)");
-  cmd->add_option("--set", a->sets,
+  AddPaperRunOptions(cmd, &a->run);
+  cmd->add_option("--set", a->run.sets,
                   "True parameter value, name=value (mu, mu_s, mu_c, mu_c_s, beta, c_sc, c_lc, "
                   "T_p, T_d0); repeatable, applied after --params");
-  cmd->add_option("--params", a->params_path,
+  cmd->add_option("--params", a->run.params_path,
                   "YAML file of true parameter values (name: value, or a truth file's "
                   "'parameters:')");
   cmd->add_option("--noise-mm", a->noise_mm, "Marker noise, standard deviation [mm]")

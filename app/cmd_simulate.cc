@@ -57,16 +57,7 @@ void AddSimulateCommand(CLI::App& root) {
   CLI::App* cmd = root.add_subcommand(
       "simulate", "Simulate the arm over the paper's protocol and write a ccsrm-run/1 HDF5 file");
   auto a = std::make_shared<SimulateArgs>();
-  cmd->add_option("--config", a->run.config_path, "Arm configuration (YAML)")
-      ->capture_default_str();
-  cmd->add_option("--case", a->run.case_number,
-                  "Paper case: 1 no friction, 2 all friction, 3 driving cables only, 4 connecting "
-                  "cables only (default: friction as configured)")
-      ->check(CLI::Range(1, 4));
-  cmd->add_option("--amplitude", a->run.amplitude_deg,
-                  "Planned joint amplitude [deg] (default: protocol.amplitude_deg)");
-  cmd->add_option("--duration", a->run.duration_s,
-                  "Simulated time [s] (default: the whole protocol)");
+  AddPaperRunOptions(cmd, &a->run);
   cmd->add_option("--output-rate", a->run.output_rate_hz,
                   "Output frames per second (default: solver.output_rate_hz)");
   cmd->add_option("--out", a->out, "Output run file (.h5)")->required();
