@@ -20,14 +20,14 @@ namespace ccsrm::app {
 namespace {
 
 // Case 2 unless told otherwise (SPEC 10).
-PaperRunArgs CaseTwo() {
-  PaperRunArgs run;
+sim::PaperRunOptions CaseTwo() {
+  sim::PaperRunOptions run;
   run.case_number = 2;
   return run;
 }
 
 struct BenchArgs {
-  PaperRunArgs run = CaseTwo();
+  sim::PaperRunOptions run = CaseTwo();
   int repeat = 3;
 };
 
@@ -39,19 +39,19 @@ double Median(std::vector<double> v) {
 
 void RunBench(const BenchArgs& a) {
   if (a.repeat < 1) ThrowInputError("--repeat", "", "must be >= 1");
-  const PaperRun run = PreparePaperRun(a.run);
-  const sim::Config& config = run.model.config();
-  sim::SimulationOptions options;
-  options.duration_s = run.duration_s;
+  const sim::PaperRun run = sim::PreparePaperRun(a.run);
+  const sim::Config& config = run.config;
+  const sim::SimulationOptions& options = run.simulation;
   std::printf("ccsrm bench: case %d, %+.3g deg, %.4g s simulated, %d run(s), one thread\n",
-              a.run.case_number, config.protocol.amplitude_rad * 180.0 / M_PI, run.duration_s,
+              a.run.case_number, config.protocol.amplitude_rad * 180.0 / M_PI, options.duration_s,
               a.repeat);
   std::vector<double> wall, rtf, rhs_rate;
   sim::SimulationSummary last;
   for (int k = 0; k < a.repeat; ++k) {
-    const sim::SimulationResult result = sim::Simulate(run.model, run.inputs, options);
+    const sim::SimulationResult result =
+        sim::Simulate(run.model, config.parameters, run.inputs, options);
     last = result.summary;
-    if (!last.completed)
+    if (!last.completed())
       ThrowInputError(a.run.config_path, "", "the benchmark run diverged: " + last.message);
     wall.push_back(last.wall_time_s);
     rtf.push_back(last.real_time_factor);

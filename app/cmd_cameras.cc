@@ -91,7 +91,7 @@ cameras::CameraRig RigFromOption(const std::string& path) {
 mocap::MarkerLayout LayoutFrom(const std::string& config, const std::string& experiment,
                                double* max_link_spacing_m) {
   if (!config.empty()) {
-    const sim::ArmModel model(sim::LoadConfig(config));
+    const sim::ArmModel model(sim::LoadConfig(config).arm);
     *max_link_spacing_m = cameras::MaxLinkSpacing(model);
     return mocap::DefaultMarkerLayout(model);
   }
@@ -327,7 +327,7 @@ void AddCalibrate(CLI::App& cameras) {
                       std::to_string(rig.cameras.size()) + " cameras but " +
                           std::to_string(m->videos.size()) + " videos");
     }
-    const sim::ArmModel model(sim::LoadConfig(m->config));
+    const sim::ArmModel model(sim::LoadConfig(m->config).arm);
     const mocap::MarkerLayout layout = mocap::DefaultMarkerLayout(model);
     const sim::JointAngles straight(model.num_joints(), Eigen::Vector2d::Zero());
     std::vector<Eigen::Vector3d> reference =

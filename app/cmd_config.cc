@@ -4,6 +4,7 @@
 
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
+#include "ccsrm/sim/parameters.h"
 #include "commands.h"
 
 namespace ccsrm::app {
@@ -13,7 +14,7 @@ void RunConfigCheck(const std::string& path) {
   const sim::Config c = sim::LoadConfig(path);
   // The model holds the cable routing; count its hole nodes rather than
   // re-deriving the layout here.
-  const sim::ArmModel model(c);
+  const sim::ArmModel model(c.arm);
   int holes = 0;
   for (const auto& cable : model.cables()) holes += cable.num_holes();
   std::printf("%s: ok\n", path.c_str());
@@ -29,12 +30,18 @@ void RunConfigCheck(const std::string& path) {
                 s.name.c_str(), s.links, s.link_length_m, s.link_mass_kg, s.hole_circle_radius_m,
                 pattern.c_str());
   }
-  std::printf("  driving cables: %zu (%d hole nodes), pre-tension %.4g N, mu %.3g / mu' %.3g\n",
-              c.arm.driving.cables.size(), holes, c.arm.driving.pretension_n,
-              c.arm.driving.friction_kinetic, c.arm.driving.friction_static);
-  std::printf("  connecting cables: T_p %.4g N, mu_c %.3g / mu'_c %.3g\n",
-              c.arm.connecting.pretension_n, c.arm.connecting.friction_kinetic,
-              c.arm.connecting.friction_static);
+  std::printf("  driving cables: %zu (%d hole nodes)\n", c.arm.driving.cables.size(), holes);
+  std::string parameters;
+  for (const sim::ParameterInfo& p : sim::Parameters()) {
+    char item[64];
+    std::snprintf(item, sizeof(item), "%s%s %.4g", parameters.empty() ? "" : ", ", p.name.c_str(),
+                  c.parameters.*p.field);
+    parameters += item;
+  }
+  std::printf("  parameters: %s\n", parameters.c_str());
+  std::printf("  structure: stick-slip %s, connecting friction smoothing %s\n",
+              c.solver.stick_slip ? "on" : "off",
+              c.solver.smooth_connecting_friction ? "on" : "off");
   std::printf("  protocol: amplitude %.4g deg over %.4g s; solver: h = %.4g s, output %.4g Hz\n",
               c.protocol.amplitude_rad * 180.0 / 3.14159265358979323846, c.protocol.duration_s(),
               c.solver.smoothing_step_s, c.solver.output_rate_hz);

@@ -62,10 +62,10 @@ Layout ResolveLayout(const std::string& rigid_bodies, const std::string& config,
   std::unique_ptr<sim::ArmModel> model;
   if (!config.empty()) {
     out.config_yaml = ReadTextFile(config);
-    model = std::make_unique<sim::ArmModel>(sim::ParseConfig(out.config_yaml, config));
+    model = std::make_unique<sim::ArmModel>(sim::ParseConfig(out.config_yaml, config).arm);
   } else if (experiment != nullptr && !experiment->config_yaml.empty()) {
     model = std::make_unique<sim::ArmModel>(
-        sim::ParseConfig(experiment->config_yaml, input + ": attribute 'config_yaml'"));
+        sim::ParseConfig(experiment->config_yaml, input + ": attribute 'config_yaml'").arm);
   }
   if (model) {
     out.chain = mocap::JointChain::FromModel(*model);

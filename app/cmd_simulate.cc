@@ -12,6 +12,7 @@
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/protocol.h"
 #include "ccsrm/sim/simulator.h"
+#include "ccsrm/sim_io/run_file.h"
 #include "commands.h"
 #include "paper_run.h"
 
@@ -19,7 +20,7 @@ namespace ccsrm::app {
 namespace {
 
 struct SimulateArgs {
-  PaperRunArgs run;
+  sim::PaperRunOptions run;
   std::string out;
   bool quiet = false;
 };
@@ -27,10 +28,8 @@ struct SimulateArgs {
 int RunSimulate(const SimulateArgs& a) {
   // Check the output path before spending minutes on the run.
   { const AtomicOutputFile probe(a.out); }
-  const PaperRun run = PreparePaperRun(a.run);
-  sim::SimulationOptions options;
-  options.duration_s = run.duration_s;
-  options.case_name = a.run.case_number != 0 ? std::to_string(a.run.case_number) : "custom";
+  const sim::PaperRun run = sim::PreparePaperRun(a.run);
+  sim::SimulationOptions options = run.simulation;
   if (!a.quiet) {
     options.progress = [](const sim::SimulationProgress& p) {
       std::fprintf(stderr,
@@ -39,11 +38,16 @@ int RunSimulate(const SimulateArgs& a) {
                    static_cast<long long>(p.stick_slip_switches));
     };
   }
-  const sim::SimulationResult result = sim::Simulate(run.model, run.inputs, options);
-  datasets::WriteRunFile(a.out, result.run);
+  const sim::SimulationResult result =
+      sim::Simulate(run.model, run.config.parameters, run.inputs, options);
+  const std::string case_name =
+      a.run.case_number != 0 ? std::to_string(a.run.case_number) : "custom";
+  datasets::WriteRunFile(
+      a.out, sim_io::ToRunFile(run.model, result, {case_name, sim::ToYaml(run.config)}));
   std::printf("%s", result.summary.FullReport().c_str());
-  std::printf("  output:                    %s (%zu frames)\n", a.out.c_str(), result.run.frames());
-  if (!result.summary.completed) {
+  std::printf("  output:                    %s (%zu frames)\n", a.out.c_str(),
+              result.trajectory.size());
+  if (!result.summary.completed()) {
     std::fprintf(stderr, "ccsrm: simulation diverged: %s (frames up to then are in %s)\n",
                  result.summary.message.c_str(), a.out.c_str());
     return 3;

@@ -1,35 +1,8 @@
 #include "paper_run.h"
 
-#include "ccsrm/common/atomic_file.h"
-#include "ccsrm/common/error.h"
-#include "ccsrm/sim/config.h"
-#include "ccsrm/sim/parameters.h"
-
 namespace ccsrm::app {
 
-PaperRun PreparePaperRun(const PaperRunArgs& a) {
-  std::string text = ReadTextFile(a.config_path);
-  sim::Config config = sim::ParseConfig(text, a.config_path);
-  if (a.case_number != 0) sim::ApplyPaperCase(a.case_number, &config);
-  if (!a.params_path.empty()) {
-    sim::ApplyParameterYaml(ReadTextFile(a.params_path), a.params_path, &config);
-  }
-  for (const std::string& assignment : a.sets) {
-    const auto [name, value] = sim::ParseParameterAssignment(assignment, "--set");
-    sim::SetParameter(name, value, "--set", &config);
-  }
-  if (!std::isnan(a.amplitude_deg)) config.protocol.amplitude_rad = a.amplitude_deg * M_PI / 180.0;
-  if (!std::isnan(a.output_rate_hz)) config.solver.output_rate_hz = a.output_rate_hz;
-  sim::Validate(config);
-  const double duration = std::isnan(a.duration_s) ? config.protocol.duration_s() : a.duration_s;
-  if (!(duration > 0.0)) ThrowInputError("--duration", "", "must be > 0 s");
-  sim::ArmModel model(config);
-  sim::CableInputs inputs =
-      sim::PlanCableInputs(model, sim::PaperTrajectory(model, config.protocol), duration);
-  return PaperRun{std::move(text), std::move(model), std::move(inputs), duration};
-}
-
-void AddPaperRunOptions(CLI::App* command, PaperRunArgs* args) {
+void AddPaperRunOptions(CLI::App* command, sim::PaperRunOptions* args) {
   command->add_option("--config", args->config_path, "Arm configuration (YAML)")
       ->capture_default_str();
   command

@@ -16,7 +16,7 @@ namespace {
 using namespace ccsrm;
 
 const sim::ArmModel& Model() {
-  static const sim::ArmModel model(sim::LoadConfig(CCSRM_SOURCE_DIR "/configs/paper.yaml"));
+  static const sim::ArmModel model(sim::LoadConfig(CCSRM_SOURCE_DIR "/configs/paper.yaml").arm);
   return model;
 }
 

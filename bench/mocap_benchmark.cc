@@ -30,7 +30,7 @@ struct Recording {
 const Recording& FortyMarkers() {
   static const Recording recording = [] {
     const sim::ArmModel model(
-        sim::LoadConfig(std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml"));
+        sim::LoadConfig(std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml").arm);
     Recording r;
     r.layout = DefaultMarkerLayout(model);
     r.layout.bodies.resize(10);

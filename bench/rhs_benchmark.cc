@@ -6,6 +6,7 @@
 
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
+#include "ccsrm/sim/paper_run.h"
 #include "ccsrm/sim/protocol.h"
 #include "dynamics.h"
 #include "kernels/ale_element.h"
@@ -15,17 +16,18 @@ namespace {
 
 Config PaperCase(int case_number) {
   Config c = LoadConfig(std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml");
-  ApplyPaperCase(case_number, &c);
+  ApplyPaperCase(case_number, &c.parameters);
   return c;
 }
 
 // One full evaluation of eqs. 59-68 for the paper's arm in a bent, moving
 // state (every stage of ArmDynamics::Evaluate, the sparse solve included).
 void BM_RightHandSide(benchmark::State& state) {
-  const ArmModel model(PaperCase(static_cast<int>(state.range(0))));
+  const Config config = PaperCase(static_cast<int>(state.range(0)));
+  const ArmModel model(config.arm);
   const CableInputs inputs =
-      PlanCableInputs(model, PaperTrajectory(model, model.config().protocol), 48.0, 1e-2);
-  internal::ArmDynamics dynamics(model, inputs);
+      PlanCableInputs(model, PaperTrajectory(model, config.protocol), 48.0, 1e-2);
+  internal::ArmDynamics dynamics(model, config.parameters, inputs, config.solver);
   Eigen::VectorXd y = dynamics.InitialState();
   Eigen::VectorXd ydot(y.size());
   // A little velocity everywhere so that no term is trivially zero.

@@ -49,7 +49,9 @@ void VisitArrays(Run& run, Visit&& visit) {
 RunStatus ParseStatus(const internal::FileReader& reader, const std::string& text) {
   if (text == RunStatusName(RunStatus::kCompleted)) return RunStatus::kCompleted;
   if (text == RunStatusName(RunStatus::kDiverged)) return RunStatus::kDiverged;
-  reader.Fail("attribute 'status' is '" + text + "'", "expected 'completed' or 'diverged'");
+  if (text == RunStatusName(RunStatus::kCancelled)) return RunStatus::kCancelled;
+  reader.Fail("attribute 'status' is '" + text + "'",
+              "expected 'completed', 'diverged' or 'cancelled'");
 }
 
 // Reads the names of /cables/1 .. /cables/C, which must be exactly those.
@@ -78,7 +80,15 @@ std::size_t CountCableGroups(const internal::FileReader& reader) {
 }  // namespace
 
 const char* RunStatusName(RunStatus status) {
-  return status == RunStatus::kCompleted ? "completed" : "diverged";
+  switch (status) {
+    case RunStatus::kCompleted:
+      return "completed";
+    case RunStatus::kDiverged:
+      return "diverged";
+    case RunStatus::kCancelled:
+      return "cancelled";
+  }
+  return "completed";
 }
 
 void ValidateRunFile(const RunFile& run, const std::string& file) {

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/gsl_errors.h"
 
 namespace ccsrm::mocap {
 namespace {
@@ -53,14 +54,6 @@ double EndPivot(const double* x, std::size_t m, int step) {
   return (sum_x - slope * sum_i) / count;
 }
 
-// GSL's default error handler aborts; the callers here check every input, so
-// a GSL error is a bug, but it must never take a user's program down silently.
-struct GslHandlerOff {
-  gsl_error_handler_t* previous;
-  GslHandlerOff() : previous(gsl_set_error_handler_off()) {}
-  ~GslHandlerOff() { gsl_set_error_handler(previous); }
-};
-
 struct SplineDeleter {
   void operator()(gsl_spline* s) const { gsl_spline_free(s); }
 };
@@ -76,7 +69,7 @@ class Interpolator {
   Interpolator(const double* x, const double* y, std::size_t n, bool cubic) : x_(x), y_(y), n_(n) {
     CCSRM_CHECK(n >= 2);
     if (cubic && n >= 3) {
-      const GslHandlerOff off;
+      UseGslErrorCodes();
       spline_.reset(gsl_spline_alloc(gsl_interp_cspline, n));
       accel_.reset(gsl_interp_accel_alloc());
       CCSRM_CHECK(spline_ && accel_);
@@ -87,7 +80,7 @@ class Interpolator {
   double operator()(double xq) const {
     if (spline_) {
       double value = kNaN;
-      const GslHandlerOff off;
+      UseGslErrorCodes();
       if (gsl_spline_eval_e(spline_.get(), xq, accel_.get(), &value) != GSL_SUCCESS) return kNaN;
       return value;
     }

@@ -78,6 +78,17 @@ class MapReader {
     Fail(Join(key), node, "expected true or false, found '" + text + "'");
   }
 
+  // A key added after ccsrm-config/1 was first published: files written
+  // before it leave it out and get `fallback`.
+  bool OptionalBoolean(const std::string& key, bool fallback) {
+    if (!node_[key].IsDefined()) {
+      read_.insert(key);
+      allowed_.push_back(key);
+      return fallback;
+    }
+    return Boolean(key);
+  }
+
   std::string String(const std::string& key) {
     const YAML::Node node = Require(key);
     if (!node.IsScalar()) Fail(Join(key), node, "expected a string");
@@ -198,6 +209,27 @@ class MapReader {
   std::vector<std::string> allowed_;
 };
 
+// The parameters whose configuration key sits in `section`'s mapping
+// (ParameterInfo::config_key), read or written through the one table.
+void ReadParameters(MapReader& section, ArmParameters* parameters) {
+  const std::string prefix = section.path() + ".";
+  for (const ParameterInfo& p : Parameters()) {
+    if (p.config_key.rfind(prefix, 0) == 0) {
+      parameters->*p.field = section.Number(p.config_key.substr(prefix.size()));
+    }
+  }
+}
+
+void WriteParameters(const std::string& section, const ArmParameters& parameters,
+                     YAML::Emitter* out) {
+  const std::string prefix = section + ".";
+  for (const ParameterInfo& p : Parameters()) {
+    if (p.config_key.rfind(prefix, 0) == 0) {
+      *out << YAML::Key << p.config_key.substr(prefix.size()) << YAML::Value << parameters.*p.field;
+    }
+  }
+}
+
 class Checker {
  public:
   Checker(const std::string& file, const LineMap* lines) : file_(file), lines_(lines) {}
@@ -227,9 +259,7 @@ class Checker {
   const LineMap* lines_;
 };
 
-void ValidateWithLines(const Config& c, const LineMap* lines) {
-  const Checker check(c.source_name, lines);
-  const ArmConfig& arm = c.arm;
+void CheckArm(const ArmConfig& arm, const Checker& check) {
   check.Positive("arm.joint_disk_gap_m", arm.joint_disk_gap_m);
   if (arm.segments.empty()) check.Fail("arm.segments", "at least one segment is required");
   for (std::size_t i = 0; i < arm.segments.size(); ++i) {
@@ -260,10 +290,6 @@ void ValidateWithLines(const Config& c, const LineMap* lines) {
   check.Positive("driving_cables.youngs_modulus_pa", d.youngs_modulus_pa);
   check.Positive("driving_cables.cross_section_m2", d.cross_section_m2);
   check.Positive("driving_cables.density_kgpm3", d.density_kgpm3);
-  check.NonNegative("driving_cables.rayleigh_beta_s", d.rayleigh_beta_s);
-  check.Positive("driving_cables.pretension_n", d.pretension_n);
-  check.InRange("driving_cables.friction_kinetic", d.friction_kinetic, 0.0, 2.0);
-  check.InRange("driving_cables.friction_static", d.friction_static, 0.0, 2.0);
   check.Positive("driving_cables.input_offset_m", d.input_offset_m);
   if (d.cables.empty())
     check.Fail("driving_cables.cables", "at least one driving cable is required");
@@ -279,13 +305,9 @@ void ValidateWithLines(const Config& c, const LineMap* lines) {
   const ConnectingCableConfig& cc = arm.connecting;
   check.Positive("connecting_cables.youngs_modulus_pa", cc.youngs_modulus_pa);
   check.Positive("connecting_cables.cross_section_m2", cc.cross_section_m2);
-  check.Positive("connecting_cables.pretension_n", cc.pretension_n);
-  check.InRange("connecting_cables.friction_kinetic", cc.friction_kinetic, 0.0, 2.0);
-  check.InRange("connecting_cables.friction_static", cc.friction_static, 0.0, 2.0);
-  check.NonNegative("connecting_cables.damping_small_nmsprad", cc.damping_small_nmsprad);
-  check.NonNegative("connecting_cables.damping_large_nmsprad", cc.damping_large_nmsprad);
+}
 
-  const SolverConfig& s = c.solver;
+void CheckSolver(const SolverConfig& s, const Checker& check) {
   check.NonNegative("solver.baumgarte_alpha_per_s", s.baumgarte_alpha_per_s);
   check.NonNegative("solver.baumgarte_beta_per_s2", s.baumgarte_beta_per_s2);
   check.NonNegative("solver.smoothing_step_s", s.smoothing_step_s);
@@ -308,8 +330,23 @@ void ValidateWithLines(const Config& c, const LineMap* lines) {
   check.Positive("solver.switch_time_tolerance_s", s.switch_time_tolerance_s);
   check.Positive("solver.max_constraint_violation", s.max_constraint_violation);
   check.InRange("solver.output_rate_hz", s.output_rate_hz, 1e-3, 1e5);
+}
 
-  const ProtocolConfig& pr = c.protocol;
+void CheckProtocol(const ProtocolConfig& pr, const Checker& check);
+
+void ValidateWithLines(const Config& c, const LineMap* lines) {
+  const Checker check(c.source_name, lines);
+  CheckArm(c.arm, check);
+  // The identifiable parameters: the same table and message as --set and --params.
+  for (const ParameterInfo& p : Parameters()) {
+    const std::string problem = ParameterValueProblem(p, c.parameters.*p.field);
+    if (!problem.empty()) check.Fail(p.config_key, problem);
+  }
+  CheckSolver(c.solver, check);
+  CheckProtocol(c.protocol, check);
+}
+
+void CheckProtocol(const ProtocolConfig& pr, const Checker& check) {
   check.InRange("protocol.amplitude_deg", pr.amplitude_rad / kDegToRad, -60.0, 60.0);
   check.Positive("protocol.ramp_s", pr.ramp_s);
   check.NonNegative("protocol.hold_s", pr.hold_s);
@@ -391,10 +428,7 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
     dc.youngs_modulus_pa = d.Number("youngs_modulus_pa");
     dc.cross_section_m2 = d.Number("cross_section_m2");
     dc.density_kgpm3 = d.Number("density_kgpm3");
-    dc.rayleigh_beta_s = d.Number("rayleigh_beta_s");
-    dc.pretension_n = d.Number("pretension_n");
-    dc.friction_kinetic = d.Number("friction_kinetic");
-    dc.friction_static = d.Number("friction_static");
+    ReadParameters(d, &c.parameters);
     dc.input_offset_m = d.Number("input_offset_m");
     d.ForEach("cables", [&](MapReader& cable, int) {
       DrivingCableRoute route;
@@ -409,16 +443,13 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
     ConnectingCableConfig& cc = c.arm.connecting;
     cc.youngs_modulus_pa = k.Number("youngs_modulus_pa");
     cc.cross_section_m2 = k.Number("cross_section_m2");
-    cc.pretension_n = k.Number("pretension_n");
-    cc.friction_kinetic = k.Number("friction_kinetic");
-    cc.friction_static = k.Number("friction_static");
-    cc.damping_small_nmsprad = k.Number("damping_small_nmsprad");
-    cc.damping_large_nmsprad = k.Number("damping_large_nmsprad");
+    ReadParameters(k, &c.parameters);
     k.Finish();
   }
   {
     MapReader s = top.Section("solver");
     SolverConfig& sc = c.solver;
+    sc.stick_slip = s.OptionalBoolean("stick_slip", true);
     sc.baumgarte_alpha_per_s = s.Number("baumgarte_alpha_per_s");
     sc.baumgarte_beta_per_s2 = s.Number("baumgarte_beta_per_s2");
     sc.smoothing_step_s = s.Number("smoothing_step_s");
@@ -458,20 +489,16 @@ Config LoadConfig(const std::string& path) { return ParseConfig(ReadTextFile(pat
 
 void Validate(const Config& config) { ValidateWithLines(config, nullptr); }
 
-void ApplyPaperCase(int case_number, Config* config) {
-  if (case_number < 1 || case_number > 4) {
-    ThrowInputError("--case", "", "must be 1, 2, 3 or 4, found " + std::to_string(case_number));
-  }
-  const bool driving = case_number == 2 || case_number == 3;
-  const bool connecting = case_number == 2 || case_number == 4;
-  if (!driving) {
-    config->arm.driving.friction_kinetic = 0.0;
-    config->arm.driving.friction_static = 0.0;
-  }
-  if (!connecting) {
-    config->arm.connecting.friction_kinetic = 0.0;
-    config->arm.connecting.friction_static = 0.0;
-  }
+void ValidateArm(const ArmConfig& arm, const std::string& source_name) {
+  CheckArm(arm, Checker(source_name, nullptr));
+}
+
+void ValidateSolver(const SolverConfig& solver, const std::string& source_name) {
+  CheckSolver(solver, Checker(source_name, nullptr));
+}
+
+void ValidateProtocol(const ProtocolConfig& protocol, const std::string& source_name) {
+  CheckProtocol(protocol, Checker(source_name, nullptr));
 }
 
 std::string ToYaml(const Config& c) {
@@ -518,10 +545,7 @@ std::string ToYaml(const Config& c) {
   out << YAML::Key << "youngs_modulus_pa" << YAML::Value << d.youngs_modulus_pa;
   out << YAML::Key << "cross_section_m2" << YAML::Value << d.cross_section_m2;
   out << YAML::Key << "density_kgpm3" << YAML::Value << d.density_kgpm3;
-  out << YAML::Key << "rayleigh_beta_s" << YAML::Value << d.rayleigh_beta_s;
-  out << YAML::Key << "pretension_n" << YAML::Value << d.pretension_n;
-  out << YAML::Key << "friction_kinetic" << YAML::Value << d.friction_kinetic;
-  out << YAML::Key << "friction_static" << YAML::Value << d.friction_static;
+  WriteParameters("driving_cables", c.parameters, &out);
   out << YAML::Key << "input_offset_m" << YAML::Value << d.input_offset_m;
   out << YAML::Key << "cables" << YAML::Value << YAML::BeginSeq;
   for (const DrivingCableRoute& r : d.cables) {
@@ -535,15 +559,12 @@ std::string ToYaml(const Config& c) {
   out << YAML::Key << "connecting_cables" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "youngs_modulus_pa" << YAML::Value << cc.youngs_modulus_pa;
   out << YAML::Key << "cross_section_m2" << YAML::Value << cc.cross_section_m2;
-  out << YAML::Key << "pretension_n" << YAML::Value << cc.pretension_n;
-  out << YAML::Key << "friction_kinetic" << YAML::Value << cc.friction_kinetic;
-  out << YAML::Key << "friction_static" << YAML::Value << cc.friction_static;
-  out << YAML::Key << "damping_small_nmsprad" << YAML::Value << cc.damping_small_nmsprad;
-  out << YAML::Key << "damping_large_nmsprad" << YAML::Value << cc.damping_large_nmsprad;
+  WriteParameters("connecting_cables", c.parameters, &out);
   out << YAML::EndMap;
 
   const SolverConfig& s = c.solver;
   out << YAML::Key << "solver" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "stick_slip" << YAML::Value << s.stick_slip;
   out << YAML::Key << "baumgarte_alpha_per_s" << YAML::Value << s.baumgarte_alpha_per_s;
   out << YAML::Key << "baumgarte_beta_per_s2" << YAML::Value << s.baumgarte_beta_per_s2;
   out << YAML::Key << "smoothing_step_s" << YAML::Value << s.smoothing_step_s;

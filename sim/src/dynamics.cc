@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 #include <Eigen/Eigenvalues>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/sim/kinematics.h"
 #include "kernels/ale_element.h"
 #include "kernels/connecting.h"
 #include "kernels/hole_friction.h"
@@ -33,23 +33,49 @@ constexpr double kRegularization = 1e-10;
 
 }  // namespace
 
-ArmDynamics::ArmDynamics(const ArmModel& model, const CableInputs& inputs)
-    : model_(model), inputs_(inputs), config_(model.config()), n_(model.num_coordinates()) {
+ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
+                         const CableInputs& inputs, const SolverConfig& solver)
+    : model_(model),
+      layout_(model.sparse_layout()),
+      inputs_(inputs),
+      parameters_(parameters),
+      solver_(solver),
+      n_(model.num_coordinates()),
+      m_(model.sparse_layout().num_constraints()),
+      system_(model.sparse_layout()) {
   CCSRM_CHECK(inputs.num_cables() == model.num_cables());
-  const DrivingCableConfig& d = config_.arm.driving;
-  stick_slip_ = d.friction_kinetic > 0.0 || d.friction_static > 0.0;
-  smooth_connecting_friction_ = config_.solver.smooth_connecting_friction &&
-                                config_.solver.smoothing_step_s > 0.0 &&
-                                (config_.arm.connecting.friction_kinetic > 0.0 ||
-                                 config_.arm.connecting.friction_static > 0.0);
-  smooth_connecting_elasticity_ =
-      config_.solver.smooth_connecting_elasticity && config_.solver.smoothing_step_s > 0.0;
-  for (int c = 0; c < model_.num_cables(); ++c) {
-    const auto& cable = model_.cables()[c];
-    for (int k = 1; k + 1 < static_cast<int>(cable.nodes.size()); ++k) holes_.push_back({c, k});
+  const ArmConfig& arm = model_.arm();
+  ale_.linear_density_kgpm = arm.driving.density_kgpm3 * arm.driving.cross_section_m2;
+  ale_.axial_stiffness_n = arm.driving.youngs_modulus_pa * arm.driving.cross_section_m2;
+  ale_.rayleigh_beta_s = parameters_.beta;
+  ale_.smoothing_step_s = solver_.smoothing_step_s;
+  const double connecting_ea = arm.connecting.youngs_modulus_pa * arm.connecting.cross_section_m2;
+  for (const ConnectingPairModel& pair : model_.connecting_pairs()) {
+    PairKernel k;
+    k.kind = pair.kind;
+    k.joint_i = pair.joint_i;
+    if (pair.kind == ConnectingKind::kSmallS) {
+      k.small = {connecting_ea, pair.pulley_radius_m, pair.cable_length_m, parameters_.c_sc};
+    } else {
+      k.large.axial_stiffness_n = connecting_ea;
+      k.large.pulley_radius_m = pair.pulley_radius_m;
+      k.large.cable_length_m = pair.cable_length_m;
+      k.large.wrap_angle_rad = pair.wrap_angle_rad;
+      k.large.pretension_n = parameters_.T_p;
+      k.large.damping_nmsprad = parameters_.c_lc;
+      k.large.friction.mu_kinetic = parameters_.mu_c;
+      k.large.friction.mu_static = parameters_.mu_c_s;
+      k.large.friction.v_static_mps = solver_.large_s_static_velocity_mps;
+      k.large.friction.v_dynamic_mps = solver_.large_s_dynamic_velocity_mps;
+    }
+    pair_kernels_.push_back(k);
   }
-  modes_.assign(holes_.size(), stick_slip_ ? HoleMode::kStuck : HoleMode::kSlipUp);
-  reports_.assign(holes_.size(), HoleReport{});
+
+  const std::size_t holes = layout_.holes().size();
+  modes_.assign(holes, has_stick_slip() ? HoleMode::kStuck : HoleMode::kSlipUp);
+  reports_.assign(holes, HoleReport{});
+  rows_.resize(m_);
+  force_.resize(n_);
   tension_.resize(model_.num_cables());
   for (int c = 0; c < model_.num_cables(); ++c)
     tension_[c].assign(model_.cables()[c].num_elements(), 0.0);
@@ -58,31 +84,6 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const CableInputs& inputs)
   omega_.resize(model_.num_links());
   relative_rotation_.resize(model_.num_joints());
   joint_moment_.resize(model_.num_joints());
-  const ConnectingCableConfig& cc = config_.arm.connecting;
-  for (const ConnectingPairModel& pair : model_.connecting_pairs()) {
-    const SegmentConfig& seg = config_.arm.segments[model_.link(pair.joint_i).segment];
-    PairKernel k;
-    k.kind = pair.kind;
-    k.joint_i = pair.joint_i;
-    k.small.axial_stiffness_n = cc.youngs_modulus_pa * cc.cross_section_m2;
-    k.small.pulley_radius_m = seg.small_s.pulley_radius_m;
-    k.small.cable_length_m = seg.small_s.cable_length_m;
-    k.small.damping_nmsprad = pair.damping_nmsprad;
-    k.large.axial_stiffness_n = cc.youngs_modulus_pa * cc.cross_section_m2;
-    k.large.pulley_radius_m = seg.large_s.pulley_radius_m;
-    k.large.cable_length_m = seg.large_s.cable_length_m;
-    k.large.wrap_angle_rad = seg.large_s.wrap_angle_rad;
-    k.large.pretension_n = cc.pretension_n;
-    k.large.damping_nmsprad = pair.damping_nmsprad;
-    k.large.friction.mu_kinetic = cc.friction_kinetic;
-    k.large.friction.mu_static = cc.friction_static;
-    k.large.friction.v_static_mps = config_.solver.large_s_static_velocity_mps;
-    k.large.friction.v_dynamic_mps = config_.solver.large_s_dynamic_velocity_mps;
-    for (int link = pair.joint_i - 1; link <= pair.joint_i + 1; ++link) {
-      if (link >= 1) k.links.push_back(link);
-    }
-    pair_kernels_.push_back(k);
-  }
   theta_.resize(model_.num_joints());
   theta_dot_.resize(model_.num_joints());
 
@@ -92,11 +93,11 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const CableInputs& inputs)
       initial_s_.push_back(y0[model_.node_offset(c, static_cast<int>(k)) + 3]);
     }
   }
-  stuck_s_.resize(holes_.size());
-  for (std::size_t h = 0; h < holes_.size(); ++h) {
-    stuck_s_[h] = y0[model_.node_offset(holes_[h].cable, holes_[h].node) + 3];
+  stuck_s_.resize(holes);
+  for (std::size_t h = 0; h < holes; ++h) {
+    const HoleNodeRef& hole = layout_.holes()[h];
+    stuck_s_[h] = y0[model_.node_offset(hole.cable, hole.node) + 3];
   }
-  BuildStructure();
 }
 
 Eigen::VectorXd ArmDynamics::InitialState() const {
@@ -110,8 +111,7 @@ Eigen::VectorXd ArmDynamics::InitialState() const {
   }
   // Uniform pre-strain: T_d0 = EA eps0 (eq. 13), so each element's
   // unstretched length is its chord / sqrt(1 + 2 eps0) (Green strain).
-  const DrivingCableConfig& d = config_.arm.driving;
-  const double eps0 = d.pretension_n / (d.youngs_modulus_pa * d.cross_section_m2);
+  const double eps0 = parameters_.T_d0 / ale_.axial_stiffness_n;
   const double stretch = std::sqrt(1.0 + 2.0 * eps0);
   for (int c = 0; c < model_.num_cables(); ++c) {
     double s = 0.0;
@@ -128,178 +128,363 @@ Eigen::VectorXd ArmDynamics::InitialState() const {
   return y;
 }
 
-void ArmDynamics::BuildStructure() {
-  // Rows: 4 per cable node, 1 per link (eq. 35), 4 per joint (eqs. 36-37).
-  auto add_row = [&](std::initializer_list<int> cols) {
-    RowData row;
-    for (int c : cols) row.cols[row.count++] = c;
-    rows_.push_back(row);
-  };
-  auto link_cols = [&](int link, int axis, std::vector<int>* cols) {
-    const int o = model_.link_offset(link);
-    cols->push_back(o + axis);
-    for (int k = 3; k < 7; ++k) cols->push_back(o + k);
-  };
-  for (int c = 0; c < model_.num_cables(); ++c) {
-    const auto& cable = model_.cables()[c];
-    for (int k = 0; k < static_cast<int>(cable.nodes.size()); ++k) {
-      const int o = model_.node_offset(c, k);
-      for (int a = 0; a < 3; ++a) {
-        std::vector<int> cols{o + a};
-        if (cable.nodes[k].link > 0) link_cols(cable.nodes[k].link, a, &cols);
-        RowData row;
-        for (int col : cols) row.cols[row.count++] = col;
-        rows_.push_back(row);
-        hole_of_node_row_.push_back(-1);
-      }
-      add_row({o + 3});
-      int hole = -1;
-      if (cable.nodes[k].kind == CableNodeModel::Kind::kHole) {
-        for (std::size_t h = 0; h < holes_.size(); ++h) {
-          if (holes_[h].cable == c && holes_[h].node == k) hole = static_cast<int>(h);
-        }
-      }
-      hole_of_node_row_.push_back(hole);
-    }
-  }
-  for (int i = 1; i <= model_.num_links(); ++i) {
-    const int o = model_.link_offset(i);
-    add_row({o + 3, o + 4, o + 5, o + 6});
-    hole_of_node_row_.push_back(-1);
-  }
-  for (int j = 1; j <= model_.num_joints(); ++j) {
-    for (int a = 0; a < 3; ++a) {
-      std::vector<int> cols;
-      if (j > 1) link_cols(j - 1, a, &cols);
-      link_cols(j, a, &cols);
-      RowData row;
-      for (int col : cols) row.cols[row.count++] = col;
-      rows_.push_back(row);
-      hole_of_node_row_.push_back(-1);
-    }
-    RowData row;
-    if (j > 1) {
-      const int p = model_.link_offset(j - 1);
-      for (int k = 3; k < 7; ++k) row.cols[row.count++] = p + k;
-    }
-    const int o = model_.link_offset(j);
-    for (int k = 3; k < 7; ++k) row.cols[row.count++] = o + k;
-    rows_.push_back(row);
-    hole_of_node_row_.push_back(-1);
-  }
-  m_ = static_cast<int>(rows_.size());
+bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
+  ++evaluations_;
+  failure_.clear();
+  const double* q = y;
+  const double* qd = y + n_;
+  system_.Clear();
+  force_.setZero();
+  dissipation_ = kinetic_ = elastic_ = 0.0;
 
-  // Sparsity pattern of the augmented system
-  //   [ M + Phi_q^T Phi_q   Phi_q^T ] [ q_dd   ]   [ F - Phi_q^T b ]
-  //   [ Phi_q               D       ] [ lambda ] = [ -b            ]
-  // (eqs. 62-64 solved together; D = 1 on the rows of slipping hole nodes,
-  // whose stick constraint is switched off, so their lambda is 0).
-  std::vector<Eigen::Triplet<double>> pattern;
-  for (int c = 0; c < model_.num_cables(); ++c) {
-    for (int e = 0; e < model_.cables()[c].num_elements(); ++e) {
-      const int o1 = model_.node_offset(c, e), o2 = model_.node_offset(c, e + 1);
-      const int cols[8] = {o1, o1 + 1, o1 + 2, o2, o2 + 1, o2 + 2, o1 + 3, o2 + 3};
-      for (int a : cols)
-        for (int b : cols) pattern.emplace_back(a, b, 0.0);
-    }
-  }
-  for (int i = 1; i <= model_.num_links(); ++i) {
-    const int o = model_.link_offset(i);
-    for (int a = 0; a < 3; ++a) pattern.emplace_back(o + a, o + a, 0.0);
-    for (int a = 3; a < 7; ++a)
-      for (int b = 3; b < 7; ++b) pattern.emplace_back(o + a, o + b, 0.0);
-  }
-  auto pair_cols = [&](const PairKernel& k) {
-    std::vector<int> cols;
-    for (int link : k.links)
-      for (int a = 3; a < 7; ++a) cols.push_back(model_.link_offset(link) + a);
-    return cols;
-  };
-  for (const PairKernel& k : pair_kernels_) {
-    for (int a : pair_cols(k))
-      for (int b : pair_cols(k)) pattern.emplace_back(a, b, 0.0);
-  }
-  for (int r = 0; r < m_; ++r) {
-    const RowData& row = rows_[r];
-    for (int a = 0; a < row.count; ++a) {
-      pattern.emplace_back(n_ + r, row.cols[a], 0.0);
-      pattern.emplace_back(row.cols[a], n_ + r, 0.0);
-      for (int b = 0; b < row.count; ++b) pattern.emplace_back(row.cols[a], row.cols[b], 0.0);
-    }
-    pattern.emplace_back(n_ + r, n_ + r, 0.0);
-  }
-  {
-    // AMD on the pattern, in the convention of Eigen's own ordering step:
-    // the ordering yields the inverse permutation.
-    Eigen::SparseMatrix<double> model_order(n_ + m_, n_ + m_);
-    model_order.setFromTriplets(pattern.begin(), pattern.end());
-    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> inverse;
-    Eigen::AMDOrdering<int>()(model_order, inverse);
-    const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> order = inverse.inverse();
-    kkt_order_.assign(order.indices().data(), order.indices().data() + n_ + m_);
-    for (auto& entry : pattern) {
-      entry = Eigen::Triplet<double>(kkt_order_[entry.row()], kkt_order_[entry.col()], 0.0);
-    }
-  }
-  kkt_.resize(n_ + m_, n_ + m_);
-  kkt_.setFromTriplets(pattern.begin(), pattern.end());
-  kkt_.makeCompressed();
-
-  for (int c = 0; c < model_.num_cables(); ++c) {
-    for (int e = 0; e < model_.cables()[c].num_elements(); ++e) {
-      const int o1 = model_.node_offset(c, e), o2 = model_.node_offset(c, e + 1);
-      const int cols[8] = {o1, o1 + 1, o1 + 2, o2, o2 + 1, o2 + 2, o1 + 3, o2 + 3};
-      for (int a : cols)
-        for (int b : cols) element_index_.push_back(Index(a, b));
-    }
-  }
-  for (int i = 1; i <= model_.num_links(); ++i) {
-    const int o = model_.link_offset(i);
-    for (int a = 0; a < 3; ++a) link_index_.push_back(Index(o + a, o + a));
-    for (int a = 3; a < 7; ++a)
-      for (int b = 3; b < 7; ++b) link_index_.push_back(Index(o + a, o + b));
-  }
-  for (PairKernel& k : pair_kernels_) {
-    for (int a : pair_cols(k))
-      for (int b : pair_cols(k)) k.block_index.push_back(Index(a, b));
-  }
-  for (int r = 0; r < m_; ++r) {
-    const RowData& row = rows_[r];
-    for (int a = 0; a < row.count; ++a) {
-      row_kkt_index_.push_back(Index(n_ + r, row.cols[a]));
-      row_kkt_index_.push_back(Index(row.cols[a], n_ + r));
-    }
-    row_pair_offset_.push_back(static_cast<int>(row_pair_index_.size()));
-    for (int a = 0; a < row.count; ++a)
-      for (int b = 0; b < row.count; ++b)
-        row_pair_index_.push_back(Index(row.cols[a], row.cols[b]));
-    row_diag_index_.push_back(Index(n_ + r, n_ + r));
-  }
-  lu_.analyzePattern(kkt_);
-  rhs_.resize(n_ + m_);
-  kkt_rhs_.resize(n_ + m_);
-  kkt_solution_.resize(n_ + m_);
-  solution_.resize(n_ + m_);
-  force_.resize(n_);
+  ComputeLinkKinematics(q, qd);                // eqs. 21-22, 26
+  if (!AddCableElements(q, qd)) return false;  // eqs. 1-6, 13, 17-20
+  AddHoleFriction(q, qd);                      // eqs. 8-12, stick-slip
+  ComputeJointAngles();                        // eqs. 23-29
+  AddConnectingMoments(q);                     // eqs. 38-58
+  AddLinkInertia(q, qd);                       // eqs. 30-34
+  AddConstraints(t, q, qd);                    // eqs. 35-37, 61-63
+  if (!SolveAugmentedSystem()) return false;   // eqs. 64-68
+  return FinishDerivative(qd, ydot);
 }
 
-int ArmDynamics::Index(int model_row, int model_col) const {
-  const int row = kkt_order_[model_row], col = kkt_order_[model_col];
-  const int* inner = kkt_.innerIndexPtr();
-  const int begin = kkt_.outerIndexPtr()[col];
-  const int end = kkt_.outerIndexPtr()[col + 1];
-  const int* at = std::lower_bound(inner + begin, inner + end, row);
-  CCSRM_CHECK(at != inner + end && *at == row);
-  return static_cast<int>(at - inner);
+// Rotation A(e), rate matrix G(e) and body angular velocity w' = G e_dot
+// of every link.
+void ArmDynamics::ComputeLinkKinematics(const double* q, const double* qd) {
+  for (int i = 1; i <= model_.num_links(); ++i) {
+    const int o = model_.link_offset(i);
+    const Vector4 e = Quaternion(q, o), ed = Quaternion(qd, o);
+    rotation_[i - 1] = RotationFromQuaternion(e);
+    rate_matrix_[i - 1] = QuaternionRateMatrix(e);
+    omega_[i - 1] = rate_matrix_[i - 1] * ed;
+  }
+}
+
+// Driving-cable ALE elements: mass, the additional inertia term Q_p, the
+// smoothed elastic force and mass, tensions; the power that Rayleigh
+// damping and smoothing take out is booked once q_dd is known.
+bool ArmDynamics::AddCableElements(const double* q, const double* qd) {
+  double* values = system_.values();
+  const double h = solver_.smoothing_step_s;
+  const double beta = parameters_.beta;
+  element_rates_.clear();
+  int element = 0;
+  for (int c = 0; c < model_.num_cables(); ++c) {
+    const int elements = model_.cables()[c].num_elements();
+    for (int e = 0; e < elements; ++e, ++element) {
+      const int o1 = model_.node_offset(c, e), o2 = model_.node_offset(c, e + 1);
+      const int cols[8] = {o1, o1 + 1, o1 + 2, o2, o2 + 1, o2 + 2, o1 + 3, o2 + 3};
+      Vector8d qe, qde;
+      for (int k = 0; k < 8; ++k) {
+        qe[k] = q[cols[k]];
+        qde[k] = qd[cols[k]];
+      }
+      const double ds = qe[7] - qe[6];
+      if (!(ds > 0.0) || !std::isfinite(ds)) {
+        failure_ = "cable " + std::to_string(c + 1) + " element " + std::to_string(e + 1) +
+                   " collapsed (material length " + std::to_string(ds) + " m)";
+        return false;
+      }
+      const AleElementTerms terms = EvaluateAleElement(ale_, qe, qde);
+      const int* index = layout_.element_block(element);
+      const Matrix8d mass = terms.mass + terms.elastic_mass;
+      for (int a = 0; a < 8; ++a)
+        for (int b = 0; b < 8; ++b) values[index[8 * a + b]] += mass(a, b);
+      const Vector8d f = terms.ale_inertia_force + terms.elastic_force;
+      for (int a = 0; a < 8; ++a) force_[cols[a]] += f[a];
+      tension_[c][e] = terms.tension;
+      kinetic_ += 0.5 * qde.dot(terms.mass * qde);
+      const double k = terms.taut ? 1.0 : 0.0;
+      elastic_ += 0.5 * ale_.axial_stiffness_n * k * terms.strain * terms.strain * ds;
+      const double beta_p = beta + k * h / 2.0;
+      const double gamma = beta * h / 2.0 + k * h * h / 6.0;
+      const double scale = ds * ale_.axial_stiffness_n * terms.strain_rate;
+      ElementRate rate;
+      rate.coefficient = scale * (beta_p * terms.strain_rate + gamma * terms.strain_accel_bias);
+      rate.gamma_term = scale * gamma;
+      rate.jac = terms.strain_jacobian;
+      std::copy(cols, cols + 8, rate.cols);
+      element_rates_.push_back(rate);
+    }
+  }
+  return true;
+}
+
+// Capstan friction on the material coordinate of every slipping hole node
+// (eqs. 9, 11), and for every node the wrap angle (eq. 12) and limiting
+// static friction (eq. 10) the stick-slip switches test. A stuck node's
+// friction is its stick constraint's reaction, known after the solve.
+void ArmDynamics::AddHoleFriction(const double* q, const double* qd) {
+  const std::vector<HoleNodeRef>& holes = layout_.holes();
+  for (std::size_t h = 0; h < holes.size(); ++h) {
+    const HoleNodeRef& hole = holes[h];
+    const int o = model_.node_offset(hole.cable, hole.node);
+    const Vector3 r_prev = Position(q, model_.node_offset(hole.cable, hole.node - 1));
+    const Vector3 r_next = Position(q, model_.node_offset(hole.cable, hole.node + 1));
+    HoleReport& report = reports_[h];
+    report.s_dot = qd[o + 3];
+    report.wrap_angle = WrapAngle(r_prev, Position(q, o), r_next);
+    const double t_before = tension_[hole.cable][hole.node - 1];
+    const double t_after = tension_[hole.cable][hole.node];
+    report.friction_limit =
+        LimitingStaticFriction(t_before, t_after, parameters_.mu_s, report.wrap_angle);
+    report.required_friction = 0.0;
+    // Where even the static limit is below the force tolerance (a cable
+    // running nearly straight through the hole) friction is negligible and
+    // left out, so that its direction need not follow a slip speed that
+    // hovers around zero.
+    const bool negligible = report.friction_limit < solver_.stick_force_tolerance_n;
+    if (!has_stick_slip() || modes_[h] == HoleMode::kStuck || negligible) continue;
+    const double sigma = modes_[h] == HoleMode::kSlipUp ? 1.0 : -1.0;
+    const double f = HoleSlipFriction(t_before, parameters_.mu, report.wrap_angle, sigma);
+    force_[o + 3] += f;
+    dissipation_ -= f * qd[o + 3];
+  }
+}
+
+// Relative rotations, universal-joint angles and rates of every joint.
+void ArmDynamics::ComputeJointAngles() {
+  for (int j = 1; j <= model_.num_joints(); ++j) {
+    Eigen::Matrix3d& rel = relative_rotation_[j - 1];
+    rel = j > 1 ? Eigen::Matrix3d(rotation_[j - 2].transpose() * rotation_[j - 1]) : rotation_[0];
+    theta_[j - 1] = UniversalJointAngles(rel);
+    const Vector3 w_parent = j > 1 ? omega_[j - 2] : Vector3::Zero();
+    theta_dot_[j - 1] = UniversalJointRates(theta_[j - 1][1],
+                                            RelativeAngularVelocity(rel, omega_[j - 1], w_parent));
+  }
+}
+
+Eigen::Matrix2d ArmDynamics::ConnectingFrictionSmoothing(const LargeSParams& large, double th_i,
+                                                         double th_j, double rt_i,
+                                                         double rt_j) const {
+  // Model smoothing of the conduit friction (interpretation beyond the
+  // paper, as eqs. 14-16 do for strain): the moments see the rates averaged
+  // over h, theta_dot + (h/2) theta_dd. Linearised, that adds (h/2) J^T C J
+  // to the mass, C = -dM/d(theta_dot), and takes the microsecond time
+  // constant of eq. 45's steep slope out of the explicit integration.
+  const double delta = 1e-3 * large.friction.v_static_mps / large.pulley_radius_m;
+  const ConnectingMoments pi = LargeSMoments(large, th_i, th_j, rt_i + delta, rt_j).moments;
+  const ConnectingMoments mi = LargeSMoments(large, th_i, th_j, rt_i - delta, rt_j).moments;
+  const ConnectingMoments pj = LargeSMoments(large, th_i, th_j, rt_i, rt_j + delta).moments;
+  const ConnectingMoments mj = LargeSMoments(large, th_i, th_j, rt_i, rt_j - delta).moments;
+  Eigen::Matrix2d d;
+  d << pi.on_i - mi.on_i, pj.on_i - mj.on_i, pi.on_j - mi.on_j, pj.on_j - mj.on_j;
+  d /= 2.0 * delta;
+  // Only the dissipative part is kept: the rate dependence of the capstan
+  // stiffness (through mu_m) makes -sym(d) indefinite once the two joints
+  // differ (det = -g^2), and a negative added mass of order (h/2) g^2 / F
+  // dwarfs the link inertia. Clipping the eigenvalues at zero keeps the
+  // smoothing positive semidefinite.
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(-0.5 * (d + d.transpose()));
+  return (0.5 * solver_.smoothing_step_s) * eig.eigenvectors() *
+         eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+}
+
+// Small-S and large-S moments on both joints of every pair and axis, their
+// model smoothing (added mass), and the joint moments mapped onto the two
+// links' quaternions (eqs. 54-58).
+void ArmDynamics::AddConnectingMoments(const double* q) {
+  double* values = system_.values();
+  const double h = solver_.smoothing_step_s;
+  const std::vector<Eigen::Matrix3d>& rel = relative_rotation_;
+  std::fill(joint_moment_.begin(), joint_moment_.end(), Eigen::Vector2d::Zero());
+  // Row `axis` of d(theta_dot of joint k)/d(e_dot of link), 1-based k and link.
+  auto rate_row = [&](int k, int link, int axis) -> Eigen::Matrix<double, 1, 4> {
+    const Matrix32d b = UniversalJointRateMatrix(theta_[k - 1][1]);
+    if (link == k) return (b.transpose() * rate_matrix_[link - 1]).row(axis);
+    if (link == k - 1) {
+      return -(b.transpose() * rel[k - 1].transpose() * rate_matrix_[link - 1]).row(axis);
+    }
+    return Eigen::Matrix<double, 1, 4>::Zero();
+  };
+  smoothing_power_.clear();
+  for (std::size_t p = 0; p < pair_kernels_.size(); ++p) {
+    const PairKernel& pair = pair_kernels_[p];
+    const std::vector<int>& links = layout_.pair_links(static_cast<int>(p));
+    const int i = pair.joint_i - 1, j = pair.joint_i;
+    const int width = 4 * static_cast<int>(links.size());
+    for (int axis = 0; axis < 2; ++axis) {
+      const double th_i = theta_[i][axis], th_j = theta_[j][axis];
+      const double rt_i = theta_dot_[i][axis], rt_j = theta_dot_[j][axis];
+      ConnectingMoments m;
+      // N·m/rad: the frictionless couple (energy bookkeeping), and the
+      // stiffness it has right now (smoothing).
+      double k_conservative = 0.0, k_now = 0.0;
+      double damping = 0.0;  // N·m·s/rad
+      // (h/2) C on (theta_dot_i, theta_dot_j): smoothing of the conduit friction.
+      Eigen::Matrix2d friction_smoothing = Eigen::Matrix2d::Zero();
+      if (pair.kind == ConnectingKind::kSmallS) {
+        m = SmallSMoments(pair.small, th_i, th_j, rt_i, rt_j);
+        k_conservative = k_now = SmallSStiffness(pair.small);
+        damping = pair.small.damping_nmsprad;
+      } else {
+        const LargeSResult large = LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j);
+        m = large.moments;
+        k_conservative = SmallSStiffness({pair.large.axial_stiffness_n, pair.large.pulley_radius_m,
+                                          pair.large.cable_length_m, 0.0});
+        k_now = large.stiffness_i;
+        damping = pair.large.damping_nmsprad;
+        if (solver_.smooth_connecting_friction && h > 0.0) {
+          friction_smoothing = ConnectingFrictionSmoothing(pair.large, th_i, th_j, rt_i, rt_j);
+        }
+      }
+      // Model smoothing of the connecting spring and damper (interpretation
+      // beyond the paper, after eqs. 14-20): the moments see the
+      // acceleration part of the average over h, k (h^2/6) d_dd + c (h/2)
+      // d_dd (d = theta_j - theta_i), which adds mu J_d^T J_d to the mass and
+      // caps the couple's torsional modes near sqrt(6)/h. The (h/2) d_dot
+      // part is left out: it would add a damper of k h/2 (0.8 N·m·s/rad, 16x
+      // c) and change the arm's slow transients by ~10 %. The bias of d_dd
+      // (quadratic in the rates, ~1e-7 N·m here) is left out too.
+      const double smoothing_mass =
+          solver_.smooth_connecting_elasticity ? k_now * h * h / 6.0 + damping * h / 2.0 : 0.0;
+      if (smoothing_mass > 0.0 || !friction_smoothing.isZero(0.0)) {
+        Eigen::Matrix<double, 2, 12> jac = Eigen::Matrix<double, 2, 12>::Zero();
+        for (std::size_t l = 0; l < links.size(); ++l) {
+          jac.block<1, 4>(0, 4 * l) = rate_row(pair.joint_i, links[l], axis);
+          jac.block<1, 4>(1, 4 * l) = rate_row(pair.joint_i + 1, links[l], axis);
+        }
+        // Both smoothings in one 2x2 form on (theta_dot_i, theta_dot_j).
+        Eigen::Matrix2d form = friction_smoothing;
+        form += smoothing_mass * (Eigen::Matrix2d() << 1.0, -1.0, -1.0, 1.0).finished();
+        const Eigen::Matrix<double, 12, 12> added = jac.transpose() * form * jac;
+        const int* block = layout_.pair_block(static_cast<int>(p));
+        for (int a = 0; a < width; ++a)
+          for (int b = 0; b < width; ++b) values[block[width * a + b]] += added(a, b);
+        // The smoothing moments -form * theta_dd do work on the rates; it is
+        // booked as dissipation once q_dd is known.
+        SmoothingPower power;
+        power.weights = (Eigen::RowVector2d(rt_i, rt_j) * form * jac).transpose();
+        for (std::size_t l = 0; l < links.size(); ++l)
+          for (int a = 0; a < 4; ++a) power.cols[4 * l + a] = model_.link_offset(links[l]) + 3 + a;
+        power.count = width;
+        smoothing_power_.push_back(power);
+      }
+      joint_moment_[i][axis] += m.on_i;
+      joint_moment_[j][axis] += m.on_j;
+      const double d_theta = th_j - th_i, d_rate = rt_j - rt_i;
+      elastic_ += 0.5 * k_conservative * d_theta * d_theta;
+      // Dissipated = -(power of the moments) - d/dt(conservative energy).
+      dissipation_ += -(m.on_i * rt_i + m.on_j * rt_j) - k_conservative * d_theta * d_rate;
+    }
+  }
+  for (int j = 1; j <= model_.num_joints(); ++j) {
+    if (joint_moment_[j - 1].isZero(0.0)) continue;
+    const JointBodyMoments body =
+        JointMomentsToBodies(rel[j - 1], theta_[j - 1][1], joint_moment_[j - 1]);
+    const int oc = model_.link_offset(j);
+    force_.segment<4>(oc + 3) += QuaternionMomentForce(Quaternion(q, oc), body.on_child_body);
+    if (j > 1) {
+      const int op = model_.link_offset(j - 1);
+      force_.segment<4>(op + 3) += QuaternionMomentForce(Quaternion(q, op), body.on_parent_body);
+    }
+  }
+}
+
+// Rigid links: translational mass, the quaternion mass and velocity terms,
+// gravity.
+void ArmDynamics::AddLinkInertia(const double* q, const double* qd) {
+  double* values = system_.values();
+  for (int i = 1; i <= model_.num_links(); ++i) {
+    const LinkModel& link = model_.link(i);
+    const int o = model_.link_offset(i);
+    const Vector4 e = Quaternion(q, o), ed = Quaternion(qd, o);
+    const Eigen::Matrix3d inertia = link.inertia_kgm2.asDiagonal();
+    const int* index = layout_.link_block(i);
+    for (int a = 0; a < 3; ++a) values[index[a]] += link.mass_kg;
+    const Eigen::Matrix4d me = QuaternionMass(e, inertia);
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) values[index[3 + 4 * a + b]] += me(a, b);
+    force_.segment<3>(o) += link.mass_kg * model_.arm().gravity_mps2;
+    force_.segment<4>(o + 3) += QuaternionVelocityForce(e, ed, inertia);
+    kinetic_ += 0.5 * link.mass_kg * Position(qd, o).squaredNorm() +
+                0.5 * omega_[i - 1].dot(inertia * omega_[i - 1]);
+  }
+}
+
+// The constraint rows with Baumgarte stabilisation, added to the augmented
+// matrix as Phi_q^T Phi_q, the coupling blocks and the regularised
+// multiplier diagonal; a stick constraint that is off gets D = 1 instead.
+void ArmDynamics::AddConstraints(double t, const double* q, const double* qd) {
+  FillConstraints(t, q, qd, true);
+  double* values = system_.values();
+  Eigen::VectorXd& rhs = system_.rhs();
+  rhs.head(n_) = force_;
+  const std::vector<ConstraintRowLayout>& layout_rows = layout_.rows();
+  for (int r = 0; r < m_; ++r) {
+    const ConstraintRowLayout& cols = layout_rows[r];
+    const RowValues& row = rows_[r];
+    if (!row.active) {
+      values[layout_.row_diagonal(r)] = -1.0;
+      rhs[n_ + r] = 0.0;
+      continue;
+    }
+    values[layout_.row_diagonal(r)] = -kRegularization;
+    rhs[n_ + r] = -row.b;
+    const int* block = layout_.row_block(r);
+    const int* coupling = layout_.row_coupling(r);
+    for (int a = 0; a < cols.count; ++a) {
+      rhs[cols.cols[a]] -= row.vals[a] * row.b;
+      values[coupling[2 * a]] += row.vals[a];
+      values[coupling[2 * a + 1]] += row.vals[a];
+      for (int b = 0; b < cols.count; ++b)
+        values[block[cols.count * a + b]] += row.vals[a] * row.vals[b];
+    }
+  }
+}
+
+bool ArmDynamics::SolveAugmentedSystem() {
+  if (!system_.Solve()) {
+    failure_ = "augmented mass matrix is singular";
+    return false;
+  }
+  return true;
+}
+
+// ydot = (q_dot, q_dd, dissipated power); the stuck nodes' required
+// friction from their multipliers.
+bool ArmDynamics::FinishDerivative(const double* qd, double* ydot) {
+  const Eigen::VectorXd& solution = system_.solution();
+  for (int k = 0; k < n_; ++k) {
+    ydot[k] = qd[k];
+    ydot[n_ + k] = solution[k];
+  }
+  // Element smoothing and Rayleigh damping dissipate
+  // Δs EA eps_dot (beta' eps_dot + gamma eps_dd) with eps_dd = bias + eps_q q_dd.
+  for (const ElementRate& rate : element_rates_) {
+    double eps_q_qdd = 0.0;
+    for (int k = 0; k < 8; ++k) eps_q_qdd += rate.jac[k] * solution[rate.cols[k]];
+    dissipation_ += rate.coefficient + rate.gamma_term * eps_q_qdd;
+  }
+  for (const SmoothingPower& power : smoothing_power_) {
+    for (int k = 0; k < power.count; ++k)
+      dissipation_ += power.weights[k] * solution[power.cols[k]];
+  }
+  ydot[2 * n_] = dissipation_;
+
+  // Friction a stuck node needs: the reaction of its constraint, -lambda.
+  const std::vector<ConstraintRowLayout>& layout_rows = layout_.rows();
+  for (int r = 0; r < m_; ++r) {
+    const int hole = layout_rows[r].hole;
+    if (hole >= 0 && rows_[r].active) reports_[hole].required_friction = -solution[n_ + r];
+  }
+  for (int k = 0; k < 2 * n_ + 1; ++k) {
+    if (!std::isfinite(ydot[k])) {
+      failure_ = "non-finite acceleration";
+      return false;
+    }
+  }
+  return true;
 }
 
 void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, bool with_jacobian) {
-  const double alpha = config_.solver.baumgarte_alpha_per_s;
-  const double beta = config_.solver.baumgarte_beta_per_s2;
+  const double alpha = solver_.baumgarte_alpha_per_s;
+  const double beta = solver_.baumgarte_beta_per_s2;
+  const std::vector<ConstraintRowLayout>& layout_rows = layout_.rows();
   int r = 0;
   int node_index = 0;
   // Sets row r's Baumgarte right-hand side b = Phi_dd(q_dd = 0) + alpha Phi_d + beta Phi.
-  auto finish = [&](RowData& row, double phi, double phi_dot, double bias) {
+  auto finish = [&](RowValues& row, double phi, double phi_dot, double bias) {
     row.phi = phi;
     row.b = bias + alpha * phi_dot + beta * phi;
   };
@@ -323,7 +508,7 @@ void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, b
         bias = -PointJacobian(ed, node.p_LN) * ed;
       }
       for (int a = 0; a < 3; ++a, ++r) {
-        RowData& row = rows_[r];
+        RowValues& row = rows_[r];
         if (with_jacobian) {
           row.vals[0] = 1.0;
           if (node.link > 0) {
@@ -333,7 +518,7 @@ void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, b
         }
         finish(row, phi[a], phi_dot[a], bias[a]);
       }
-      RowData& srow = rows_[r++];
+      RowValues& srow = rows_[r];
       srow.vals[0] = 1.0;
       const double s = q[o + 3], sd = qd[o + 3];
       srow.active = true;
@@ -344,16 +529,17 @@ void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, b
       } else if (node.kind == CableNodeModel::Kind::kAnchor) {
         finish(srow, s - initial_s_[node_index], sd, 0.0);
       } else {
-        const int h = hole_of_node_row_[r - 1];
+        const int h = layout_rows[r].hole;
         srow.active = modes_[h] == HoleMode::kStuck;
         finish(srow, srow.active ? s - stuck_s_[h] : 0.0, sd, 0.0);
       }
+      ++r;
     }
   }
   for (int i = 1; i <= model_.num_links(); ++i, ++r) {
     const int o = model_.link_offset(i);
     const Vector4 e = Quaternion(q, o), ed = Quaternion(qd, o);
-    RowData& row = rows_[r];
+    RowValues& row = rows_[r];
     for (int k = 0; k < 4; ++k) row.vals[k] = 2.0 * e[k];
     finish(row, e.squaredNorm() - 1.0, 2.0 * e.dot(ed), 2.0 * ed.squaredNorm());
   }
@@ -380,7 +566,7 @@ void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, b
       phi += u_p;
     }
     for (int a = 0; a < 3; ++a, ++r) {
-      RowData& row = rows_[r];
+      RowValues& row = rows_[r];
       int v = 0;
       if (j > 1) {
         row.vals[v++] = 1.0;
@@ -397,7 +583,7 @@ void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, b
     const Vector3 c_dot = dc * edc;
     Vector3 a_dot = Vector3::Zero();
     double bias_o = a_vec.dot(PointJacobian(edc, y_axis) * edc);
-    RowData& row = rows_[r++];
+    RowValues& row = rows_[r++];
     int v = 0;
     if (j > 1) {
       const Eigen::Matrix<double, 3, 4> dp = PointJacobian(ep, x_axis);
@@ -413,336 +599,19 @@ void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, b
   CCSRM_CHECK(r == m_);
 }
 
-bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
-  ++evaluations_;
-  failure_.clear();
-  const double* q = y;
-  const double* qd = y + n_;
-  const SolverConfig& solver = config_.solver;
-  const DrivingCableConfig& dc = config_.arm.driving;
-  double* values = kkt_.valuePtr();
-  std::fill(values, values + kkt_.nonZeros(), 0.0);
-  force_.setZero();
-  double dissipation = 0.0;  // W, power taken out by friction and damping
-  const double h = solver.smoothing_step_s;
-  kinetic_ = 0.0;
-  elastic_ = 0.0;
-
-  // Stage 1: link kinematics.
-  std::vector<Vector3>& omega = omega_;
-  for (int i = 1; i <= model_.num_links(); ++i) {
-    const int o = model_.link_offset(i);
-    const Vector4 e = Quaternion(q, o), ed = Quaternion(qd, o);
-    rotation_[i - 1] = RotationFromQuaternion(e);
-    rate_matrix_[i - 1] = QuaternionRateMatrix(e);
-    omega[i - 1] = rate_matrix_[i - 1] * ed;
-  }
-
-  // Stage 2: driving-cable ALE elements (eqs. 1-6, 13, 17-20).
-  AleElementParams ale;
-  ale.linear_density_kgpm = dc.density_kgpm3 * dc.cross_section_m2;
-  ale.axial_stiffness_n = dc.youngs_modulus_pa * dc.cross_section_m2;
-  ale.rayleigh_beta_s = dc.rayleigh_beta_s;
-  ale.smoothing_step_s = solver.smoothing_step_s;
-  std::vector<ElementRate>& element_rates = element_rates_;
-  element_rates.clear();
-  int element_counter = 0;
-  for (int c = 0; c < model_.num_cables(); ++c) {
-    const int elements = model_.cables()[c].num_elements();
-    for (int e = 0; e < elements; ++e, ++element_counter) {
-      const int o1 = model_.node_offset(c, e), o2 = model_.node_offset(c, e + 1);
-      const int cols[8] = {o1, o1 + 1, o1 + 2, o2, o2 + 1, o2 + 2, o1 + 3, o2 + 3};
-      Vector8d qe, qde;
-      for (int k = 0; k < 8; ++k) {
-        qe[k] = q[cols[k]];
-        qde[k] = qd[cols[k]];
-      }
-      const double ds = qe[7] - qe[6];
-      if (!(ds > 0.0) || !std::isfinite(ds)) {
-        failure_ = "cable " + std::to_string(c + 1) + " element " + std::to_string(e + 1) +
-                   " collapsed (material length " + std::to_string(ds) + " m)";
-        return false;
-      }
-      const AleElementTerms terms = EvaluateAleElement(ale, qe, qde);
-      const int* index = &element_index_[64 * element_counter];
-      const Matrix8d mass = terms.mass + terms.elastic_mass;
-      for (int a = 0; a < 8; ++a)
-        for (int b = 0; b < 8; ++b) values[index[8 * a + b]] += mass(a, b);
-      const Vector8d f = terms.ale_inertia_force + terms.elastic_force;
-      for (int a = 0; a < 8; ++a) force_[cols[a]] += f[a];
-      tension_[c][e] = terms.tension;
-      kinetic_ += 0.5 * qde.dot(terms.mass * qde);
-      const double k = terms.taut ? 1.0 : 0.0;
-      elastic_ += 0.5 * ale.axial_stiffness_n * k * terms.strain * terms.strain * ds;
-      const double beta_p = dc.rayleigh_beta_s + k * h / 2.0;
-      const double gamma = dc.rayleigh_beta_s * h / 2.0 + k * h * h / 6.0;
-      const double scale = ds * ale.axial_stiffness_n * terms.strain_rate;
-      ElementRate rate;
-      rate.coefficient = scale * (beta_p * terms.strain_rate + gamma * terms.strain_accel_bias);
-      rate.gamma_term = scale * gamma;
-      rate.jac = terms.strain_jacobian;
-      std::copy(cols, cols + 8, rate.cols);
-      element_rates.push_back(rate);
-    }
-  }
-
-  // Stage 3: capstan friction at the hole nodes (eqs. 9-12).
-  for (std::size_t hidx = 0; hidx < holes_.size(); ++hidx) {
-    const HoleNodeRef& hole = holes_[hidx];
-    const int o = model_.node_offset(hole.cable, hole.node);
-    const Vector3 r_prev = Position(q, model_.node_offset(hole.cable, hole.node - 1));
-    const Vector3 r_next = Position(q, model_.node_offset(hole.cable, hole.node + 1));
-    HoleReport& report = reports_[hidx];
-    report.s_dot = qd[o + 3];
-    report.wrap_angle = WrapAngle(r_prev, Position(q, o), r_next);
-    const double t_before = tension_[hole.cable][hole.node - 1];
-    const double t_after = tension_[hole.cable][hole.node];
-    report.friction_limit =
-        LimitingStaticFriction(t_before, t_after, dc.friction_static, report.wrap_angle);
-    report.required_friction = 0.0;
-    // Where even the static limit is below the force tolerance (a cable
-    // running nearly straight through the hole) friction is negligible and
-    // left out, so that its direction need not follow a slip speed that
-    // hovers around zero.
-    const bool negligible = report.friction_limit < solver.stick_force_tolerance_n;
-    if (modes_[hidx] != HoleMode::kStuck && dc.friction_kinetic > 0.0 && !negligible) {
-      const double sigma = modes_[hidx] == HoleMode::kSlipUp ? 1.0 : -1.0;
-      const double f = HoleSlipFriction(t_before, dc.friction_kinetic, report.wrap_angle, sigma);
-      force_[o + 3] += f;
-      dissipation -= f * qd[o + 3];
-    }
-  }
-
-  // Stage 4: joint angles (eqs. 23-29) and connecting-cable moments (eqs. 38-58).
-  std::vector<Eigen::Matrix3d>& rel = relative_rotation_;
-  for (int j = 1; j <= model_.num_joints(); ++j) {
-    rel[j - 1] =
-        j > 1 ? Eigen::Matrix3d(rotation_[j - 2].transpose() * rotation_[j - 1]) : rotation_[0];
-    theta_[j - 1] = UniversalJointAngles(rel[j - 1]);
-    const Vector3 w_parent = j > 1 ? omega[j - 2] : Vector3::Zero();
-    theta_dot_[j - 1] = UniversalJointRates(
-        theta_[j - 1][1], RelativeAngularVelocity(rel[j - 1], omega[j - 1], w_parent));
-  }
-  std::vector<Eigen::Vector2d>& joint_moment = joint_moment_;
-  std::fill(joint_moment.begin(), joint_moment.end(), Eigen::Vector2d::Zero());
-  // Row `axis` of d(theta_dot of joint k)/d(e_dot of link), 1-based k and link.
-  auto rate_row = [&](int k, int link, int axis) -> Eigen::Matrix<double, 1, 4> {
-    const Matrix32d b = UniversalJointRateMatrix(theta_[k - 1][1]);
-    if (link == k) return (b.transpose() * rate_matrix_[link - 1]).row(axis);
-    if (link == k - 1) {
-      return -(b.transpose() * rel[k - 1].transpose() * rate_matrix_[link - 1]).row(axis);
-    }
-    return Eigen::Matrix<double, 1, 4>::Zero();
-  };
-  smoothing_power_.clear();
-  for (const PairKernel& pair : pair_kernels_) {
-    const int i = pair.joint_i - 1, j = pair.joint_i;
-    const int links = static_cast<int>(pair.links.size());
-    const int width = 4 * links;
-    for (int axis = 0; axis < 2; ++axis) {
-      const double th_i = theta_[i][axis], th_j = theta_[j][axis];
-      const double rt_i = theta_dot_[i][axis], rt_j = theta_dot_[j][axis];
-      ConnectingMoments m;
-      // N·m/rad: the frictionless couple (energy bookkeeping), and the
-      // stiffness it has right now (smoothing).
-      double k_conservative = 0.0, k_now = 0.0;
-      double damping = 0.0;  // N·m·s/rad
-      // (h/2) C on (theta_dot_i, theta_dot_j): smoothing of the conduit friction.
-      Eigen::Matrix2d friction_smoothing = Eigen::Matrix2d::Zero();
-      if (pair.kind == ConnectingKind::kSmallS) {
-        m = SmallSMoments(pair.small, th_i, th_j, rt_i, rt_j);
-        k_conservative = k_now = SmallSStiffness(pair.small);
-        damping = pair.small.damping_nmsprad;
-      } else {
-        const LargeSResult large = LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j);
-        m = large.moments;
-        k_conservative = SmallSStiffness({pair.large.axial_stiffness_n, pair.large.pulley_radius_m,
-                                          pair.large.cable_length_m, 0.0});
-        k_now = large.stiffness_i;
-        damping = pair.large.damping_nmsprad;
-        if (smooth_connecting_friction_) {
-          // Model smoothing of the conduit friction (interpretation beyond the
-          // paper, as eqs. 14-16 do for strain): the moments see the rates
-          // averaged over h, theta_dot + (h/2) theta_dd. Linearised, that
-          // adds (h/2) J^T C J to the mass, C = -dM/d(theta_dot), and takes
-          // the microsecond time constant of eq. 45's steep slope out of the
-          // explicit integration.
-          const double delta = 1e-3 * pair.large.friction.v_static_mps / pair.large.pulley_radius_m;
-          const ConnectingMoments pi =
-              LargeSMoments(pair.large, th_i, th_j, rt_i + delta, rt_j).moments;
-          const ConnectingMoments mi =
-              LargeSMoments(pair.large, th_i, th_j, rt_i - delta, rt_j).moments;
-          const ConnectingMoments pj =
-              LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j + delta).moments;
-          const ConnectingMoments mj =
-              LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j - delta).moments;
-          Eigen::Matrix2d d;
-          d << pi.on_i - mi.on_i, pj.on_i - mj.on_i, pi.on_j - mi.on_j, pj.on_j - mj.on_j;
-          d /= 2.0 * delta;
-          // Only the dissipative part is kept: the rate dependence of the
-          // capstan stiffness (through mu_m) makes -sym(d) indefinite once
-          // the two joints differ (det = -g^2), and a negative added mass of
-          // order (h/2) g^2 / F dwarfs the link inertia. Clipping the
-          // eigenvalues at zero keeps the smoothing positive semidefinite.
-          Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(-0.5 * (d + d.transpose()));
-          friction_smoothing = (0.5 * h) * eig.eigenvectors() *
-                               eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
-                               eig.eigenvectors().transpose();
-        }
-      }
-      // Model smoothing of the connecting spring and damper (interpretation
-      // beyond the paper, after eqs. 14-20): the moments see the
-      // acceleration part of the average over h, k (h^2/6) d_dd + c (h/2)
-      // d_dd (d = theta_j - theta_i), which adds mu J_d^T J_d to the mass and
-      // caps the couple's torsional modes near sqrt(6)/h. The (h/2) d_dot
-      // part is left out: it would add a damper of k h/2 (0.8 N·m·s/rad, 16x
-      // c) and change the arm's slow transients by ~10 %. The bias of d_dd
-      // (quadratic in the rates, ~1e-7 N·m here) is left out too.
-      const double smoothing_mass =
-          smooth_connecting_elasticity_ ? k_now * h * h / 6.0 + damping * h / 2.0 : 0.0;
-      if (smoothing_mass > 0.0 || !friction_smoothing.isZero(0.0)) {
-        Eigen::Matrix<double, 2, 12> jac = Eigen::Matrix<double, 2, 12>::Zero();
-        for (int l = 0; l < links; ++l) {
-          jac.block<1, 4>(0, 4 * l) = rate_row(pair.joint_i, pair.links[l], axis);
-          jac.block<1, 4>(1, 4 * l) = rate_row(pair.joint_i + 1, pair.links[l], axis);
-        }
-        // Both smoothings in one 2x2 form on (theta_dot_i, theta_dot_j).
-        Eigen::Matrix2d form = friction_smoothing;
-        form += smoothing_mass * (Eigen::Matrix2d() << 1.0, -1.0, -1.0, 1.0).finished();
-        const Eigen::Matrix<double, 12, 12> added = jac.transpose() * form * jac;
-        for (int a = 0; a < width; ++a)
-          for (int b = 0; b < width; ++b) values[pair.block_index[width * a + b]] += added(a, b);
-        // The smoothing moments -form * theta_dd do work on the rates; it is
-        // booked as dissipation once q_dd is known.
-        SmoothingPower power;
-        power.weights = (Eigen::RowVector2d(rt_i, rt_j) * form * jac).transpose();
-        for (int l = 0; l < links; ++l)
-          for (int a = 0; a < 4; ++a)
-            power.cols[4 * l + a] = model_.link_offset(pair.links[l]) + 3 + a;
-        power.count = width;
-        smoothing_power_.push_back(power);
-      }
-      joint_moment[i][axis] += m.on_i;
-      joint_moment[j][axis] += m.on_j;
-      const double d_theta = th_j - th_i, d_rate = rt_j - rt_i;
-      elastic_ += 0.5 * k_conservative * d_theta * d_theta;
-      // Dissipated = -(power of the moments) - d/dt(conservative energy).
-      dissipation += -(m.on_i * rt_i + m.on_j * rt_j) - k_conservative * d_theta * d_rate;
-    }
-  }
-  for (int j = 1; j <= model_.num_joints(); ++j) {
-    if (joint_moment[j - 1].isZero(0.0)) continue;
-    const JointBodyMoments body =
-        JointMomentsToBodies(rel[j - 1], theta_[j - 1][1], joint_moment[j - 1]);
-    const int oc = model_.link_offset(j);
-    force_.segment<4>(oc + 3) += QuaternionMomentForce(Quaternion(q, oc), body.on_child_body);
-    if (j > 1) {
-      const int op = model_.link_offset(j - 1);
-      force_.segment<4>(op + 3) += QuaternionMomentForce(Quaternion(q, op), body.on_parent_body);
-    }
-  }
-
-  // Stage 5: rigid links (eqs. 30-34).
-  for (int i = 1; i <= model_.num_links(); ++i) {
-    const LinkModel& link = model_.link(i);
-    const int o = model_.link_offset(i);
-    const Vector4 e = Quaternion(q, o), ed = Quaternion(qd, o);
-    const Eigen::Matrix3d inertia = link.inertia_kgm2.asDiagonal();
-    const int* index = &link_index_[19 * (i - 1)];
-    for (int a = 0; a < 3; ++a) values[index[a]] += link.mass_kg;
-    const Eigen::Matrix4d me = QuaternionMass(e, inertia);
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) values[index[3 + 4 * a + b]] += me(a, b);
-    force_.segment<3>(o) += link.mass_kg * config_.arm.gravity_mps2;
-    force_.segment<4>(o + 3) += QuaternionVelocityForce(e, ed, inertia);
-    kinetic_ += 0.5 * link.mass_kg * Position(qd, o).squaredNorm() +
-                0.5 * omega[i - 1].dot(inertia * omega[i - 1]);
-  }
-
-  // Stage 6: constraints with Baumgarte stabilisation (eqs. 35-37, 61-63).
-  FillConstraints(t, q, qd, true);
-  rhs_.head(n_) = force_;
-  for (int r = 0; r < m_; ++r) {
-    const RowData& row = rows_[r];
-    values[row_diag_index_[r]] = -kRegularization;
-    if (!row.active) {
-      values[row_diag_index_[r]] = -1.0;
-      rhs_[n_ + r] = 0.0;
-      continue;
-    }
-    rhs_[n_ + r] = -row.b;
-    const int* pair = &row_pair_index_[row_pair_offset_[r]];
-    for (int a = 0; a < row.count; ++a) {
-      rhs_[row.cols[a]] -= row.vals[a] * row.b;
-      for (int b = 0; b < row.count; ++b)
-        values[pair[row.count * a + b]] += row.vals[a] * row.vals[b];
-    }
-  }
-  {
-    int k = 0;
-    for (int r = 0; r < m_; ++r) {
-      const RowData& row = rows_[r];
-      for (int a = 0; a < row.count; ++a, k += 2) {
-        if (!row.active) continue;
-        values[row_kkt_index_[k]] += row.vals[a];
-        values[row_kkt_index_[k + 1]] += row.vals[a];
-      }
-    }
-  }
-
-  // Stage 7: solve the augmented system (eqs. 64-68) for q_dd and lambda.
-  lu_.factorize(kkt_);
-  if (lu_.info() != Eigen::Success) {
-    failure_ = "augmented mass matrix is singular";
-    return false;
-  }
-  for (int k = 0; k < n_ + m_; ++k) kkt_rhs_[kkt_order_[k]] = rhs_[k];
-  kkt_solution_ = lu_.solve(kkt_rhs_);
-  for (int k = 0; k < n_ + m_; ++k) solution_[k] = kkt_solution_[kkt_order_[k]];
-  const Eigen::VectorXd& solution = solution_;
-  for (int k = 0; k < n_; ++k) {
-    ydot[k] = qd[k];
-    ydot[n_ + k] = solution[k];
-  }
-  // Element smoothing and Rayleigh damping dissipate
-  // Δs EA eps_dot (beta' eps_dot + gamma eps_dd) with eps_dd = bias + eps_q q_dd.
-  for (const ElementRate& rate : element_rates) {
-    double eps_q_qdd = 0.0;
-    for (int k = 0; k < 8; ++k) eps_q_qdd += rate.jac[k] * solution[rate.cols[k]];
-    dissipation += rate.coefficient + rate.gamma_term * eps_q_qdd;
-  }
-  for (const SmoothingPower& power : smoothing_power_) {
-    for (int k = 0; k < power.count; ++k) dissipation += power.weights[k] * solution[power.cols[k]];
-  }
-  ydot[2 * n_] = dissipation;
-
-  // Friction a stuck node needs: the reaction of its constraint, -lambda.
-  for (int r = 0; r < m_; ++r) {
-    const int hidx = hole_of_node_row_[r];
-    if (hidx >= 0 && rows_[r].active) reports_[hidx].required_friction = -solution[n_ + r];
-  }
-  for (int k = 0; k < 2 * n_ + 1; ++k) {
-    if (!std::isfinite(ydot[k])) {
-      failure_ = "non-finite acceleration";
-      return false;
-    }
-  }
-  return true;
-}
-
 double ArmDynamics::ConstraintViolation(double t, const double* y) {
   for (int i = 1; i <= model_.num_links(); ++i) {
     rotation_[i - 1] = RotationFromQuaternion(Quaternion(y, model_.link_offset(i)));
   }
   FillConstraints(t, y, y + n_, false);
   double sum = 0.0;
-  for (const RowData& row : rows_) {
+  for (const RowValues& row : rows_) {
     if (row.active) sum += row.phi * row.phi;
   }
   return std::sqrt(sum);
 }
 
-void ArmDynamics::Observe(double t, const double* y, Observation* out, bool evaluate) {
+void ArmDynamics::Observe(double t, const double* y, TrajectoryFrame* out, bool evaluate) {
   if (evaluate) {
     std::vector<double> ydot(state_size());
     Evaluate(t, y, ydot.data());
@@ -760,10 +629,11 @@ void ArmDynamics::Observe(double t, const double* y, Observation* out, bool eval
   out->element_tension = tension_;
   out->hole_slip_velocity.assign(model_.num_cables(), {});
   out->hole_stuck.assign(model_.num_cables(), {});
-  for (std::size_t hidx = 0; hidx < holes_.size(); ++hidx) {
-    const int c = holes_[hidx].cable;
-    out->hole_slip_velocity[c].push_back(reports_[hidx].s_dot);
-    out->hole_stuck[c].push_back(modes_[hidx] == HoleMode::kStuck ? 1 : 0);
+  const std::vector<HoleNodeRef>& holes = layout_.holes();
+  for (std::size_t h = 0; h < holes.size(); ++h) {
+    const int c = holes[h].cable;
+    out->hole_slip_velocity[c].push_back(reports_[h].s_dot);
+    out->hole_stuck[c].push_back(modes_[h] == HoleMode::kStuck ? 1 : 0);
   }
   out->input_length_change.resize(model_.num_cables());
   for (int c = 0; c < model_.num_cables(); ++c) {

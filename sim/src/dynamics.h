@@ -1,33 +1,32 @@
 #pragma once
 // The right-hand side of the arm's equations of motion (paper eqs. 59-68):
 // the per-run data of one simulation (MuJoCo's "data") over a shared,
-// immutable ArmModel. Evaluate() runs the stages of the model in order:
-//   link kinematics -> cable elements -> hole friction -> connecting moments
-//   -> link inertia -> constraints (Baumgarte) -> augmented solve.
+// immutable ArmModel, with the run's own ArmParameters and solver settings.
+// Evaluate() is the physics in order, one named stage per call (see
+// dynamics.cc); the index bookkeeping of the sparse system lives in
+// sparse_system.h.
 //
 // State y = [q (n), q_dot (n), dissipated energy (1)]; q follows eq. 59:
 // every cable node (x, y, z, s) then every link (x, y, z, e0..e3).
 #include <Eigen/Core>
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseCore>
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
+#include "ccsrm/sim/parameters.h"
 #include "ccsrm/sim/protocol.h"
+#include "ccsrm/sim/simulator.h"
+#include "kernels/ale_element.h"
 #include "kernels/connecting.h"
+#include "sparse_system.h"
 
 namespace ccsrm::sim::internal {
 
 // Stick-slip state of one hole node: stuck (a temporary constraint s = s*),
 // or slipping with a fixed direction sigma = sgn(s_dot) for the whole step.
 enum class HoleMode : std::int8_t { kSlipDown = -1, kStuck = 0, kSlipUp = 1 };
-
-struct HoleNodeRef {
-  int cable = 0;
-  int node = 0;  // index within the cable (1 .. nodes-2)
-};
 
 // What one evaluation learned about a hole node, for switch detection.
 struct HoleReport {
@@ -37,28 +36,16 @@ struct HoleReport {
   double wrap_angle = 0.0;         // rad
 };
 
-// Everything written per output frame.
-struct Observation {
-  std::vector<Eigen::Vector2d> joint_angles;            // rad
-  std::vector<Eigen::Vector2d> joint_rates;             // rad/s
-  std::vector<Eigen::Matrix<double, 7, 1>> link_pose;   // x, y, z, e0..e3
-  std::vector<std::vector<double>> element_tension;     // per cable, per element [N]
-  std::vector<std::vector<double>> hole_slip_velocity;  // per cable, per hole [m/s]
-  std::vector<std::vector<int>> hole_stuck;             // per cable, per hole
-  Eigen::VectorXd input_length_change;                  // per cable [m]
-  double constraint_violation = 0.0;
-  double kinetic_energy = 0.0;
-  double elastic_energy = 0.0;
-  double dissipated_energy = 0.0;
-};
-
 class ArmDynamics {
  public:
-  // `model` and `inputs` must outlive this object.
-  ArmDynamics(const ArmModel& model, const CableInputs& inputs);
+  // `model` and `inputs` must outlive this object. Preconditions (checked):
+  // parameters valid, inputs for every cable of the model.
+  ArmDynamics(const ArmModel& model, const ArmParameters& parameters, const CableInputs& inputs,
+              const SolverConfig& solver);
 
   int num_coordinates() const { return n_; }
   int state_size() const { return 2 * n_ + 1; }
+  const SolverConfig& solver() const { return solver_; }
 
   // Straight arm at rest, driving cables uniformly strained to T_d0.
   Eigen::VectorXd InitialState() const;
@@ -69,10 +56,10 @@ class ArmDynamics {
   bool Evaluate(double t, const double* y, double* ydot);
   const std::string& failure() const { return failure_; }
 
-  // Driving-cable friction is on (mu or mu' > 0): hole nodes switch
-  // between stick and slip; otherwise every node slips without friction.
-  bool has_stick_slip() const { return stick_slip_; }
-  const std::vector<HoleNodeRef>& holes() const { return holes_; }
+  // Hole nodes switch between stick and slip (SolverConfig::stick_slip);
+  // otherwise every node slips without friction.
+  bool has_stick_slip() const { return solver_.stick_slip; }
+  const std::vector<HoleNodeRef>& holes() const { return layout_.holes(); }
   std::vector<HoleMode>& hole_modes() { return modes_; }
   std::vector<double>& stuck_position() { return stuck_s_; }
   // Filled by the last Evaluate().
@@ -84,89 +71,75 @@ class ArmDynamics {
   // Output quantities at (t, y); calls Evaluate for the tensions.
   // With `evaluate` false the caller guarantees that the last Evaluate() was
   // at (t, y) with the current hole modes, and its results are reused.
-  void Observe(double t, const double* y, Observation* out, bool evaluate = true);
+  void Observe(double t, const double* y, TrajectoryFrame* out, bool evaluate = true);
 
   std::int64_t evaluations() const { return evaluations_; }
 
  private:
-  void BuildStructure();
-  int Index(int row, int col) const;
+  // The stages of Evaluate, in order.
+  void ComputeLinkKinematics(const double* q, const double* qd);
+  bool AddCableElements(const double* q, const double* qd);
+  void AddHoleFriction(const double* q, const double* qd);
+  void ComputeJointAngles();
+  void AddConnectingMoments(const double* q);
+  void AddLinkInertia(const double* q, const double* qd);
+  void AddConstraints(double t, const double* q, const double* qd);
+  bool SolveAugmentedSystem();
+  bool FinishDerivative(const double* qd, double* ydot);
+
+  // Phi, its Baumgarte right-hand side b and (with_jacobian) Phi_q of every
+  // row (eqs. 35-37, 61-63); needs the link rotations.
   void FillConstraints(double t, const double* q, const double* qd, bool with_jacobian);
+  // (h/2) C of one large-S pair and axis: the smoothing of its conduit friction.
+  Eigen::Matrix2d ConnectingFrictionSmoothing(const LargeSParams& large, double th_i, double th_j,
+                                              double rt_i, double rt_j) const;
 
   const ArmModel& model_;
+  const SparseLayout& layout_;
   const CableInputs& inputs_;
-  const Config& config_;
+  const ArmParameters parameters_;
+  const SolverConfig solver_;
   int n_ = 0;  // coordinates
   int m_ = 0;  // constraint rows
-  bool stick_slip_ = false;
-  bool smooth_connecting_friction_ = false;
-  bool smooth_connecting_elasticity_ = false;
-  // Power of the friction-smoothing term, (h/2) theta_dot^T C J q_dd, per
-  // large-S pair and axis of the last evaluation (needs q_dd, so after the solve).
-  struct SmoothingPower {
-    Eigen::Matrix<double, 12, 1> weights;
-    int cols[12];
-    int count = 0;
-  };
-  std::vector<SmoothingPower> smoothing_power_;
 
-  std::vector<HoleNodeRef> holes_;
-  std::vector<int> hole_of_node_row_;  // row -> hole index, or -1
-  std::vector<HoleMode> modes_;
-  std::vector<double> stuck_s_;
-  std::vector<HoleReport> reports_;
-  std::vector<double> initial_s_;  // per cable node, s at t = 0
-
-  // Constraint rows with a fixed column structure (<= 14 columns each).
-  struct RowData {
-    int count = 0;
-    int cols[14];
-    double vals[14];
-    double phi = 0.0;  // Phi
-    double b = 0.0;    // b of eq. 63
-    bool active = true;
-  };
-  std::vector<RowData> rows_;
-  std::vector<int> row_kkt_index_;   // per row: index of (n+r, col) then (col, n+r), 2*count
-  std::vector<int> row_pair_index_;  // per row: count*count indices of (col_a, col_b)
-  std::vector<int> row_pair_offset_;
-  std::vector<int> row_diag_index_;  // index of (n+r, n+r)
-  std::vector<int> element_index_;   // per element: 64 indices
-  std::vector<int> link_index_;      // per link: 3 + 16 indices
-  // Connecting pairs with their kernel parameters; for large S pairs the
-  // links whose quaternion rates their joint rates involve (i-1, i, i+1)
-  // and the KKT indices of those quaternion blocks (friction smoothing mass).
+  // Element and connecting-pair kernel parameters of this run.
+  AleElementParams ale_;
   struct PairKernel {
     ConnectingKind kind = ConnectingKind::kSmallS;
     int joint_i = 0;  // 1-based; the other joint is joint_i + 1
     SmallSParams small;
     LargeSParams large;
-    std::vector<int> links;
-    std::vector<int> block_index;
   };
   std::vector<PairKernel> pair_kernels_;
 
-  // The augmented matrix is stored (both triangles) already in the
-  // fill-reducing order found once by AMD, so that each factorization reads
-  // it in place instead of permuting a copy (14% of the time before).
-  // Index() and the vectors below are in the model's own order.
-  Eigen::SparseMatrix<double> kkt_;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper, Eigen::NaturalOrdering<int>> lu_;
-  std::vector<int> kkt_order_;  // position of model unknown k in kkt_
-  Eigen::VectorXd rhs_;
-  Eigen::VectorXd kkt_rhs_, kkt_solution_;  // in kkt_ order
-  Eigen::VectorXd solution_;                // q_dd then lambda, model order
+  std::vector<HoleMode> modes_;
+  std::vector<double> stuck_s_;
+  std::vector<HoleReport> reports_;
+  std::vector<double> initial_s_;  // per cable node, s at t = 0
+
+  // Per constraint row: its values at the current state.
+  struct RowValues {
+    double vals[ConstraintRowLayout::kMaxColumns];
+    double phi = 0.0;  // Phi
+    double b = 0.0;    // b of eq. 63
+    bool active = true;
+  };
+  std::vector<RowValues> rows_;
+  AugmentedSystem system_;
   Eigen::VectorXd force_;
   std::string failure_;
   std::int64_t evaluations_ = 0;
 
   // Scratch of the last evaluation.
+  double dissipation_ = 0.0;  // W, power taken out by friction, damping and smoothing
+  double kinetic_ = 0.0, elastic_ = 0.0;
   std::vector<std::vector<double>> tension_;              // per cable element
   std::vector<Eigen::Matrix3d> rotation_;                 // per link A(e)
   std::vector<Eigen::Matrix<double, 3, 4>> rate_matrix_;  // per link G(e)
   std::vector<Eigen::Vector3d> omega_;                    // per link w' [rad/s]
   std::vector<Eigen::Matrix3d> relative_rotation_;        // per joint R_{L(i-1) L(i)}
   std::vector<Eigen::Vector2d> joint_moment_;             // per joint [N m]
+  std::vector<Eigen::Vector2d> theta_, theta_dot_;        // per joint [rad], [rad/s]
   // Per element, what the dissipated power needs once q_dd is known.
   struct ElementRate {
     double coefficient;  // Δs EA eps_dot (beta' eps_dot + gamma eps_dot_q q_dot)
@@ -175,8 +148,14 @@ class ArmDynamics {
     int cols[8];
   };
   std::vector<ElementRate> element_rates_;
-  std::vector<Eigen::Vector2d> theta_, theta_dot_;
-  double kinetic_ = 0.0, elastic_ = 0.0;
+  // Power of the connecting-cable smoothing terms, (h/2) theta_dot^T C J q_dd,
+  // per pair and axis (needs q_dd, so after the solve).
+  struct SmoothingPower {
+    Eigen::Matrix<double, 12, 1> weights;
+    int cols[12];
+    int count = 0;
+  };
+  std::vector<SmoothingPower> smoothing_power_;
 };
 
 }  // namespace ccsrm::sim::internal

@@ -2,11 +2,13 @@
 
 #include <cmath>
 
+#include "sparse_system.h"
+
 namespace ccsrm::sim {
 
-ArmModel::ArmModel(const Config& config) : config_(config) {
-  Validate(config_);
-  const ArmConfig& arm = config_.arm;
+ArmModel::ArmModel(const ArmConfig& arm_config) : arm_(arm_config) {
+  ValidateArm(arm_, "arm configuration");
+  const ArmConfig& arm = arm_;
   const double d = arm.joint_disk_gap_m;
 
   for (std::size_t s = 0; s < arm.segments.size(); ++s) {
@@ -30,12 +32,12 @@ ArmModel::ArmModel(const Config& config) : config_(config) {
       if (pair.kind == ConnectingKind::kSmallS) {
         const double r = seg.small_s.pulley_radius_m;
         pair.stiffness_nmprad = 2.0 * ea * r * r / seg.small_s.cable_length_m;  // eq. 41
-        pair.damping_nmsprad = cc.damping_small_nmsprad;
+        pair.cable_length_m = seg.small_s.cable_length_m;
         pair.pulley_radius_m = r;
       } else {
         const double r = seg.large_s.pulley_radius_m;
         pair.stiffness_nmprad = ea * r * r / seg.large_s.cable_length_m;  // eq. 50 prefactor
-        pair.damping_nmsprad = cc.damping_large_nmsprad;
+        pair.cable_length_m = seg.large_s.cable_length_m;
         pair.pulley_radius_m = r;
         pair.wrap_angle_rad = seg.large_s.wrap_angle_rad;
       }
@@ -81,6 +83,7 @@ ArmModel::ArmModel(const Config& config) : config_(config) {
     offset += 7;
   }
   num_coordinates_ = offset;
+  sparse_layout_ = std::make_shared<const internal::SparseLayout>(*this);
 }
 
 Eigen::Vector3d ArmModel::p_parent_joint(int joint) const {

@@ -13,22 +13,6 @@
 namespace ccsrm::sim {
 namespace {
 
-// The field a parameter stands for; one table so Get and Set cannot disagree.
-double* Field(const std::string& name, Config* config) {
-  DrivingCableConfig& d = config->arm.driving;
-  ConnectingCableConfig& c = config->arm.connecting;
-  if (name == "mu") return &d.friction_kinetic;
-  if (name == "mu_s") return &d.friction_static;
-  if (name == "mu_c") return &c.friction_kinetic;
-  if (name == "mu_c_s") return &c.friction_static;
-  if (name == "beta") return &d.rayleigh_beta_s;
-  if (name == "c_sc") return &c.damping_small_nmsprad;
-  if (name == "c_lc") return &c.damping_large_nmsprad;
-  if (name == "T_p") return &c.pretension_n;
-  if (name == "T_d0") return &d.pretension_n;
-  return nullptr;
-}
-
 std::string KnownNames() {
   std::string names;
   for (const ParameterInfo& p : Parameters()) names += (names.empty() ? "" : ", ") + p.name;
@@ -41,59 +25,79 @@ std::string FormatValue(double value) {
   return buffer;
 }
 
-// "" when value is finite and within the bounds, else what is wrong.
-std::string BoundsProblem(const ParameterInfo& info, double value) {
-  if (std::isfinite(value) && value >= info.lower && value <= info.upper) return "";
-  return FormatValue(value) + " is outside [" + FormatValue(info.lower) + ", " +
-         FormatValue(info.upper) + "] " + info.units;
+const ParameterInfo* LookUp(const std::string& name) {
+  for (const ParameterInfo& p : Parameters()) {
+    if (p.name == name) return &p;
+  }
+  return nullptr;
 }
 
 }  // namespace
 
+bool ArmParameters::IsValid(std::string* error) const {
+  for (const ParameterInfo& p : Parameters()) {
+    const std::string problem = ParameterValueProblem(p, this->*p.field);
+    if (!problem.empty()) {
+      *error = problem;
+      return false;
+    }
+  }
+  return true;
+}
+
 const std::vector<ParameterInfo>& Parameters() {
-  // Bounds: friction coefficients as configuration validation accepts them;
-  // the others span what a physical arm of this size can plausibly have.
+  // Bounds: friction coefficients up to 2 (steel on polymer is 0.1-0.5;
+  // 2 leaves room for a badly worn hole); damping up to 10 N m s/rad (200x
+  // the assumed 0.05); pre-tensions from 1 N (a cable barely held straight)
+  // to what a 1.3 mm wire rope carries well below its breaking load.
+  using P = ArmParameters;
   static const std::vector<ParameterInfo> parameters = {
       {"mu", "driving_cables.friction_kinetic", "1", 0.0, 2.0,
-       "kinetic friction coefficient of the driving cables (mu)"},
+       "kinetic friction coefficient of the driving cables (mu)", &P::mu},
       {"mu_s", "driving_cables.friction_static", "1", 0.0, 2.0,
-       "static friction coefficient of the driving cables (mu')"},
+       "static friction coefficient of the driving cables (mu')", &P::mu_s},
       {"mu_c", "connecting_cables.friction_kinetic", "1", 0.0, 2.0,
-       "kinetic friction coefficient of the connecting cables (mu_c)"},
+       "kinetic friction coefficient of the connecting cables (mu_c)", &P::mu_c},
       {"mu_c_s", "connecting_cables.friction_static", "1", 0.0, 2.0,
-       "static friction coefficient of the connecting cables (mu'_c)"},
+       "static friction coefficient of the connecting cables (mu'_c)", &P::mu_c_s},
       {"beta", "driving_cables.rayleigh_beta_s", "s", 0.0, 0.1,
-       "Rayleigh damping factor of the driving cables"},
+       "Rayleigh damping factor of the driving cables", &P::beta},
       {"c_sc", "connecting_cables.damping_small_nmsprad", "N m s/rad", 0.0, 10.0,
-       "damping of the small-S connecting mechanisms"},
+       "damping of the small-S connecting mechanisms", &P::c_sc},
       {"c_lc", "connecting_cables.damping_large_nmsprad", "N m s/rad", 0.0, 10.0,
-       "damping of the large-S connecting mechanisms"},
+       "damping of the large-S connecting mechanisms", &P::c_lc},
       {"T_p", "connecting_cables.pretension_n", "N", 1.0, 500.0,
-       "pre-tension of the connecting cables"},
-      {"T_d0", "driving_cables.pretension_n", "N", 1.0, 1000.0,
-       "pre-tension of the driving cables"},
+       "pre-tension of the connecting cables", &P::T_p},
+      {"T_d0", "driving_cables.pretension_n", "N", 1.0, 1000.0, "pre-tension of the driving cables",
+       &P::T_d0},
   };
   return parameters;
 }
 
 const ParameterInfo& FindParameter(const std::string& name, const std::string& where) {
-  for (const ParameterInfo& p : Parameters()) {
-    if (p.name == name) return p;
+  const ParameterInfo* info = LookUp(name);
+  if (info == nullptr) {
+    ThrowInputError(where, "", "unknown parameter '" + name + "' (known: " + KnownNames() + ")");
   }
-  ThrowInputError(where, "", "unknown parameter '" + name + "' (known: " + KnownNames() + ")");
+  return *info;
 }
 
-double GetParameter(const Config& config, const std::string& name) {
-  const double* field = Field(name, const_cast<Config*>(&config));
-  if (field == nullptr) FindParameter(name, "GetParameter");  // throws with the known names
-  return *field;
+std::string ParameterValueProblem(const ParameterInfo& info, double value) {
+  if (std::isfinite(value) && value >= info.lower && value <= info.upper) return "";
+  return "parameter '" + info.name + "' = " + FormatValue(value) + " is outside [" +
+         FormatValue(info.lower) + ", " + FormatValue(info.upper) + "] " + info.units;
 }
 
-void SetParameter(const std::string& name, double value, const std::string& where, Config* config) {
+double GetParameter(const ArmParameters& parameters, const std::string& name) {
+  return parameters.*FindParameter(name, "GetParameter").field;
+}
+
+void SetParameter(const std::string& name, double value, const std::string& where,
+                  ArmParameters* parameters) {
   const ParameterInfo& info = FindParameter(name, where);
-  const std::string problem = BoundsProblem(info, value);
-  if (!problem.empty()) ThrowInputError(where, "parameter '" + name + "'", problem);
-  *Field(name, config) = value;
+  const std::string problem = ParameterValueProblem(info, value);
+  if (!problem.empty()) ThrowInputError(where, "", problem);
+  parameters->*info.field = value;
 }
 
 std::pair<std::string, double> ParseParameterAssignment(const std::string& text,
@@ -116,7 +120,7 @@ std::pair<std::string, double> ParseParameterAssignment(const std::string& text,
 
 std::vector<std::pair<std::string, double>> ApplyParameterYaml(const std::string& yaml_text,
                                                                const std::string& file,
-                                                               Config* config) {
+                                                               ArmParameters* parameters) {
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
@@ -133,15 +137,14 @@ std::vector<std::pair<std::string, double>> ApplyParameterYaml(const std::string
   if (!root.IsMap()) {
     ThrowInputError(file, "", "expected a mapping of parameter names to values (e.g. 'mu: 0.18')");
   }
+  // Checked whole before anything is applied, so a bad file changes nothing.
+  ArmParameters updated = *parameters;
   std::vector<std::pair<std::string, double>> applied;
   for (const auto& entry : root) {
     const std::string key = entry.first.as<std::string>();
     const std::string where =
         "line " + std::to_string(entry.first.Mark().line + 1) + ", key '" + prefix + key + "'";
-    const ParameterInfo* info = nullptr;
-    for (const ParameterInfo& p : Parameters()) {
-      if (p.name == key) info = &p;
-    }
+    const ParameterInfo* info = LookUp(key);
     if (info == nullptr) {
       ThrowInputError(file, where, "unknown parameter (known: " + KnownNames() + ")");
     }
@@ -152,11 +155,12 @@ std::vector<std::pair<std::string, double>> ApplyParameterYaml(const std::string
     } catch (const YAML::Exception&) {
       ThrowInputError(file, where, "expected a number");
     }
-    const std::string problem = BoundsProblem(*info, value);
+    const std::string problem = ParameterValueProblem(*info, value);
     if (!problem.empty()) ThrowInputError(file, where, problem);
-    *Field(key, config) = value;
+    updated.*info->field = value;
     applied.emplace_back(key, value);
   }
+  *parameters = updated;
   return applied;
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/gsl_errors.h"
 
 namespace ccsrm::sim {
 
@@ -55,6 +56,7 @@ CableInputs::CableInputs(Eigen::VectorXd time, Eigen::MatrixXd length_change)
   }
   if (!length_change_.allFinite())
     ThrowInputError("cable inputs", "length_change", "has a non-finite value");
+  UseGslErrorCodes();
   const gsl_interp_type* type = n >= 3 ? gsl_interp_cspline : gsl_interp_linear;
   for (Eigen::Index c = 0; c < length_change_.cols(); ++c) {
     Eigen::VectorXd column = length_change_.col(c);

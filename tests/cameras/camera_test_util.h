@@ -20,7 +20,7 @@
 namespace ccsrm::cameras::testing {
 
 inline const sim::ArmModel& PaperModel() {
-  static const sim::ArmModel model(sim::LoadConfig(CCSRM_SOURCE_DIR "/configs/paper.yaml"));
+  static const sim::ArmModel model(sim::LoadConfig(CCSRM_SOURCE_DIR "/configs/paper.yaml").arm);
   return model;
 }
 

@@ -401,8 +401,10 @@ TEST(RunFileRead, RejectsUnknownCaseAndStatus) {
   SetRootString(path, "case", "2");
   SetRootString(path, "status", "crashed");
   EXPECT_THAT(InputErrorMessage([&] { ReadRunFile(path); }),
-              HasSubstr(path + ": attribute 'status' is 'crashed': expected 'completed' or "
-                               "'diverged'"));
+              HasSubstr(path + ": attribute 'status' is 'crashed': expected 'completed', "
+                               "'diverged' or 'cancelled'"));
+  SetRootString(path, "status", "cancelled");
+  EXPECT_EQ(ReadRunFile(path).status, RunStatus::kCancelled);
 }
 
 TEST(RunFileRead, RejectsMarkersWithoutNames) {

@@ -12,7 +12,7 @@ namespace ccsrm::mocap {
 namespace {
 
 const sim::ArmModel& PaperModel() {
-  static const sim::ArmModel model(sim::LoadConfig(CCSRM_SOURCE_DIR "/configs/paper.yaml"));
+  static const sim::ArmModel model(sim::LoadConfig(CCSRM_SOURCE_DIR "/configs/paper.yaml").arm);
   return model;
 }
 

@@ -16,7 +16,7 @@ namespace {
 using testing::InputErrorOf;
 
 const sim::ArmModel& PaperModel() {
-  static const sim::ArmModel model(sim::LoadConfig(CCSRM_SOURCE_DIR "/configs/paper.yaml"));
+  static const sim::ArmModel model(sim::LoadConfig(CCSRM_SOURCE_DIR "/configs/paper.yaml").arm);
   return model;
 }
 

@@ -21,8 +21,10 @@
 #include "ccsrm/mocap/virtual_experiment.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
+#include "ccsrm/sim/paper_run.h"
 #include "ccsrm/sim/protocol.h"
 #include "ccsrm/sim/simulator.h"
+#include "ccsrm/sim_io/run_file.h"
 
 namespace ccsrm::mocap::testing {
 
@@ -55,25 +57,26 @@ inline RoundTripTrial MakeRoundTripTrial(int case_number, const ProtocolConfig& 
   nominal.protocol.return_s = protocol.return_s;
   nominal.protocol.rest_s = protocol.rest_s;
   sim::Config truth = nominal;
-  sim::ApplyPaperCase(case_number, &truth);
-  const sim::ArmModel model(truth);
+  sim::ApplyPaperCase(case_number, &truth.parameters);
+  const sim::ArmModel model(truth.arm);
   const double duration = truth.protocol.duration_s();
   const sim::CableInputs inputs =
       sim::PlanCableInputs(model, sim::PaperTrajectory(model, truth.protocol), duration);
   sim::SimulationOptions options;
   options.duration_s = duration;
-  options.case_name = std::to_string(case_number);
-  sim::SimulationResult simulated = sim::Simulate(model, inputs, options);
+  options.solver = truth.solver;
+  const sim::SimulationResult simulated = sim::Simulate(model, truth.parameters, inputs, options);
 
   RoundTripTrial trial;
-  trial.completed = simulated.summary.completed;
+  trial.completed = simulated.summary.completed();
   trial.message = simulated.summary.message;
   VirtualExperimentOptions recording;
   recording.name = name;
   recording.nominal_config_yaml = sim::ToYaml(nominal);
   recording.recording.seed = seed;
-  VirtualExperiment generated =
-      MakeVirtualExperiment(simulated.run, DefaultMarkerLayout(model), recording);
+  VirtualExperiment generated = MakeVirtualExperiment(
+      sim_io::ToRunFile(model, simulated, {std::to_string(case_number), sim::ToYaml(truth)}),
+      DefaultMarkerLayout(model), recording);
   trial.truth = std::move(generated.truth);
   trial.experiment = std::move(generated.experiment);
   trial.recording = generated.recording;
@@ -90,7 +93,7 @@ inline RoundTripTrial MakeRoundTripTrial(int case_number, const ProtocolConfig& 
 // The experiment processed with the default options, its own rigid bodies
 // and the joint chain of its nominal configuration.
 inline ProcessingResult ProcessTrial(const RoundTripTrial& trial) {
-  const sim::ArmModel model(sim::ParseConfig(trial.experiment.config_yaml, "nominal"));
+  const sim::ArmModel model(sim::ParseConfig(trial.experiment.config_yaml, "nominal").arm);
   const JointChain chain = JointChain::FromModel(model);
   return ProcessMarkers(MarkerTableFromExperiment(trial.experiment),
                         trial.experiment.mocap_time.values,

@@ -20,7 +20,7 @@ TEST(RoundTripSlow, PaperCase2FullProtocolWithin005DegRms) {
   // And through a C3D file.
   const std::string c3d = trial.directory + "/recording.c3d";
   WriteC3d(c3d, MarkerTableFromExperiment(trial.experiment));
-  const sim::ArmModel model(sim::ParseConfig(trial.experiment.config_yaml, "nominal"));
+  const sim::ArmModel model(sim::ParseConfig(trial.experiment.config_yaml, "nominal").arm);
   const JointChain chain = JointChain::FromModel(model);
   const ProcessingResult from_c3d = ProcessMarkers(
       ReadMarkerFile(c3d), {}, DefaultMarkerLayout(model), ProcessingOptions(), c3d, &chain);

@@ -78,7 +78,7 @@ TEST(RoundTrip, ThroughTheC3dWriterAndReaderToo) {
   ASSERT_EQ(back.frames(), table.frames());
   EXPECT_EQ(back.rate_hz, 100.0);
   // The C3D carries no rigid bodies: the layout comes from the configuration.
-  const sim::ArmModel model(sim::ParseConfig(trial.experiment.config_yaml, "nominal"));
+  const sim::ArmModel model(sim::ParseConfig(trial.experiment.config_yaml, "nominal").arm);
   const JointChain chain = JointChain::FromModel(model);
   const ProcessingResult result =
       ProcessMarkers(back, {}, DefaultMarkerLayout(model), ProcessingOptions(), c3d, &chain);

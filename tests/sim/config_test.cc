@@ -57,7 +57,9 @@ TEST(Config, PaperConfigurationHoldsTable1) {
   EXPECT_EQ(c.arm.driving.cables[3].segment, 2);
   EXPECT_NEAR(c.arm.driving.cables[3].hole_angle_rad, M_PI / 3.0, 1e-15);
   EXPECT_DOUBLE_EQ(c.arm.driving.youngs_modulus_pa, 2.6e10);
-  EXPECT_DOUBLE_EQ(c.arm.connecting.pretension_n, 50.0);
+  EXPECT_DOUBLE_EQ(c.parameters.T_p, 50.0);
+  EXPECT_DOUBLE_EQ(c.parameters.mu_s, 0.21);
+  EXPECT_TRUE(c.solver.stick_slip);
   EXPECT_DOUBLE_EQ(c.solver.smoothing_step_s, 0.01);
   EXPECT_DOUBLE_EQ(c.protocol.duration_s(), 48.0);
   EXPECT_EQ(c.arm.segment_of_link(6), 0);
@@ -115,6 +117,15 @@ TEST(Config, YamlRoundTripKeepsEveryValue) {
   EXPECT_EQ(ToYaml(a), ToYaml(b));
   EXPECT_EQ(b.arm.segments[1].large_s.wrap_angle_rad, a.arm.segments[1].large_s.wrap_angle_rad);
   EXPECT_EQ(b.arm.driving.cables[5].hole_angle_rad, a.arm.driving.cables[5].hole_angle_rad);
+}
+
+TEST(Config, FileWithoutTheStickSlipSwitchKeepsItOn) {
+  // `solver.stick_slip` came after ccsrm-config/1 was first published; a
+  // run file's config_yaml from before it still parses.
+  const Config c = ParseConfig(Edited("  stick_slip: true\n", ""), "old.yaml");
+  EXPECT_TRUE(c.solver.stick_slip);
+  EXPECT_FALSE(
+      ParseConfig(Edited("stick_slip: true", "stick_slip: false"), "off.yaml").solver.stick_slip);
 }
 
 TEST(Config, ValidateRejectsConfigBuiltInCode) {

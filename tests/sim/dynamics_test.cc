@@ -9,6 +9,7 @@
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/kinematics.h"
 #include "ccsrm/sim/model.h"
+#include "ccsrm/sim/paper_run.h"
 #include "ccsrm/sim/protocol.h"
 #include "ccsrm/sim/simulator.h"
 
@@ -44,8 +45,8 @@ CableInputs PullAndHold(const ArmModel& model, int pulled, double amount_m, doub
   return CableInputs(time, change);
 }
 
-double TotalEnergy(const datasets::RunFile& run, std::size_t frame) {
-  return run.energy.at(frame, 0) + run.energy.at(frame, 1) + run.energy.at(frame, 2);
+double TotalEnergy(const TrajectoryFrame& frame) {
+  return frame.kinetic_energy + frame.elastic_energy + frame.dissipated_energy;
 }
 
 // Energy figures of a run from `from_s` on (after the inputs have stopped).
@@ -58,20 +59,50 @@ struct EnergyBalance {
   double span_s = 0.0;
 };
 
-EnergyBalance BalanceAfter(const datasets::RunFile& run, double from_s) {
+EnergyBalance BalanceAfter(const Trajectory& run, double from_s) {
   std::size_t start = 0;
-  while (run.time.at(start) < from_s) ++start;
+  while (run.time[start] < from_s) ++start;
+  const TrajectoryFrame& first = run.frames[start];
+  const TrajectoryFrame& last = run.frames.back();
   EnergyBalance b;
-  b.reference = TotalEnergy(run, start);
-  for (std::size_t f = start; f < run.frames(); ++f) {
-    b.drift = std::max(b.drift, std::abs(TotalEnergy(run, f) - b.reference));
-    b.kinetic_max = std::max(b.kinetic_max, run.energy.at(f, 0));
+  b.reference = TotalEnergy(first);
+  for (std::size_t f = start; f < run.size(); ++f) {
+    const TrajectoryFrame& frame = run.frames[f];
+    b.drift = std::max(b.drift, std::abs(TotalEnergy(frame) - b.reference));
+    b.kinetic_max = std::max(b.kinetic_max, frame.kinetic_energy);
     b.elastic_swing =
-        std::max(b.elastic_swing, std::abs(run.energy.at(f, 1) - run.energy.at(start, 1)));
+        std::max(b.elastic_swing, std::abs(frame.elastic_energy - first.elastic_energy));
   }
-  b.dissipated = run.energy.at(run.frames() - 1, 2) - run.energy.at(start, 2);
-  b.span_s = run.time.at(run.frames() - 1) - run.time.at(start);
+  b.dissipated = last.dissipated_energy - first.dissipated_energy;
+  b.span_s = run.time.back() - run.time[start];
   return b;
+}
+
+// No friction and no damping anywhere; the equations keep all their terms.
+void SwitchOffDissipation(ArmParameters* p) {
+  p->mu = p->mu_s = p->mu_c = p->mu_c_s = 0.0;
+  p->beta = p->c_sc = p->c_lc = 0.0;
+}
+
+SimulationOptions OptionsFor(const Config& c, double duration_s) {
+  SimulationOptions options;
+  options.duration_s = duration_s;
+  options.solver = c.solver;
+  return options;
+}
+
+// Every sampled quantity the same to the last bit.
+void ExpectBitIdentical(const Trajectory& a, const Trajectory& b) {
+  ASSERT_EQ(a.time, b.time);
+  for (std::size_t f = 0; f < a.size(); ++f) {
+    const TrajectoryFrame &x = a.frames[f], &y = b.frames[f];
+    ASSERT_EQ(x.joint_angles, y.joint_angles) << "frame " << f;
+    ASSERT_EQ(x.joint_rates, y.joint_rates) << "frame " << f;
+    ASSERT_EQ(x.link_pose, y.link_pose) << "frame " << f;
+    ASSERT_EQ(x.element_tension, y.element_tension) << "frame " << f;
+    ASSERT_EQ(x.hole_stuck, y.hole_stuck) << "frame " << f;
+    ASSERT_EQ(x.dissipated_energy, y.dissipated_energy) << "frame " << f;
+  }
 }
 
 TEST(ArmDynamics, EnergyIsConservedWithoutDissipation) {
@@ -83,23 +114,18 @@ TEST(ArmDynamics, EnergyIsConservedWithoutDissipation) {
   Config c = SmallArm(3);
   c.arm.driving.youngs_modulus_pa = 2.6e8;
   c.arm.driving.density_kgpm3 = 7.85e6;
-  c.arm.driving.friction_kinetic = c.arm.driving.friction_static = 0.0;
-  c.arm.driving.rayleigh_beta_s = 0.0;
-  c.arm.connecting.friction_kinetic = c.arm.connecting.friction_static = 0.0;
-  c.arm.connecting.damping_small_nmsprad = c.arm.connecting.damping_large_nmsprad = 0.0;
-  c.arm.driving.pretension_n = 1.0;  // strain 2.9e-3, as T_d0 gives the real cable
+  SwitchOffDissipation(&c.parameters);
+  c.parameters.T_d0 = 1.0;  // strain 2.9e-3, as T_d0 gives the real cable
   c.solver.smoothing_step_s = 0.0;
   c.solver.relative_tolerance = 1e-9;
   c.solver.absolute_tolerance = 1e-12;
   c.solver.max_step_s = 1e-4;
   c.solver.output_rate_hz = 1000.0;
-  const ArmModel model(c);
+  const ArmModel model(c.arm);
   const CableInputs inputs = PullAndHold(model, 2, 0.5e-3, 0.02, 0.2);
-  SimulationOptions options;
-  options.duration_s = 0.2;
-  const SimulationResult result = Simulate(model, inputs, options);
-  ASSERT_TRUE(result.summary.completed) << result.summary.message;
-  const EnergyBalance e = BalanceAfter(result.run, 0.03);
+  const SimulationResult result = Simulate(model, c.parameters, inputs, OptionsFor(c, 0.2));
+  ASSERT_TRUE(result.summary.completed()) << result.summary.message;
+  const EnergyBalance e = BalanceAfter(result.trajectory, 0.03);
   std::printf(
       "energy after the pull: %.6e J; kinetic up to %.3e J; elastic swings %.3e J; "
       "drift %.3e J over %.2f s (%zu steps, violation %.2e)\n",
@@ -124,42 +150,42 @@ TEST(ArmDynamics, SameInputsGiveBitIdenticalRuns) {
   // Identification differentiates simulations by finite differences, so a
   // run must be a pure function of its inputs.
   Config c = SmallArm(4);
-  const ArmModel model(c);
+  const ArmModel model(c.arm);
   const CableInputs inputs = PullAndHold(model, 2, 1e-3, 0.05, 0.1);
-  SimulationOptions options;
-  options.duration_s = 0.1;
-  const SimulationResult a = Simulate(model, inputs, options);
-  const SimulationResult b = Simulate(model, inputs, options);
-  ASSERT_TRUE(a.summary.completed) << a.summary.message;
+  const SimulationOptions options = OptionsFor(c, 0.1);
+  const SimulationResult a = Simulate(model, c.parameters, inputs, options);
+  const SimulationResult b = Simulate(model, c.parameters, inputs, options);
+  ASSERT_TRUE(a.summary.completed()) << a.summary.message;
   EXPECT_EQ(a.summary.steps, b.summary.steps);
   EXPECT_EQ(a.summary.stick_slip_switches, b.summary.stick_slip_switches);
-  EXPECT_EQ(a.run.joint_angles.values, b.run.joint_angles.values);
-  EXPECT_EQ(a.run.link_pose.values, b.run.link_pose.values);
-  EXPECT_EQ(a.run.input_tension.values, b.run.input_tension.values);
+  ExpectBitIdentical(a.trajectory, b.trajectory);
 }
 
 // The paper arm over a compressed protocol: 6 deg in 1.5 s, held 0.5 s (the
 // run stops before the return).
 SimulationResult RunCompressedCase(int case_number, const Config& base) {
   Config c = base;
-  ApplyPaperCase(case_number, &c);
+  ApplyPaperCase(case_number, &c.parameters);
   c.protocol.ramp_s = 1.5;
   c.protocol.hold_s = 0.5;
   c.protocol.return_s = 2.0;
   c.protocol.rest_s = 0.5;
-  const ArmModel model(c);
+  const ArmModel model(c.arm);
   const CableInputs inputs =
       PlanCableInputs(model, PaperTrajectory(model, c.protocol), c.protocol.duration_s());
-  SimulationOptions options;
-  options.duration_s = c.protocol.ramp_s + c.protocol.hold_s;
-  return Simulate(model, inputs, options);
+  return Simulate(model, c.parameters, inputs,
+                  OptionsFor(c, c.protocol.ramp_s + c.protocol.hold_s));
 }
 
-double MaxJointAngleDifferenceDeg(const datasets::RunFile& a, const datasets::RunFile& b) {
-  EXPECT_EQ(a.joint_angles.values.size(), b.joint_angles.values.size());
+double MaxJointAngleDifferenceDeg(const Trajectory& a, const Trajectory& b) {
+  EXPECT_EQ(a.size(), b.size());
   double worst = 0.0;
-  for (std::size_t k = 0; k < a.joint_angles.values.size(); ++k)
-    worst = std::max(worst, std::abs(a.joint_angles.values[k] - b.joint_angles.values[k]));
+  for (std::size_t f = 0; f < std::min(a.size(), b.size()); ++f) {
+    for (std::size_t j = 0; j < a.frames[f].joint_angles.size(); ++j) {
+      worst = std::max(
+          worst, (a.frames[f].joint_angles[j] - b.frames[f].joint_angles[j]).cwiseAbs().maxCoeff());
+    }
+  }
   return worst * 180.0 / M_PI;
 }
 
@@ -174,8 +200,8 @@ TEST(ArmDynamics, DefaultTolerancesAreConvergedForJointAngles) {
   tight.solver.absolute_tolerance /= 10.0;
   const SimulationResult a = RunCompressedCase(2, paper);
   const SimulationResult b = RunCompressedCase(2, tight);
-  ASSERT_TRUE(a.summary.completed && b.summary.completed);
-  const double difference = MaxJointAngleDifferenceDeg(a.run, b.run);
+  ASSERT_TRUE(a.summary.completed() && b.summary.completed());
+  const double difference = MaxJointAngleDifferenceDeg(a.trajectory, b.trajectory);
   std::printf("case 2, 2 s: %lld vs %lld steps, joint angles differ by %.2e deg at most\n",
               static_cast<long long>(a.summary.steps), static_cast<long long>(b.summary.steps),
               difference);
@@ -195,8 +221,8 @@ TEST(ArmDynamics, ConnectingCableSmoothingChangesJointAnglesLittle) {
   for (int case_number : {1, 2}) {
     const SimulationResult a = RunCompressedCase(case_number, paper);
     const SimulationResult b = RunCompressedCase(case_number, unsmoothed);
-    ASSERT_TRUE(a.summary.completed && b.summary.completed);
-    const double difference = MaxJointAngleDifferenceDeg(a.run, b.run);
+    ASSERT_TRUE(a.summary.completed() && b.summary.completed());
+    const double difference = MaxJointAngleDifferenceDeg(a.trajectory, b.trajectory);
     std::printf(
         "case %d: %lld steps smoothed vs %lld unsmoothed, joint angles differ by %.2e deg at "
         "most\n",
@@ -212,20 +238,15 @@ TEST(ArmDynamics, EnergyBookkeepingHoldsWithModelSmoothing) {
   // damping, whatever the smoothing takes out is booked as dissipated, so
   // kinetic + elastic + dissipated stays put.
   Config c = SmallArm(4);
-  c.arm.driving.friction_kinetic = c.arm.driving.friction_static = 0.0;
-  c.arm.driving.rayleigh_beta_s = 0.0;
-  c.arm.connecting.friction_kinetic = c.arm.connecting.friction_static = 0.0;
-  c.arm.connecting.damping_small_nmsprad = c.arm.connecting.damping_large_nmsprad = 0.0;
+  SwitchOffDissipation(&c.parameters);
   c.solver.relative_tolerance = 1e-8;
   c.solver.absolute_tolerance = 1e-11;
   c.solver.output_rate_hz = 1000.0;
-  const ArmModel model(c);
+  const ArmModel model(c.arm);
   const CableInputs inputs = PullAndHold(model, 2, 0.5e-3, 0.02, 0.2);
-  SimulationOptions options;
-  options.duration_s = 0.2;
-  const SimulationResult result = Simulate(model, inputs, options);
-  ASSERT_TRUE(result.summary.completed) << result.summary.message;
-  const EnergyBalance e = BalanceAfter(result.run, 0.03);
+  const SimulationResult result = Simulate(model, c.parameters, inputs, OptionsFor(c, 0.2));
+  ASSERT_TRUE(result.summary.completed()) << result.summary.message;
+  const EnergyBalance e = BalanceAfter(result.trajectory, 0.03);
   std::printf("smoothed: kinetic up to %.3e J, smoothing took %.3e J, drift %.3e J\n",
               e.kinetic_max, e.dissipated, e.drift);
   ASSERT_GT(e.kinetic_max, 1e-7);

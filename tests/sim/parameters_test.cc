@@ -4,7 +4,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/sim/config.h"
 
 namespace ccsrm::sim {
 namespace {
@@ -26,14 +28,14 @@ TEST(Parameters, SpecNamesInOrderEachMappedToItsConfigField) {
   for (const ParameterInfo& p : Parameters()) names.push_back(p.name);
   EXPECT_EQ(names, (std::vector<std::string>{"mu", "mu_s", "mu_c", "mu_c_s", "beta", "c_sc", "c_lc",
                                              "T_p", "T_d0"}));
-  const Config c = Paper();
-  EXPECT_EQ(GetParameter(c, "mu"), c.arm.driving.friction_kinetic);
+  const ArmParameters c = Paper().parameters;
+  EXPECT_EQ(GetParameter(c, "mu"), c.mu);
   EXPECT_EQ(GetParameter(c, "T_d0"), 100.0);
   EXPECT_EQ(GetParameter(c, "T_p"), 50.0);
   EXPECT_EQ(GetParameter(c, "c_lc"), 0.05);
   // Setting each one changes exactly its own field.
   for (const ParameterInfo& p : Parameters()) {
-    Config changed = Paper();
+    ArmParameters changed = c;
     const double value = 0.5 * (p.lower + p.upper);
     SetParameter(p.name, value, "test", &changed);
     for (const ParameterInfo& other : Parameters()) {
@@ -42,6 +44,49 @@ TEST(Parameters, SpecNamesInOrderEachMappedToItsConfigField) {
           << p.name << " changed " << other.name;
     }
   }
+}
+
+// Every door checks a value against the one table and says the same thing
+// about it; only the place named before it differs.
+TEST(Parameters, OutOfBoundsValueGetsOneMessageFromEveryDoor) {
+  const std::string text = ReadTextFile(CCSRM_SOURCE_DIR "/configs/paper.yaml");
+  for (const ParameterInfo& p : Parameters()) {
+    const double value = p.upper * 2.0 + 1.0;
+    const std::string expected = ParameterValueProblem(p, value);
+    ASSERT_THAT(expected, HasSubstr("parameter '" + p.name + "'"));
+    // A configuration file: the parameter's key in its cable section.
+    const std::string key = p.config_key.substr(p.config_key.find('.') + 1);
+    const std::string section = p.config_key.substr(0, p.config_key.find('.'));
+    const std::size_t at = text.find("\n  " + key + ":", text.find(section + ":"));
+    ASSERT_NE(at, std::string::npos) << p.config_key;
+    const std::size_t end = text.find('\n', at + 1);
+    std::string edited = text;
+    edited.replace(at, end - at, "\n  " + key + ": " + std::to_string(value));
+    const std::string from_config = ErrorOf([&] { ParseConfig(edited, "arm.yaml"); });
+    EXPECT_THAT(from_config, HasSubstr("key '" + p.config_key + "': " + expected));
+    // --set and --params.
+    ArmParameters parameters = Paper().parameters;
+    const std::string from_set =
+        ErrorOf([&] { SetParameter(p.name, value, "--set", &parameters); });
+    EXPECT_EQ(from_set, "--set: " + expected);
+    const std::string from_params = ErrorOf([&] {
+      ApplyParameterYaml(p.name + ": " + std::to_string(value) + "\n", "p.yaml", &parameters);
+    });
+    EXPECT_EQ(from_params, "p.yaml: line 1, key '" + p.name + "': " + expected);
+    // Simulate's own check of the value it is handed.
+    parameters.*p.field = value;
+    std::string error;
+    EXPECT_FALSE(parameters.IsValid(&error));
+    EXPECT_EQ(error, expected);
+  }
+  // The bounds the configuration used to check on its own are gone: beta
+  // above the table's 0.1 s and T_p below its 1 N are refused from a file.
+  EXPECT_THAT(ErrorOf([&] {
+                std::string edited = text;
+                edited.replace(edited.find("rayleigh_beta_s: 1.0e-3"), 23, "rayleigh_beta_s: 0.5");
+                ParseConfig(edited, "arm.yaml");
+              }),
+              HasSubstr("parameter 'beta' = 0.5 is outside [0, 0.1] s"));
 }
 
 TEST(Parameters, AssignmentsParseAndBadOnesNameTheProblem) {
@@ -53,26 +98,30 @@ TEST(Parameters, AssignmentsParseAndBadOnesNameTheProblem) {
                         "T_p, T_d0)"));
   EXPECT_THAT(ErrorOf([] { ParseParameterAssignment("mu=0.1x", "--set"); }),
               HasSubstr("value '0.1x' is not a number"));
-  Config c = Paper();
+  ArmParameters c = Paper().parameters;
   EXPECT_THAT(ErrorOf([&] { SetParameter("T_d0", -5, "--set", &c); }),
-              HasSubstr("--set: parameter 'T_d0': -5 is outside [1, 1000] N"));
+              HasSubstr("--set: parameter 'T_d0' = -5 is outside [1, 1000] N"));
   EXPECT_EQ(GetParameter(c, "T_d0"), 100.0);  // unchanged
 }
 
 TEST(Parameters, YamlFileFlatOrTruthStyleWithLineAndKeyInErrors) {
-  Config c = Paper();
+  ArmParameters c = Paper().parameters;
   const auto applied = ApplyParameterYaml("mu: 0.1\nc_sc: 0.2\n", "p.yaml", &c);
   EXPECT_EQ(applied.size(), 2u);
-  EXPECT_EQ(c.arm.driving.friction_kinetic, 0.1);
-  EXPECT_EQ(c.arm.connecting.damping_small_nmsprad, 0.2);
+  EXPECT_EQ(c.mu, 0.1);
+  EXPECT_EQ(c.c_sc, 0.2);
   ApplyParameterYaml("schema: ccsrm-truth/1\nseed: 3\nparameters:\n  T_p: 40\n", "t.yaml", &c);
-  EXPECT_EQ(c.arm.connecting.pretension_n, 40.0);
+  EXPECT_EQ(c.T_p, 40.0);
   EXPECT_THAT(ErrorOf([&] { ApplyParameterYaml("mu: 0.1\nmuu: 0.2\n", "p.yaml", &c); }),
               HasSubstr("p.yaml: line 2, key 'muu': unknown parameter"));
   EXPECT_THAT(ErrorOf([&] { ApplyParameterYaml("parameters:\n  beta: [1]\n", "t.yaml", &c); }),
               HasSubstr("t.yaml: line 2, key 'parameters.beta': expected a number"));
   EXPECT_THAT(ErrorOf([&] { ApplyParameterYaml("mu: 5\n", "p.yaml", &c); }),
-              HasSubstr("p.yaml: line 1, key 'mu': 5 is outside [0, 2]"));
+              HasSubstr("p.yaml: line 1, key 'mu': parameter 'mu' = 5 is outside [0, 2]"));
+  // A bad file changes nothing, not even the values before the bad line.
+  EXPECT_THAT(ErrorOf([&] { ApplyParameterYaml("c_sc: 0.3\nmu: 5\n", "p.yaml", &c); }),
+              HasSubstr("line 2"));
+  EXPECT_EQ(c.c_sc, 0.2);
   EXPECT_THAT(ErrorOf([&] { ApplyParameterYaml("- mu\n", "p.yaml", &c); }),
               HasSubstr("p.yaml: expected a mapping"));
 }

@@ -37,7 +37,7 @@ double PulledIn(const Config& c, int segment, double phi, double theta) {
 
 TEST(KinematicPlanner, InputLengthsMatchClosedFormPathLengthsAtSixDegrees) {
   const Config c = LoadConfig(kPaper);
-  const ArmModel model(c);
+  const ArmModel model(c.arm);
   const double theta = 6.0 * M_PI / 180.0;
   const JointAngles bent(model.num_joints(), Eigen::Vector2d(theta, 0.0));
   const JointAngles straight(model.num_joints(), Eigen::Vector2d::Zero());
@@ -63,7 +63,7 @@ TEST(KinematicPlanner, InputLengthsMatchClosedFormPathLengthsAtSixDegrees) {
 
 TEST(KinematicPlanner, PaperProtocolFollowsTheQuinticAndHolds) {
   Config c = LoadConfig(kPaper);
-  const ArmModel model(c);
+  const ArmModel model(c.arm);
   const JointTrajectory plan = PaperTrajectory(model, c.protocol);
   const double a = c.protocol.amplitude_rad;
   EXPECT_DOUBLE_EQ(plan(0.0)[0][0], 0.0);
@@ -93,7 +93,7 @@ TEST(KinematicPlanner, MirroredAmplitudeMirrorsTheInputs) {
   Config plus = LoadConfig(kPaper);
   Config minus = plus;
   minus.protocol.amplitude_rad = -plus.protocol.amplitude_rad;
-  const ArmModel model_plus(plus), model_minus(minus);
+  const ArmModel model_plus(plus.arm), model_minus(minus.arm);
   const CableInputs a =
       PlanCableInputs(model_plus, PaperTrajectory(model_plus, plus.protocol), 48.0, 0.01);
   const CableInputs b =

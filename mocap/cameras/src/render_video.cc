@@ -48,7 +48,7 @@ double RateOf(const std::vector<double>& time_s, double fallback) {
 MarkerMotion MotionFromRun(const std::string& path, const FrameSelection& selection) {
   const datasets::RunFile run = datasets::ReadRunFile(path);
   const sim::Config config = sim::ParseConfig(run.config_yaml, path + ": config_yaml");
-  const sim::ArmModel model(config);
+  const sim::ArmModel model(config.arm);
   const mocap::MarkerLayout layout = mocap::DefaultMarkerLayout(model);
   const std::size_t links = run.link_pose.shape[1];
   if (static_cast<int>(links) != model.num_links()) {

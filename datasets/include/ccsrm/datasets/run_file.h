@@ -20,9 +20,10 @@ inline constexpr const char* kRunSchema = "ccsrm-run/1";
 
 // How the run ended: a diverging run is a numerical outcome, recorded in the
 // file with the frames written so far (SPEC §3, "Divergence").
-enum class RunStatus { kCompleted, kDiverged };
+enum class RunStatus { kCompleted, kDiverged, kCancelled };
 
-// "completed" / "diverged", the values of the root attribute `status`.
+// "completed" / "diverged" / "cancelled", the values of the root attribute
+// `status`.
 const char* RunStatusName(RunStatus status);
 
 // Per-cable records, stored under /cables/<k> (k = 1..C).

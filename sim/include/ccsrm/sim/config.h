@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "ccsrm/sim/parameters.h"
+
 namespace ccsrm::sim {
 
 // Kind of cable-constrained synchronous rotating mechanism between two
@@ -48,10 +50,6 @@ struct DrivingCableConfig {
   double youngs_modulus_pa = 0.0;
   double cross_section_m2 = 0.0;
   double density_kgpm3 = 0.0;
-  double rayleigh_beta_s = 0.0;
-  double pretension_n = 0.0;      // T_d0
-  double friction_kinetic = 0.0;  // mu
-  double friction_static = 0.0;   // mu'
   double input_offset_m = 0.0;
   std::vector<DrivingCableRoute> cables;
 };
@@ -59,13 +57,11 @@ struct DrivingCableConfig {
 struct ConnectingCableConfig {
   double youngs_modulus_pa = 0.0;
   double cross_section_m2 = 0.0;
-  double pretension_n = 0.0;           // T_p
-  double friction_kinetic = 0.0;       // mu_c
-  double friction_static = 0.0;        // mu'_c
-  double damping_small_nmsprad = 0.0;  // c_sc [N m s/rad]
-  double damping_large_nmsprad = 0.0;  // c_lc [N m s/rad]
 };
 
+// Geometry, inertia and materials: what an ArmModel is built from. The
+// friction, damping and pre-tension of the cables are not here but in
+// ArmParameters, which each run takes on its own.
 struct ArmConfig {
   double joint_disk_gap_m = 0.0;  // d
   Eigen::Vector3d gravity_mps2 = Eigen::Vector3d::Zero();
@@ -78,12 +74,21 @@ struct ArmConfig {
   int segment_of_link(int link) const;
 };
 
+// How a run is integrated (SimulationOptions::solver). The switches that
+// decide which terms the equations have are options here, never implied by
+// a parameter's value, so a fit that reaches a bound of zero keeps the same
+// model.
 struct SolverConfig {
+  // Hole nodes of the driving cables switch between stick and slip (paper
+  // section 2.3). Off: the cables slide through their holes with no
+  // friction at all, whatever mu and mu' are.
+  bool stick_slip = true;
   double baumgarte_alpha_per_s = 100.0;
   double baumgarte_beta_per_s2 = 100.0;
   double smoothing_step_s = 0.01;
   // Extends model smoothing to the large-S conduit friction (see
   // docs/model-notes.md): without it eq. 45's slope makes cases 2 and 4 stiff.
+  // It acts whatever mu_c and mu'_c are (with both at zero it adds nothing).
   bool smooth_connecting_friction = true;
   // Extends model smoothing to the connecting-cable springs and dampers (see
   // docs/model-notes.md): their torsional modes (150-300 Hz against the link
@@ -119,6 +124,8 @@ struct ProtocolConfig {
 
 struct Config {
   ArmConfig arm;
+  ArmParameters
+      parameters;  // their YAML keys sit in the cable sections (ParameterInfo::config_key)
   SolverConfig solver;
   ProtocolConfig protocol;
   std::string source_name;  // file name used in error messages
@@ -137,14 +144,14 @@ Config LoadConfig(const std::string& path);
 // (so a run file's config_yaml reflects any overrides applied in C++).
 std::string ToYaml(const Config& config);
 
-// The friction switches of the paper's four cases (section 6), applied on
-// top of any configuration: 1 no friction; 2 friction on all cables (the
-// configured values); 3 driving cables only; 4 connecting cables only.
-// Throws InputError for a case outside 1..4.
-void ApplyPaperCase(int case_number, Config* config);
-
 // Checks cross-field consistency of a Config built or modified in C++.
 // Throws InputError naming the offending key.
 void Validate(const Config& config);
+
+// The same checks for one part: an arm (ArmModel's constructor), solver
+// settings (Simulate) or a protocol. `source_name` stands for the file in the message.
+void ValidateArm(const ArmConfig& arm, const std::string& source_name);
+void ValidateSolver(const SolverConfig& solver, const std::string& source_name);
+void ValidateProtocol(const ProtocolConfig& protocol, const std::string& source_name);
 
 }  // namespace ccsrm::sim

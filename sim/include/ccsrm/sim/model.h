@@ -1,17 +1,25 @@
 #pragma once
 // The immutable model of an arm (MuJoCo's "model"): geometry, inertia,
-// cable routing and coordinate layout, built once from a Config and shared
-// read-only by any number of runs (each run owns its own data).
+// cable routing, the coordinate layout and the sparsity pattern of its
+// equations with their fill-reducing ordering. Built once from an ArmConfig
+// and shared read-only by any number of runs, in any threads; what a run
+// may change (friction, damping, pre-tension: ArmParameters) is not in it,
+// so changing a parameter never rebuilds the model.
 //
 // Frames and names follow docs/conventions.md: W is the world frame (origin
 // at joint 1, z along the straight arm, x normal to the table), B_i the body
 // frame of link i at its mass centre. p_BH is a hole H in its link's frame.
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "ccsrm/sim/config.h"
 
 namespace ccsrm::sim {
+
+namespace internal {
+class SparseLayout;
+}
 
 struct LinkModel {
   int segment = 0;  // 0-based
@@ -48,17 +56,17 @@ struct ConnectingPairModel {
   int joint_i = 0;
   int joint_j = 0;
   double stiffness_nmprad = 0.0;  // small S: k_sc (eq. 41); large S: E_cA_c r_lc^2/l_lc
-  double damping_nmsprad = 0.0;
-  double pulley_radius_m = 0.0;  // large S: r_lc
-  double wrap_angle_rad = 0.0;   // large S: Theta_lc
+  double cable_length_m = 0.0;    // l_sc or l_lc
+  double pulley_radius_m = 0.0;   // r_sc or r_lc
+  double wrap_angle_rad = 0.0;    // large S: Theta_lc
 };
 
 class ArmModel {
  public:
   // Builds the model. Throws InputError if the configuration is invalid.
-  explicit ArmModel(const Config& config);
+  explicit ArmModel(const ArmConfig& arm);
 
-  const Config& config() const { return config_; }
+  const ArmConfig& arm() const { return arm_; }
   int num_links() const { return static_cast<int>(links_.size()); }
   int num_joints() const { return num_links(); }  // joint i joins link i-1 and link i
   int num_cables() const { return static_cast<int>(cables_.size()); }
@@ -77,14 +85,18 @@ class ArmModel {
   Eigen::Vector3d p_parent_joint(int joint) const;
   Eigen::Vector3d p_child_joint(int joint) const;
 
+  // The sparse system's topology, pattern and ordering (internal to sim).
+  const internal::SparseLayout& sparse_layout() const { return *sparse_layout_; }
+
  private:
-  Config config_;
+  ArmConfig arm_;
   std::vector<LinkModel> links_;
   std::vector<DrivingCableModel> cables_;
   std::vector<ConnectingPairModel> pairs_;
   std::vector<std::vector<int>> node_offsets_;
   std::vector<int> link_offsets_;
   int num_coordinates_ = 0;
+  std::shared_ptr<const internal::SparseLayout> sparse_layout_;  // immutable, shared by copies
 };
 
 }  // namespace ccsrm::sim

@@ -1,22 +1,45 @@
 #pragma once
-// The identifiable parameters of the arm by name (SPEC 6): the names used in
-// YAML, on the command line (`--set name=value`), in truth files and in every
-// JSON output, each mapped onto one field of sim::Config.
+// The identifiable parameters of the arm (SPEC 6), apart from its model: a
+// small value that each run takes, so that identification can change them
+// between runs of one shared ArmModel without rebuilding anything.
+//
+// One table (Parameters()) gives every parameter its name, units, bounds and
+// YAML key; configuration files, `--set`, `--params`, truth files and
+// identification all check values against it with the same message.
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "ccsrm/sim/config.h"
-
 namespace ccsrm::sim {
 
+// Friction, damping and pre-tension. Zero-initialised: fill it from a
+// configuration (Config::parameters) or set every field; Simulate checks it
+// with IsValid. The field names are the SPEC 6 parameter names.
+struct ArmParameters {
+  double mu = 0.0;      // kinetic friction coefficient, driving cable on hole (mu) [1]
+  double mu_s = 0.0;    // static friction coefficient, driving cable on hole (mu') [1]
+  double mu_c = 0.0;    // kinetic friction coefficient, large-S conduit (mu_c) [1]
+  double mu_c_s = 0.0;  // static friction coefficient, large-S conduit (mu'_c) [1]
+  double beta = 0.0;    // Rayleigh damping factor of the driving cables [s]
+  double c_sc = 0.0;    // damping of the small-S mechanisms [N m s/rad]
+  double c_lc = 0.0;    // damping of the large-S mechanisms [N m s/rad]
+  double T_p = 0.0;     // pre-tension of the connecting cables [N]
+  double T_d0 = 0.0;    // pre-tension of the driving cables [N]
+
+  // False (with the table's message in *error) when a value is outside its
+  // bounds or not finite.
+  bool IsValid(std::string* error) const;
+};
+
 struct ParameterInfo {
-  std::string name;        // "mu", "T_d0", ...
-  std::string config_key;  // the YAML key it sets, e.g. "driving_cables.friction_kinetic"
-  std::string units;       // SI units of the value ("1" for a dimensionless one)
-  double lower = 0.0;      // bounds accepted by SetParameter and by identification
+  std::string name;  // "mu", "T_d0", ...
+  std::string
+      config_key;      // its key in a configuration file, e.g. "driving_cables.friction_kinetic"
+  std::string units;   // SI units of the value ("1" for a dimensionless one)
+  double lower = 0.0;  // the bounds every door checks (config, --set, --params, identification)
   double upper = 0.0;
   std::string description;
+  double ArmParameters::*field = nullptr;
 };
 
 // Every named parameter, in SPEC 6 order: mu, mu_s, mu_c, mu_c_s, beta, c_sc,
@@ -27,11 +50,16 @@ const std::vector<ParameterInfo>& Parameters();
 // (known: mu, mu_s, ...)") for a name that is not one of Parameters().
 const ParameterInfo& FindParameter(const std::string& name, const std::string& where);
 
-// Reads / writes the parameter's field of `config`. SetParameter checks the
-// value against the bounds and throws InputError naming `where` and the
-// parameter when it is outside them or not finite.
-double GetParameter(const Config& config, const std::string& name);
-void SetParameter(const std::string& name, double value, const std::string& where, Config* config);
+// "" when `value` is finite and within the parameter's bounds, else the one
+// message every door uses: "parameter 'beta' = 5 is outside [0, 0.1] s".
+std::string ParameterValueProblem(const ParameterInfo& info, double value);
+
+// Reads / writes a parameter by name. SetParameter checks the value against
+// the bounds and throws InputError "<where>: <ParameterValueProblem>" when it
+// is outside them or not finite (the parameters are then unchanged).
+double GetParameter(const ArmParameters& parameters, const std::string& name);
+void SetParameter(const std::string& name, double value, const std::string& where,
+                  ArmParameters* parameters);
 
 // Parses "name=value" (e.g. "mu=0.18"). Throws InputError naming `where`
 // (e.g. "--set") for a missing '=', an unknown name or a value that is not a
@@ -40,12 +68,13 @@ std::pair<std::string, double> ParseParameterAssignment(const std::string& text,
                                                         const std::string& where);
 
 // Applies a YAML mapping of parameter names to numbers (e.g. "mu: 0.18\nT_d0:
-// 80"), as in a `--params truth.yaml` file; `file` names it in errors.
-// Throws InputError "<file>: line N, key 'x': ..." for an unknown name, a
-// value that is not a number or out of bounds, or text that is not a mapping.
-// Returns the assignments in file order.
+// 80"), as in a `--params truth.yaml` file; `file` names it in errors. A truth
+// file's `parameters:` section is read the same way. Throws InputError
+// "<file>: line N, key 'x': ..." for an unknown name, a value that is not a
+// number or out of bounds, or text that is not a mapping. Returns the
+// assignments in file order.
 std::vector<std::pair<std::string, double>> ApplyParameterYaml(const std::string& yaml_text,
                                                                const std::string& file,
-                                                               Config* config);
+                                                               ArmParameters* parameters);
 
 }  // namespace ccsrm::sim

@@ -1,15 +1,23 @@
 #pragma once
-// Forward dynamics of the arm over a protocol: explicit embedded Runge-Kutta
-// 4(5) (GSL odeiv2 rkf45) with step control, stick-slip switches of the
-// driving-cable hole nodes located in time by bisection, and the outputs of
-// SPEC 4 recorded at a fixed rate. Thread-compatible: runs on one ArmModel
-// may go in parallel threads, each with its own Simulate call.
+// Forward dynamics of the arm: Simulate(model, parameters, inputs, options).
+//
+// The run API that identification calls thousands of times. One ArmModel
+// (geometry, topology, sparsity) is shared read-only; each call owns its
+// data and takes its own ArmParameters, so runs may go in parallel threads,
+// and the same call always gives bit-identical results. Inside: an explicit
+// embedded Runge-Kutta 4(5) with step control, the stick-slip switches of
+// the driving-cable hole nodes located in time, and frames sampled at the
+// requested times (sim/src/: integrator, stick_slip, output_sampler).
+#include <Eigen/Core>
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
-#include "ccsrm/datasets/run_file.h"
+#include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
+#include "ccsrm/sim/parameters.h"
 #include "ccsrm/sim/protocol.h"
 
 namespace ccsrm::sim {
@@ -27,17 +35,55 @@ struct SimulationProgress {
 struct SimulationOptions {
   // Simulated time [s]; the run starts at t = 0.
   double duration_s = 48.0;
-  // Written to the run file's `case` attribute: "1".."4" or "custom".
-  std::string case_name = "custom";
+  // Times [s] at which frames are sampled, non-decreasing, in [0,
+  // duration_s] (e.g. an experiment's mocap frame times). Empty: every
+  // 1 / solver.output_rate_hz from 0 to duration_s.
+  std::vector<double> sample_times;
+  // Integration and structure switches; the defaults are those of
+  // configs/paper.yaml's `solver:` section (Config::solver).
+  SolverConfig solver;
+  // Cancellation: the run stops with status kCancelled at the next step
+  // once *cancel is true (may be null), or once it has used
+  // wall_time_budget_s of wall time (0: no budget).
+  const std::atomic<bool>* cancel = nullptr;
+  double wall_time_budget_s = 0.0;
   // Called from the simulating thread; may be empty.
   std::function<void(const SimulationProgress&)> progress;
   double progress_interval_s = 1.0;  // wall seconds between progress calls
 
+  // Checks every field except `solver` (Simulate checks that with
+  // ValidateSolver).
   bool IsValid(std::string* error) const;
 };
 
+// Everything sampled at one instant.
+struct TrajectoryFrame {
+  std::vector<Eigen::Vector2d> joint_angles;            // per joint (θx, θy) [rad]
+  std::vector<Eigen::Vector2d> joint_rates;             // per joint [rad/s]
+  std::vector<Eigen::Matrix<double, 7, 1>> link_pose;   // per link x, y, z [m], e0..e3
+  std::vector<std::vector<double>> element_tension;     // per cable, per element [N]
+  std::vector<std::vector<double>> hole_slip_velocity;  // per cable, per hole [m/s]
+  std::vector<std::vector<int>> hole_stuck;             // per cable, per hole (1 stuck)
+  Eigen::VectorXd input_length_change;                  // per cable, pulled in [m]
+  double constraint_violation = 0.0;                    // |Phi|
+  double kinetic_energy = 0.0;                          // [J]
+  double elastic_energy = 0.0;                          // [J]
+  double dissipated_energy = 0.0;                       // since t = 0 [J]
+};
+
+// The frames of a run at the sample times it reached (all of them when it
+// completed; those up to its end when it diverged or was cancelled).
+struct Trajectory {
+  std::vector<double> time;  // [s]
+  std::vector<TrajectoryFrame> frames;
+  std::size_t size() const { return time.size(); }
+};
+
+enum class SimulationStatus { kCompleted, kDiverged, kCancelled };
+
 struct SimulationSummary {
-  bool completed = false;    // false: diverged (see message)
+  SimulationStatus status = SimulationStatus::kCompleted;
+  bool completed() const { return status == SimulationStatus::kCompleted; }
   std::string message;       // "completed", or the cause with its time
   double simulated_s = 0.0;  // time reached
   double wall_time_s = 0.0;
@@ -46,7 +92,7 @@ struct SimulationSummary {
   std::int64_t rejected_steps = 0;
   std::int64_t rhs_evaluations = 0;
   std::int64_t stick_slip_switches = 0;
-  double max_constraint_violation = 0.0;  // largest |Phi| over the output frames
+  double max_constraint_violation = 0.0;  // largest |Phi| over the sampled frames
 
   // One line; and the one-screen summary of SPEC 3.
   std::string BriefReport() const;
@@ -54,16 +100,17 @@ struct SimulationSummary {
 };
 
 struct SimulationResult {
-  datasets::RunFile run;  // every output frame written so far (also on divergence)
+  Trajectory trajectory;
   SimulationSummary summary;
 };
 
 // Simulates the arm driven by `inputs` from the straight, pre-tensioned
 // state at rest. A divergence (non-finite state, constraint violation above
-// solver.max_constraint_violation, a step below solver.min_step_s) ends the
-// run early with summary.completed = false; it is not thrown.
-// Throws InputError only for invalid options.
-SimulationResult Simulate(const ArmModel& model, const CableInputs& inputs,
-                          const SimulationOptions& options);
+// solver.max_constraint_violation, a step below solver.min_step_s) or a
+// cancellation ends the run early with its status in the summary; it is not
+// thrown. Throws InputError only for invalid parameters or options, or
+// inputs that do not drive every cable of the model.
+SimulationResult Simulate(const ArmModel& model, const ArmParameters& parameters,
+                          const CableInputs& inputs, const SimulationOptions& options);
 
 }  // namespace ccsrm::sim

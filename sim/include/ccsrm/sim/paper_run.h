@@ -1,0 +1,52 @@
+#pragma once
+// The paper's runs (section 6, SPEC 3): a configuration with one of the four
+// friction cases, named parameters and overrides applied, its model, the
+// planned inputs of the protocol and the simulation options; one library
+// call shared by `ccsrm simulate`, `generate`, `bench`, identification and
+// the tests.
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "ccsrm/sim/config.h"
+#include "ccsrm/sim/model.h"
+#include "ccsrm/sim/parameters.h"
+#include "ccsrm/sim/protocol.h"
+#include "ccsrm/sim/simulator.h"
+
+namespace ccsrm::sim {
+
+// The friction switches of the paper's four cases, applied to any
+// parameters: 1 no friction; 2 friction on all cables (as given); 3 driving
+// cables only; 4 connecting cables only. Only parameter values change (the
+// equations keep their terms). Throws InputError for a case outside 1..4.
+void ApplyPaperCase(int case_number, ArmParameters* parameters);
+
+// What a paper run is made of. The fields stand for the command-line
+// options of the same names, and errors name those options.
+struct PaperRunOptions {
+  std::string config_path = "configs/paper.yaml";  // --config
+  int case_number = 0;                             // --case; 0: friction as configured
+  double amplitude_deg = NAN;                      // --amplitude; NaN: protocol.amplitude_deg
+  double output_rate_hz = NAN;                     // --output-rate; NaN: solver.output_rate_hz
+  double duration_s = NAN;                         // --duration; NaN: the whole protocol
+  // Named parameters (SPEC 6), applied after the case: a YAML file
+  // (--params), then name=value assignments (--set).
+  std::string params_path;
+  std::vector<std::string> sets;
+};
+
+struct PaperRun {
+  std::string config_text;  // the configuration file as given
+  Config config;            // with the case, parameters and overrides applied
+  ArmModel model;
+  CableInputs inputs;
+  SimulationOptions simulation;  // duration and solver settings of the run
+  int case_number = 0;           // 0: custom
+};
+
+// Reads the configuration and builds the run. Throws InputError for a bad
+// file or value.
+PaperRun PreparePaperRun(const PaperRunOptions& options);
+
+}  // namespace ccsrm::sim

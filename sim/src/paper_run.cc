@@ -1,0 +1,52 @@
+#include "ccsrm/sim/paper_run.h"
+
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/common/error.h"
+
+namespace ccsrm::sim {
+
+void ApplyPaperCase(int case_number, ArmParameters* parameters) {
+  if (case_number < 1 || case_number > 4) {
+    ThrowInputError("--case", "", "must be 1, 2, 3 or 4, found " + std::to_string(case_number));
+  }
+  const bool driving = case_number == 2 || case_number == 3;
+  const bool connecting = case_number == 2 || case_number == 4;
+  if (!driving) parameters->mu = parameters->mu_s = 0.0;
+  if (!connecting) parameters->mu_c = parameters->mu_c_s = 0.0;
+}
+
+PaperRun PreparePaperRun(const PaperRunOptions& o) {
+  std::string text = ReadTextFile(o.config_path);
+  Config config = ParseConfig(text, o.config_path);
+  if (o.case_number != 0) ApplyPaperCase(o.case_number, &config.parameters);
+  if (!o.params_path.empty()) {
+    ApplyParameterYaml(ReadTextFile(o.params_path), o.params_path, &config.parameters);
+  }
+  for (const std::string& assignment : o.sets) {
+    const auto [name, value] = ParseParameterAssignment(assignment, "--set");
+    SetParameter(name, value, "--set", &config.parameters);
+  }
+  // Overrides are checked with the configuration's own rules, but the
+  // message names the option they came from.
+  if (!std::isnan(o.amplitude_deg)) {
+    config.protocol.amplitude_rad = o.amplitude_deg * M_PI / 180.0;
+    ValidateProtocol(config.protocol, "--amplitude");
+  }
+  if (!std::isnan(o.output_rate_hz)) {
+    config.solver.output_rate_hz = o.output_rate_hz;
+    ValidateSolver(config.solver, "--output-rate");
+  }
+  const double duration = std::isnan(o.duration_s) ? config.protocol.duration_s() : o.duration_s;
+  if (!(duration > 0.0) || !std::isfinite(duration)) {
+    ThrowInputError("--duration", "", "must be > 0 s");
+  }
+  ArmModel model(config.arm);
+  CableInputs inputs = PlanCableInputs(model, PaperTrajectory(model, config.protocol), duration);
+  SimulationOptions simulation;
+  simulation.duration_s = duration;
+  simulation.solver = config.solver;
+  return PaperRun{std::move(text),   std::move(config),     std::move(model),
+                  std::move(inputs), std::move(simulation), o.case_number};
+}
+
+}  // namespace ccsrm::sim
