@@ -73,13 +73,5 @@ TEST(HoleFriction, SlipFrictionIsTheCapstanValue) {
   EXPECT_EQ(HoleSlipFriction(-5.0, mu, theta, 1e-3), 0.0);
 }
 
-TEST(HoleFriction, StickFrictionCancelsTensionDifferenceUpToLimit) {
-  const double f_max = LimitingStaticFriction(100.0, 90.0, 0.21, 0.4);
-  EXPECT_NEAR(HoleStickFriction(100.0, 98.0, f_max), -2.0, 1e-12);
-  EXPECT_NEAR(HoleStickFriction(98.0, 100.0, f_max), 2.0, 1e-12);
-  EXPECT_NEAR(HoleStickFriction(200.0, 90.0, f_max), -f_max, 1e-12);
-  EXPECT_EQ(HoleStickFriction(50.0, 50.0, f_max), 0.0);
-}
-
 }  // namespace
 }  // namespace ccsrm::sim::internal

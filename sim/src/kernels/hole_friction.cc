@@ -32,10 +32,4 @@ double HoleSlipFriction(double tension_before, double mu, double wrap_angle, dou
   return t_b * std::expm1(-mu * wrap_angle * sigma);
 }
 
-double HoleStickFriction(double tension_before, double tension_after, double f_max) {
-  const double diff = tension_before - tension_after;
-  const double magnitude = std::min(std::abs(diff), f_max);
-  return diff > 0.0 ? -magnitude : (diff < 0.0 ? magnitude : 0.0);
-}
-
 }  // namespace ccsrm::sim::internal

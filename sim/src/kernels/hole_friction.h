@@ -41,14 +41,11 @@ double LimitingStaticFriction(double tension_1, double tension_2, double mu_stat
 // sigma = -1: F = T_b (e^{mu theta} - 1), the capstan value.
 // F * s_i_dot <= 0 always (friction dissipates); F = 0 when s_i_dot == 0.
 // The caller decides stick or slip (velocity tolerance v_eps, trial and
-// error); this function does not look at the magnitude of s_i_dot.
+// error); this function does not look at the magnitude of s_i_dot. The
+// static branch of eq. 9 has no kernel: a stuck node is held by the
+// constraint s = s* whose reaction is checked against f_max
+// (docs/model-notes.md, row 3).
 // Preconditions: mu >= 0, theta >= 0.
 double HoleSlipFriction(double tension_before, double mu, double wrap_angle, double s_dot);
-
-// Static-friction branch of eq. 9 (v_tau = 0) in force form, right-hand-side
-// signed: F = -min(|T_b - T_a|, f_max) sgn(T_b - T_a). The net elastic pull of
-// the two elements on s_i is about T_b - T_a, so a stuck node sees friction
-// that cancels it up to the limit f_max. Precondition: f_max >= 0.
-double HoleStickFriction(double tension_before, double tension_after, double f_max);
 
 }  // namespace ccsrm::sim::internal
