@@ -40,6 +40,30 @@ void BM_RightHandSide(benchmark::State& state) {
 }
 BENCHMARK(BM_RightHandSide)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
 
+// What a parameter change costs: building the model (routing, layout,
+// sparsity pattern and its AMD ordering) happens once; each run only sets up
+// its own data over it (kernel parameters, initial state, numeric
+// workspace and the symbolic analysis of the fixed pattern).
+void BM_ArmModelBuild(benchmark::State& state) {
+  const Config config = PaperCase(2);
+  for (auto _ : state) benchmark::DoNotOptimize(ArmModel(config.arm).num_coordinates());
+}
+BENCHMARK(BM_ArmModelBuild)->Unit(benchmark::kMillisecond);
+
+void BM_RunSetUp(benchmark::State& state) {
+  const Config config = PaperCase(2);
+  const ArmModel model(config.arm);
+  const CableInputs inputs =
+      PlanCableInputs(model, PaperTrajectory(model, config.protocol), 48.0, 1e-2);
+  ArmParameters parameters = config.parameters;
+  for (auto _ : state) {
+    parameters.mu *= 1.0000001;  // a new parameter set each run
+    internal::ArmDynamics dynamics(model, parameters, inputs, config.solver);
+    benchmark::DoNotOptimize(dynamics.state_size());
+  }
+}
+BENCHMARK(BM_RunSetUp)->Unit(benchmark::kMillisecond);
+
 void BM_AleElement(benchmark::State& state) {
   internal::AleElementParams p{7850.0 * 1.3273e-6, 2.6e10 * 1.3273e-6, 1e-3, 0.01};
   internal::Vector8d q, qd;
