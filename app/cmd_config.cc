@@ -39,8 +39,9 @@ void RunConfigCheck(const std::string& path) {
     parameters += item;
   }
   std::printf("  parameters: %s\n", parameters.c_str());
-  std::printf("  structure: stick-slip %s, connecting friction smoothing %s\n",
-              c.solver.stick_slip ? "on" : "off",
+  static const char* const kHoleFriction[] = {"events", "smoothed", "off"};
+  std::printf("  structure: hole friction %s, connecting friction smoothing %s\n",
+              kHoleFriction[static_cast<int>(c.solver.hole_friction)],
               c.solver.smooth_connecting_friction ? "on" : "off");
   std::printf("  protocol: amplitude %.4g deg over %.4g s; solver: h = %.4g s, output %.4g Hz\n",
               c.protocol.amplitude_rad * 180.0 / 3.14159265358979323846, c.protocol.duration_s(),

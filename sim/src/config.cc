@@ -17,6 +17,8 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegToRad = kPi / 180.0;
 constexpr const char* kSchema = "ccsrm-config/1";
+// The YAML words of HoleFrictionModel, in its order.
+const std::vector<std::string> kHoleFrictionWords = {"events", "smoothed", "off"};
 
 // Line (1-based) of every key path seen while parsing, so that Validate can
 // name the line of a value that is out of range.
@@ -61,6 +63,17 @@ class MapReader {
 
   double Number(const std::string& key) { return AsNumber(Require(key), Join(key)); }
 
+  // A key added after ccsrm-config/1 was first published: files written
+  // before it leave it out and mean `fallback`.
+  double OptionalNumber(const std::string& key, double fallback) {
+    if (!node_[key].IsDefined()) {
+      read_.insert(key);
+      allowed_.push_back(key);
+      return fallback;
+    }
+    return Number(key);
+  }
+
   int Integer(const std::string& key) {
     const YAML::Node node = Require(key);
     const double value = AsNumber(node, Join(key));
@@ -79,14 +92,20 @@ class MapReader {
   }
 
   // A key added after ccsrm-config/1 was first published: files written
-  // before it leave it out and get `fallback`.
-  bool OptionalBoolean(const std::string& key, bool fallback) {
-    if (!node_[key].IsDefined()) {
-      read_.insert(key);
-      allowed_.push_back(key);
-      return fallback;
+  // before it leave it out and get `fallback`; else one of `choices`.
+  int OptionalWord(const std::string& key, const std::vector<std::string>& choices, int fallback) {
+    read_.insert(key);
+    allowed_.push_back(key);
+    const YAML::Node node = node_[key];
+    if (!node.IsDefined()) return fallback;
+    Record(Join(key), node);
+    const std::string word = node.IsScalar() ? node.Scalar() : std::string();
+    for (std::size_t i = 0; i < choices.size(); ++i) {
+      if (word == choices[i]) return static_cast<int>(i);
     }
-    return Boolean(key);
+    std::string list;
+    for (const auto& c : choices) list += (list.empty() ? "'" : ", '") + c + "'";
+    Fail(Join(key), node, "expected one of " + list + ", found '" + word + "'");
   }
 
   std::string String(const std::string& key) {
@@ -214,9 +233,10 @@ class MapReader {
 void ReadParameters(MapReader& section, ArmParameters* parameters) {
   const std::string prefix = section.path() + ".";
   for (const ParameterInfo& p : Parameters()) {
-    if (p.config_key.rfind(prefix, 0) == 0) {
-      parameters->*p.field = section.Number(p.config_key.substr(prefix.size()));
-    }
+    if (p.config_key.rfind(prefix, 0) != 0) continue;
+    const std::string key = p.config_key.substr(prefix.size());
+    parameters->*p.field = std::isnan(p.absent_value) ? section.Number(key)
+                                                      : section.OptionalNumber(key, p.absent_value);
   }
 }
 
@@ -311,6 +331,11 @@ void CheckSolver(const SolverConfig& s, const Checker& check) {
   check.NonNegative("solver.baumgarte_alpha_per_s", s.baumgarte_alpha_per_s);
   check.NonNegative("solver.baumgarte_beta_per_s2", s.baumgarte_beta_per_s2);
   check.NonNegative("solver.smoothing_step_s", s.smoothing_step_s);
+  if (s.hole_friction == HoleFrictionModel::kSmoothed && !(s.smoothing_step_s > 0.0)) {
+    // The stick band's slope, T mu' theta / v_eps ~ 1e6 N s/m against a
+    // node mass of 1e-4 kg, is integrable explicitly only when smoothed.
+    check.Fail("solver.hole_friction", "smoothed needs solver.smoothing_step_s > 0");
+  }
   check.Positive("solver.stick_velocity_tolerance_mps", s.stick_velocity_tolerance_mps);
   check.Positive("solver.stick_force_tolerance_n", s.stick_force_tolerance_n);
   check.Positive("solver.large_s_static_velocity_mps", s.large_s_static_velocity_mps);
@@ -449,7 +474,8 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
   {
     MapReader s = top.Section("solver");
     SolverConfig& sc = c.solver;
-    sc.stick_slip = s.OptionalBoolean("stick_slip", true);
+    sc.hole_friction =
+        static_cast<HoleFrictionModel>(s.OptionalWord("hole_friction", kHoleFrictionWords, 0));
     sc.baumgarte_alpha_per_s = s.Number("baumgarte_alpha_per_s");
     sc.baumgarte_beta_per_s2 = s.Number("baumgarte_beta_per_s2");
     sc.smoothing_step_s = s.Number("smoothing_step_s");
@@ -564,7 +590,8 @@ std::string ToYaml(const Config& c) {
 
   const SolverConfig& s = c.solver;
   out << YAML::Key << "solver" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "stick_slip" << YAML::Value << s.stick_slip;
+  out << YAML::Key << "hole_friction" << YAML::Value
+      << kHoleFrictionWords[static_cast<int>(s.hole_friction)];
   out << YAML::Key << "baumgarte_alpha_per_s" << YAML::Value << s.baumgarte_alpha_per_s;
   out << YAML::Key << "baumgarte_beta_per_s2" << YAML::Value << s.baumgarte_beta_per_s2;
   out << YAML::Key << "smoothing_step_s" << YAML::Value << s.smoothing_step_s;

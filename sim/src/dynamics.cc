@@ -210,12 +210,20 @@ bool ArmDynamics::AddCableElements(const double* q, const double* qd) {
   return true;
 }
 
-// Capstan friction on the material coordinate of every slipping hole node
-// (eqs. 9, 11), and for every node the wrap angle (eq. 12) and limiting
-// static friction (eq. 10) the stick-slip switches test. A stuck node's
-// friction is its stick constraint's reaction, known after the solve.
+// Capstan friction on the material coordinate of the hole nodes (eqs. 9,
+// 11) with the Stribeck coefficient of HoleFrictionCoefficient, and for
+// every node the wrap angle (eq. 12) and limiting static friction (eq. 10).
+// kEvents: on every slipping node; a stuck node's friction is its stick
+// constraint's reaction, known after the solve. kSmoothed: one smooth law
+// of the slip speed on every node, whose slope is smoothed over h like the
+// elastic forces (eqs. 14-16): the moment sees the slip speed averaged over
+// the step, v + (h/2) v_dot, which adds -(h/2) dF/dv to the node's mass.
 void ArmDynamics::AddHoleFriction(const double* q, const double* qd) {
   const std::vector<HoleNodeRef>& holes = layout_.holes();
+  const HoleFrictionLaw law{parameters_.mu, parameters_.mu_s, parameters_.v_s,
+                            solver_.stick_velocity_tolerance_mps};
+  double* values = system_.values();
+  hole_smoothing_power_.clear();
   for (std::size_t h = 0; h < holes.size(); ++h) {
     const HoleNodeRef& hole = holes[h];
     const int o = model_.node_offset(hole.cable, hole.node);
@@ -229,6 +237,21 @@ void ArmDynamics::AddHoleFriction(const double* q, const double* qd) {
     report.friction_limit =
         LimitingStaticFriction(t_before, t_after, parameters_.mu_s, report.wrap_angle);
     report.required_friction = 0.0;
+    const double v = qd[o + 3];
+    if (solver_.hole_friction == HoleFrictionModel::kSmoothed) {
+      const HoleFrictionForce f = SmoothedHoleFriction(law, t_before, report.wrap_angle, v);
+      report.required_friction = f.force;
+      force_[o + 3] += f.force;
+      dissipation_ -= f.force * v;
+      // Only a falling force (dF/dv < 0) is smoothed: where the Stribeck
+      // transition makes it rise, a negative added mass would be unphysical.
+      const double added_mass = -0.5 * solver_.smoothing_step_s * std::min(0.0, f.slope);
+      if (added_mass > 0.0) {
+        values[layout_.hole_material_diagonal(static_cast<int>(h))] += added_mass;
+        hole_smoothing_power_.push_back({o + 3, added_mass * v});
+      }
+      continue;
+    }
     // Where even the static limit is below the force tolerance (a cable
     // running nearly straight through the hole) friction is negligible and
     // left out, so that its direction need not follow a slip speed that
@@ -236,9 +259,10 @@ void ArmDynamics::AddHoleFriction(const double* q, const double* qd) {
     const bool negligible = report.friction_limit < solver_.stick_force_tolerance_n;
     if (!has_stick_slip() || modes_[h] == HoleMode::kStuck || negligible) continue;
     const double sigma = modes_[h] == HoleMode::kSlipUp ? 1.0 : -1.0;
-    const double f = HoleSlipFriction(t_before, parameters_.mu, report.wrap_angle, sigma);
+    const double mu = HoleFrictionCoefficient(law, v, nullptr);
+    const double f = HoleSlipFriction(t_before, mu, report.wrap_angle, sigma);
     force_[o + 3] += f;
-    dissipation_ -= f * qd[o + 3];
+    dissipation_ -= f * v;
   }
 }
 
@@ -460,6 +484,7 @@ bool ArmDynamics::FinishDerivative(const double* qd, double* ydot) {
     for (int k = 0; k < power.count; ++k)
       dissipation_ += power.weights[k] * solution[power.cols[k]];
   }
+  for (const auto& [col, weight] : hole_smoothing_power_) dissipation_ += weight * solution[col];
   ydot[2 * n_] = dissipation_;
 
   // Friction a stuck node needs: the reaction of its constraint, -lambda.
@@ -633,7 +658,11 @@ void ArmDynamics::Observe(double t, const double* y, TrajectoryFrame* out, bool 
   for (std::size_t h = 0; h < holes.size(); ++h) {
     const int c = holes[h].cable;
     out->hole_slip_velocity[c].push_back(reports_[h].s_dot);
-    out->hole_stuck[c].push_back(modes_[h] == HoleMode::kStuck ? 1 : 0);
+    // Smoothed: stuck is creeping inside the stick band, the SPEC's definition.
+    const bool stuck = solver_.hole_friction == HoleFrictionModel::kSmoothed
+                           ? std::abs(reports_[h].s_dot) < solver_.stick_velocity_tolerance_mps
+                           : modes_[h] == HoleMode::kStuck;
+    out->hole_stuck[c].push_back(stuck ? 1 : 0);
   }
   out->input_length_change.resize(model_.num_cables());
   for (int c = 0; c < model_.num_cables(); ++c) {

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ccsrm/sim/config.h"
@@ -20,6 +21,7 @@
 #include "ccsrm/sim/simulator.h"
 #include "kernels/ale_element.h"
 #include "kernels/connecting.h"
+#include "kernels/hole_friction.h"
 #include "sparse_system.h"
 
 namespace ccsrm::sim::internal {
@@ -56,9 +58,9 @@ class ArmDynamics {
   bool Evaluate(double t, const double* y, double* ydot);
   const std::string& failure() const { return failure_; }
 
-  // Hole nodes switch between stick and slip (SolverConfig::stick_slip);
-  // otherwise every node slips without friction.
-  bool has_stick_slip() const { return solver_.stick_slip; }
+  // Hole nodes switch between stick and slip by events (kEvents); otherwise
+  // every node's friction is a function of its state (kSmoothed, kOff).
+  bool has_stick_slip() const { return solver_.hole_friction == HoleFrictionModel::kEvents; }
   const std::vector<HoleNodeRef>& holes() const { return layout_.holes(); }
   std::vector<HoleMode>& hole_modes() { return modes_; }
   std::vector<double>& stuck_position() { return stuck_s_; }
@@ -156,6 +158,8 @@ class ArmDynamics {
     int count = 0;
   };
   std::vector<SmoothingPower> smoothing_power_;
+  // The same for the smoothed hole friction: (s column, added mass * s_dot).
+  std::vector<std::pair<int, double>> hole_smoothing_power_;
 };
 
 }  // namespace ccsrm::sim::internal

@@ -70,6 +70,11 @@ const std::vector<ParameterInfo>& Parameters() {
        "pre-tension of the connecting cables", &P::T_p},
       {"T_d0", "driving_cables.pretension_n", "N", 1.0, 1000.0, "pre-tension of the driving cables",
        &P::T_d0},
+      // 0 is the paper's law (mu' drops to mu at once); 0.1 m/s is well
+      // above any slip speed of the arm (inputs move at ~1 mm/s).
+      {"v_s", "driving_cables.stribeck_velocity_mps", "m/s", 0.0, 0.1,
+       "Stribeck velocity of the holes: the static coefficient falls to the kinetic one over it",
+       &P::v_s, 0.0},
   };
   return parameters;
 }

@@ -164,6 +164,10 @@ SparseLayout::SparseLayout(const ArmModel& model) : n_(model.num_coordinates()) 
         row_pair_index_.push_back(Index(row.cols[a], row.cols[b]));
     row_diag_index_.push_back(Index(n_ + r, n_ + r));
   }
+  for (const HoleNodeRef& h : holes_) {
+    const int s = model.node_offset(h.cable, h.node) + 3;
+    hole_index_.push_back(Index(s, s));
+  }
 }
 
 int SparseLayout::Index(int model_row, int model_col) const {

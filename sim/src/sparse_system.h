@@ -61,6 +61,8 @@ class SparseLayout {
   const int* row_coupling(int r) const { return &row_kkt_index_[row_kkt_offset_[r]]; }
   const int* row_block(int r) const { return &row_pair_index_[row_pair_offset_[r]]; }
   int row_diagonal(int r) const { return row_diag_index_[r]; }
+  // The (s, s) entry of hole node h (its material coordinate).
+  int hole_material_diagonal(int h) const { return hole_index_[h]; }
 
   // The pattern with zero values, stored in the fill-reducing (AMD) order,
   // and the position of model unknown k in that order.
@@ -83,6 +85,7 @@ class SparseLayout {
   std::vector<int> row_kkt_index_, row_kkt_offset_;
   std::vector<int> row_pair_index_, row_pair_offset_;
   std::vector<int> row_diag_index_;
+  std::vector<int> hole_index_;
 };
 
 // One run's augmented system over a shared layout. The matrix is stored

@@ -59,7 +59,8 @@ TEST(Config, PaperConfigurationHoldsTable1) {
   EXPECT_DOUBLE_EQ(c.arm.driving.youngs_modulus_pa, 2.6e10);
   EXPECT_DOUBLE_EQ(c.parameters.T_p, 50.0);
   EXPECT_DOUBLE_EQ(c.parameters.mu_s, 0.21);
-  EXPECT_TRUE(c.solver.stick_slip);
+  EXPECT_EQ(c.solver.hole_friction, HoleFrictionModel::kEvents);
+  EXPECT_DOUBLE_EQ(c.parameters.v_s, 1e-3);
   EXPECT_DOUBLE_EQ(c.solver.smoothing_step_s, 0.01);
   EXPECT_DOUBLE_EQ(c.protocol.duration_s(), 48.0);
   EXPECT_EQ(c.arm.segment_of_link(6), 0);
@@ -119,13 +120,22 @@ TEST(Config, YamlRoundTripKeepsEveryValue) {
   EXPECT_EQ(b.arm.driving.cables[5].hole_angle_rad, a.arm.driving.cables[5].hole_angle_rad);
 }
 
-TEST(Config, FileWithoutTheStickSlipSwitchKeepsItOn) {
-  // `solver.stick_slip` came after ccsrm-config/1 was first published; a
-  // run file's config_yaml from before it still parses.
-  const Config c = ParseConfig(Edited("  stick_slip: true\n", ""), "old.yaml");
-  EXPECT_TRUE(c.solver.stick_slip);
-  EXPECT_FALSE(
-      ParseConfig(Edited("stick_slip: true", "stick_slip: false"), "off.yaml").solver.stick_slip);
+TEST(Config, KeysAddedLaterMayBeLeftOutAndMeanThePapersLaw) {
+  // `solver.hole_friction` and `driving_cables.stribeck_velocity_mps` came
+  // after ccsrm-config/1 was first published; a run file's config_yaml from
+  // before them still parses, with the paper's trial and error and no
+  // Stribeck transition.
+  std::string old = Edited("  hole_friction: events\n", "");
+  old.replace(old.find("  stribeck_velocity_mps: 1.0e-3\n"), 32, "");
+  const Config c = ParseConfig(old, "old.yaml");
+  EXPECT_EQ(c.solver.hole_friction, HoleFrictionModel::kEvents);
+  EXPECT_EQ(c.parameters.v_s, 0.0);
+  EXPECT_EQ(ParseConfig(Edited("hole_friction: events", "hole_friction: smoothed"), "s.yaml")
+                .solver.hole_friction,
+            HoleFrictionModel::kSmoothed);
+  EXPECT_THAT(ErrorOf(Edited("hole_friction: events", "hole_friction: sticky")),
+              HasSubstr("key 'solver.hole_friction': expected one of 'events', 'smoothed', 'off', "
+                        "found 'sticky'"));
 }
 
 TEST(Config, ValidateRejectsConfigBuiltInCode) {

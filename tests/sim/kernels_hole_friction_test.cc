@@ -73,5 +73,70 @@ TEST(HoleFriction, SlipFrictionIsTheCapstanValue) {
   EXPECT_EQ(HoleSlipFriction(-5.0, mu, theta, 1e-3), 0.0);
 }
 
+TEST(HoleFriction, StribeckCoefficientFallsFromStaticToKineticContinuously) {
+  const HoleFrictionLaw law{0.21, 0.25, 1e-3, 1e-6};
+  // The static value through the stick band and at its edge; the kinetic
+  // value far beyond; in between a monotone, continuous fall.
+  EXPECT_EQ(HoleFrictionCoefficient(law, 0.0, nullptr), 0.25);
+  EXPECT_EQ(HoleFrictionCoefficient(law, -1e-6, nullptr), 0.25);
+  EXPECT_NEAR(HoleFrictionCoefficient(law, 1e-6 + 1e-12, nullptr), 0.25, 1e-9);
+  EXPECT_NEAR(HoleFrictionCoefficient(law, 0.05, nullptr), 0.21, 1e-12);
+  // One Stribeck velocity past the band: e^-1 of the excess is left.
+  EXPECT_NEAR(HoleFrictionCoefficient(law, 1e-6 + 1e-3, nullptr), 0.21 + 0.04 / M_E, 1e-12);
+  double previous = 0.25;
+  for (double v = 1e-6; v < 5e-3; v += 1e-5) {
+    const double mu = HoleFrictionCoefficient(law, v, nullptr);
+    EXPECT_LE(mu, previous + 1e-15);
+    EXPECT_LT(previous - mu, 1e-3) << "jump at " << v;  // 1e-5 m/s steps: no jumps
+    previous = mu;
+  }
+  // The analytic slope against central differences.
+  for (double v : {3e-4, 1e-3, 2.5e-3, -1.7e-3}) {
+    double slope = 0.0;
+    HoleFrictionCoefficient(law, v, &slope);
+    const double dv = 1e-8;
+    const double fd = (HoleFrictionCoefficient(law, std::abs(v) + dv, nullptr) -
+                       HoleFrictionCoefficient(law, std::abs(v) - dv, nullptr)) /
+                      (2.0 * dv);
+    EXPECT_NEAR(slope, fd, 1e-6 * std::abs(fd) + 1e-9) << v;
+  }
+  // With mu = mu' the law is the paper's whatever v_s is; with v_s = 0 the
+  // coefficient drops to mu at once beyond the band.
+  EXPECT_EQ(HoleFrictionCoefficient({0.21, 0.21, 1e-3, 1e-6}, 5e-4, nullptr), 0.21);
+  EXPECT_EQ(HoleFrictionCoefficient({0.21, 0.25, 0.0, 1e-6}, 2e-6, nullptr), 0.21);
+}
+
+TEST(HoleFriction, SmoothedFrictionIsTheCapstanValueBeyondTheStickBandAndDissipates) {
+  const HoleFrictionLaw law{0.21, 0.25, 1e-3, 1e-6};
+  const double theta = 0.4, t_b = 80.0;
+  // Beyond the band it is eq. 9 with the Stribeck coefficient.
+  for (double v : {5e-6, 4e-4, 2e-3, -3e-5, -1e-2}) {
+    const double mu = HoleFrictionCoefficient(law, v, nullptr);
+    EXPECT_NEAR(SmoothedHoleFriction(law, t_b, theta, v).force, HoleSlipFriction(t_b, mu, theta, v),
+                1e-12)
+        << v;
+  }
+  // Zero at rest, odd in sign, dissipative, and its slope is the derivative.
+  EXPECT_EQ(SmoothedHoleFriction(law, t_b, theta, 0.0).force, 0.0);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> t(-20.0, 200.0), th(0.0, kPi), v(-3e-3, 3e-3);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const double s_dot = v(rng), tension = t(rng), angle = th(rng);
+    const HoleFrictionForce f = SmoothedHoleFriction(law, tension, angle, s_dot);
+    EXPECT_LE(f.force * s_dot, 0.0);
+    const double dv = 1e-10;
+    const double fd = (SmoothedHoleFriction(law, tension, angle, s_dot + dv).force -
+                       SmoothedHoleFriction(law, tension, angle, s_dot - dv).force) /
+                      (2.0 * dv);
+    // Skip the band's edges, where the slope is only continuous (C1 law).
+    if (std::abs(std::abs(s_dot) - 1e-6) < 1e-9) continue;
+    EXPECT_NEAR(f.slope, fd, 1e-5 * std::abs(fd) + 1e-3) << s_dot;
+  }
+  // Inside the stick band a node holds up to the static capstan value: at
+  // the band's edge the force reaches T_b expm1(-mu' theta).
+  EXPECT_NEAR(SmoothedHoleFriction(law, t_b, theta, 1e-6).force, t_b * std::expm1(-0.25 * theta),
+              1e-12);
+}
+
 }  // namespace
 }  // namespace ccsrm::sim::internal

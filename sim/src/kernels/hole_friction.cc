@@ -32,4 +32,37 @@ double HoleSlipFriction(double tension_before, double mu, double wrap_angle, dou
   return t_b * std::expm1(-mu * wrap_angle * sigma);
 }
 
+double HoleFrictionCoefficient(const HoleFrictionLaw& law, double speed, double* slope) {
+  const double beyond = std::abs(speed) - law.stick_velocity_mps;
+  const double excess = law.mu_static - law.mu_kinetic;
+  if (slope != nullptr) *slope = 0.0;
+  if (beyond <= 0.0 || excess == 0.0) return beyond <= 0.0 ? law.mu_static : law.mu_kinetic;
+  if (!(law.stribeck_velocity_mps > 0.0)) return law.mu_kinetic;
+  const double x = beyond / law.stribeck_velocity_mps;
+  const double decay = std::exp(-x * x);
+  if (slope != nullptr) *slope = -2.0 * x * excess * decay / law.stribeck_velocity_mps;
+  return law.mu_kinetic + excess * decay;
+}
+
+HoleFrictionForce SmoothedHoleFriction(const HoleFrictionLaw& law, double tension_before,
+                                       double wrap_angle, double s_dot) {
+  HoleFrictionForce out;
+  const double t_b = std::max(0.0, tension_before);
+  if (t_b == 0.0 || wrap_angle == 0.0) return out;
+  const double u = s_dot / law.stick_velocity_mps;
+  double r = u > 0.0 ? 1.0 : -1.0, dr_dv = 0.0;
+  if (std::abs(u) < 1.0) {
+    r = 1.5 * u - 0.5 * u * u * u;
+    dr_dv = 1.5 * (1.0 - u * u) / law.stick_velocity_mps;
+  }
+  double dmu_dspeed = 0.0;
+  const double mu = HoleFrictionCoefficient(law, s_dot, &dmu_dspeed);
+  const double exponent = -mu * wrap_angle * r;
+  out.force = t_b * std::expm1(exponent);
+  // d|v|/dv = sgn(v); r sgn(v) = |r|.
+  const double dexponent_dv = -wrap_angle * (dmu_dspeed * std::abs(r) + mu * dr_dv);
+  out.slope = t_b * std::exp(exponent) * dexponent_dv;
+  return out;
+}
+
 }  // namespace ccsrm::sim::internal

@@ -48,4 +48,38 @@ double LimitingStaticFriction(double tension_1, double tension_2, double mu_stat
 // Preconditions: mu >= 0, theta >= 0.
 double HoleSlipFriction(double tension_before, double mu, double wrap_angle, double s_dot);
 
+// The friction law of a hole beyond eq. 9's two coefficients: real friction
+// does not drop from static to kinetic in zero time (docs/model-notes.md,
+// "Stribeck transition"). Within the stick band |v| <= v_eps the
+// coefficient is mu'; beyond it, it falls to mu over the Stribeck velocity:
+//   mu(|v|) = mu + (mu' - mu) exp(-((|v| - v_eps) / v_s)^2).
+// With mu = mu' it is the paper's law whatever v_s is; with v_s = 0 it drops
+// to mu at once beyond v_eps (the paper's force form of eq. 9).
+struct HoleFrictionLaw {
+  double mu_kinetic = 0.0;             // mu
+  double mu_static = 0.0;              // mu'
+  double stribeck_velocity_mps = 0.0;  // v_s >= 0
+  double stick_velocity_mps = 0.0;     // v_eps > 0
+};
+
+// mu(|v|) of the law above [1]; *slope (may be null) is d mu / d|v| [s/m].
+double HoleFrictionCoefficient(const HoleFrictionLaw& law, double speed, double* slope);
+
+// Friction on s_i as one smooth function of the slip speed v = s_i_dot, for
+// the smoothed treatment of stick-slip (docs/model-notes.md): the capstan
+// force of eq. 9 with the coefficient mu(|v|) and the direction sgn(v)
+// replaced by r(v), which rises from 0 to +-1 across the stick band,
+// r = 1.5 u - 0.5 u^3 for u = v / v_eps in [-1, 1] (C1 at the band's edges):
+//   F = T_b expm1(-mu(|v|) theta r(v)).
+// A node loaded below its static limit so creeps at |v| < v_eps, the SPEC's
+// definition of stuck; beyond the band it is eq. 9 with the Stribeck
+// coefficient. `slope` is dF/dv [N s/m], for model smoothing.
+// Preconditions: law.stick_velocity_mps > 0, theta >= 0.
+struct HoleFrictionForce {
+  double force = 0.0;  // F [N], right-hand-side signed, F v <= 0
+  double slope = 0.0;  // dF/dv [N s/m]
+};
+HoleFrictionForce SmoothedHoleFriction(const HoleFrictionLaw& law, double tension_before,
+                                       double wrap_angle, double s_dot);
+
 }  // namespace ccsrm::sim::internal

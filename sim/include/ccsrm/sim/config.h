@@ -12,6 +12,15 @@
 
 namespace ccsrm::sim {
 
+// How the driving cables' hole nodes stick and slip (docs/model-notes.md):
+//  kEvents:   the paper's trial and error: a stuck node is held by a
+//             constraint, switches are events located in time;
+//  kSmoothed: one smooth friction law of the slip speed (stick band v_eps,
+//             Stribeck transition), with model smoothing of its slope: no
+//             events, so the output is smooth in every parameter;
+//  kOff:      no friction in the holes, whatever mu and mu' are.
+enum class HoleFrictionModel { kEvents, kSmoothed, kOff };
+
 // Kind of cable-constrained synchronous rotating mechanism between two
 // adjacent joints of a segment.
 enum class ConnectingKind { kSmallS, kLargeS };
@@ -79,10 +88,8 @@ struct ArmConfig {
 // a parameter's value, so a fit that reaches a bound of zero keeps the same
 // model.
 struct SolverConfig {
-  // Hole nodes of the driving cables switch between stick and slip (paper
-  // section 2.3). Off: the cables slide through their holes with no
-  // friction at all, whatever mu and mu' are.
-  bool stick_slip = true;
+  // YAML `hole_friction: events | smoothed | off`.
+  HoleFrictionModel hole_friction = HoleFrictionModel::kEvents;
   double baumgarte_alpha_per_s = 100.0;
   double baumgarte_beta_per_s2 = 100.0;
   double smoothing_step_s = 0.01;

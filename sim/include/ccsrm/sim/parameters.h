@@ -6,6 +6,7 @@
 // One table (Parameters()) gives every parameter its name, units, bounds and
 // YAML key; configuration files, `--set`, `--params`, truth files and
 // identification all check values against it with the same message.
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -25,6 +26,7 @@ struct ArmParameters {
   double c_lc = 0.0;    // damping of the large-S mechanisms [N m s/rad]
   double T_p = 0.0;     // pre-tension of the connecting cables [N]
   double T_d0 = 0.0;    // pre-tension of the driving cables [N]
+  double v_s = 0.0;     // Stribeck velocity of the holes: mu' falls to mu over it [m/s]
 
   // False (with the table's message in *error) when a value is outside its
   // bounds or not finite.
@@ -40,10 +42,13 @@ struct ParameterInfo {
   double upper = 0.0;
   std::string description;
   double ArmParameters::*field = nullptr;
+  // What a configuration file written before the parameter existed means
+  // by leaving it out (the paper's law); NaN: the key is required.
+  double absent_value = std::numeric_limits<double>::quiet_NaN();
 };
 
-// Every named parameter, in SPEC 6 order: mu, mu_s, mu_c, mu_c_s, beta, c_sc,
-// c_lc, T_p, T_d0.
+// Every named parameter: SPEC 6's nine in its order (mu, mu_s, mu_c,
+// mu_c_s, beta, c_sc, c_lc, T_p, T_d0), then v_s.
 const std::vector<ParameterInfo>& Parameters();
 
 // The entry of `name`. Throws InputError("<where>: unknown parameter 'x'
