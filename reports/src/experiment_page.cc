@@ -457,6 +457,7 @@ Document BuildExperimentDocument(const ExperimentFile& experiment, const std::st
                                  const ReportOptions& options) {
   std::string why;
   if (!options.IsValid(&why)) ThrowInputError("report options", "", why);
+  datasets::ValidateExperimentFile(experiment, source);
   const bool measured = experiment.measured_joint_angles.has_value();
   const std::size_t joints = measured ? experiment.measured_joint_angles->shape[1] : 0;
   const std::size_t cables = experiment.input_length_change.shape[1];

@@ -124,9 +124,12 @@ void WriteAxis(const char* name, const Axis& axis, std::ostream& gp) {
   gp << "set " << name << "range [" << (axis.min ? Number(*axis.min) : "*") << ':'
      << (axis.max ? Number(*axis.max) : "*") << "]\n";
   if (axis.log_scale) {
-    gp << "set logscale " << name << " 10\nset format " << name << " \"%.0e\"\n";
+    // No minor tics: over ten decades they merge into a solid bar.
+    gp << "set logscale " << name << " 10\nset format " << name << " \"%.0e\"\nset m" << name
+       << "tics 1\n";
   } else {
-    gp << "unset logscale " << name << "\nset format " << name << " \"%g\"\n";
+    gp << "unset logscale " << name << "\nset format " << name << " \"%g\"\nset m" << name
+       << "tics default\n";
   }
   if (axis.tics.empty()) {
     gp << "set " << name << "tics autofreq norotate\n";
@@ -164,6 +167,8 @@ void WriteScript(const Figure& figure, const PlotOptions& options, const std::st
   gp << "set grid back lc rgb \"#d9d9d9\" lw 1 dt 1\n";
   gp << "set border 3 lc rgb \"#555555\"\nset tics nomirror out\n";
   gp << "set style fill solid 0.85 noborder\n";
+  // An autoscaled x axis ends at the data (a 48 s run ends at 48 s, not 50).
+  gp << "set autoscale xfix\n";
   gp << "set lmargin 11\nset tmargin 2.5\n";
   gp << "set multiplot layout " << rows << ',' << figure.columns << '\n';
   int index = 0;
@@ -175,7 +180,9 @@ void WriteScript(const Figure& figure, const PlotOptions& options, const std::st
     if (panel.x.rotate_tics) {
       for (const auto& tic : panel.x.tics) longest_tic = std::max(longest_tic, tic.second.size());
     }
-    gp << "set bmargin " << Number(3.5 + 0.8 * static_cast<double>(longest_tic)) << '\n';
+    const double legend_below = panel.legend == LegendPlace::kBelow ? 1.8 : 0.0;
+    gp << "set bmargin " << Number(3.5 + legend_below + 0.8 * static_cast<double>(longest_tic))
+       << '\n';
     WriteAxis("x", panel.x, gp);
     WriteAxis("y", panel.y, gp);
     switch (panel.legend) {

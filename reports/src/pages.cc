@@ -92,10 +92,13 @@ Figure CableFigure(const std::string& name, const std::vector<double>& time,
                    SeriesStyle style) {
   Figure figure;
   figure.name = name;
-  // Two segments side by side (the page is wide enough), else stacked.
-  if (segments.size() == 2) {
+  // Two segments side by side (the page is wide enough), their legends
+  // below so the plots keep their width; else stacked.
+  const bool side_by_side = segments.size() == 2;
+  if (side_by_side) {
     figure.columns = 2;
     figure.panel_width_px = 640;
+    figure.panel_height_px = 320;
   } else {
     figure.panel_width_px = 1100;
   }
@@ -115,6 +118,7 @@ Figure CableFigure(const std::string& name, const std::vector<double>& time,
       s.style = style;
       panel.series.push_back(std::move(s));
     }
+    if (side_by_side) panel.legend = LegendPlace::kBelow;
     figure.panels.push_back(std::move(panel));
   }
   return figure;

@@ -123,10 +123,11 @@ Table JointAnglesAtInstants(const RunFile& run, const ArmFacts& facts,
   table.columns = {{"joint", "joint", "", NumberFormat::Integer()},
                    {"segment", "segment", "", NumberFormat::Integer()}};
   for (const Instant& instant : instants) {
-    // Four significant digits: 6.012 deg at the end of a ramp, and the
-    // 1e-5 deg of θy in a short run, which fixed decimals would show as 0.
-    table.columns.push_back({key + "_deg_" + Slug(instant.label), InstantHeader(instant), "deg",
-                             NumberFormat::Significant(4)});
+    // θx to 0.001 deg (the scale of the paper's figures); θy, which stays
+    // small, to 3 significant digits so 1e-5 deg does not show as 0.
+    table.columns.push_back(
+        {key + "_deg_" + Slug(instant.label), InstantHeader(instant), "deg",
+         component == 0 ? NumberFormat::Fixed(3) : NumberFormat::Significant(3)});
   }
   const std::size_t joints = run.joint_angles.shape[1];
   const std::size_t c = static_cast<std::size_t>(component);
@@ -303,7 +304,7 @@ Section InputSection(const RunFile& run, const ArmFacts& facts,
                             SeriesStyle::kLine),
       "Prescribed inputs",
       "Length of each driving cable pulled in at its input (/input_length_change; positive = "
-      "pulled), planned by kinematics for the paper's protocol.",
+      "pulled), as prescribed to the simulation.",
       ""});
   Table table;
   table.id = "input_tension";
@@ -335,10 +336,12 @@ Section InputSection(const RunFile& run, const ArmFacts& facts,
 Section StickSlipSection(const RunFile& run, const ArmFacts& facts,
                          const std::vector<Instant>& instants) {
   Section section{"stick-slip", "Stick–slip", {}};
+  // Counts start at 0; half a count of air keeps a cable at 0 off the axis.
+  Axis stuck_axis{"stuck hole nodes", "1"};
+  stuck_axis.min = -0.5;
   section.blocks.push_back(FigureBlock{
-      internal::CableFigure("stuck_nodes", run.time.values, run.stuck_nodes, 1.0,
-                            Axis{"stuck hole nodes", "1"}, facts.segments, facts.cable_segment,
-                            SeriesStyle::kSteps),
+      internal::CableFigure("stuck_nodes", run.time.values, run.stuck_nodes, 1.0, stuck_axis,
+                            facts.segments, facts.cable_segment, SeriesStyle::kSteps),
       "Stuck hole nodes",
       "Number of hole nodes of each driving cable held by static friction (/stuck_nodes). "
       "Flat stretches at a cable's hole count mean the whole cable sticks.",
@@ -394,14 +397,17 @@ Section CableTensionSection(const RunFile& run, const std::vector<Instant>& inst
       s.style = SeriesStyle::kLinePoints;
       panel.series.push_back(std::move(s));
     }
+    // One legend for all six panels (same instants, same colours), inside
+    // the first, so every panel keeps the same plot width.
+    panel.legend = k == 0 ? LegendPlace::kInside : LegendPlace::kNone;
     figure.panels.push_back(std::move(panel));
   }
   section.blocks.push_back(FigureBlock{
       std::move(figure), "Element tensions at the instants",
       "Tension of every element of each driving cable (/cables/<k>/tension) at the instants of "
-      "the summary. Element 1 runs from the input point to the ground-disk hole, element e "
-      "ends at hole e; capstan friction makes the tension step at each hole, and where a "
-      "stretch of holes sticks the tension stays as it was.",
+      "the summary (colours in the legend of cable 1). Element 1 runs from the input point to "
+      "the ground-disk hole, element e ends at hole e. Without friction the tension is the same "
+      "all along a cable; friction at the holes makes it change from element to element.",
       ""});
   return section;
 }
@@ -469,8 +475,8 @@ Document BuildRunDocument(const RunFile& run, const std::string& source,
                           const ReportOptions& options) {
   std::string why;
   if (!options.IsValid(&why)) ThrowInputError("report options", "", why);
+  datasets::ValidateRunFile(run, source);
   const std::vector<double>& time = run.time.values;
-  CCSRM_CHECK(!time.empty() && run.joint_angles.rank() == 3 && run.input_tension.rank() == 2);
   const bool paper_case = PaperCaseFriction(run.case_name) != nullptr;
   const ArmFacts facts = internal::ReadArmFacts(
       run.config_yaml, source + ": attribute 'config_yaml'", run.joint_angles.shape[1],

@@ -20,10 +20,10 @@ using ::testing::HasSubstr;
 
 constexpr double kDeg = 180.0 / M_PI;
 
-// A value as a table shows it with 4 significant digits, or 3 decimals.
-double Sig4(double x) {
+// A value as a table shows it with 3 significant digits, or 3 decimals.
+double Sig3(double x) {
   char text[32];
-  std::snprintf(text, sizeof(text), "%.4g", x);
+  std::snprintf(text, sizeof(text), "%.3g", x);
   return std::stod(text);
 }
 double Fixed3(double x) { return std::round(x * 1000) / 1000; }
@@ -117,11 +117,11 @@ TEST(RunPage, KnownRunShowsItsStoredNumbers) {
   // Joint 7 at the end: 0.28 rad; the plan row: 6° · quintic(2 s / 20 s).
   const nlohmann::json joint7 = Row(json, "theta_x_at_instants", "joint", 7);
   EXPECT_EQ(joint7["segment"], 2);
-  EXPECT_EQ(joint7["theta_x_deg_end_of_run"], Sig4(0.28 * kDeg));
+  EXPECT_EQ(joint7["theta_x_deg_end_of_run"], Fixed3(0.28 * kDeg));
   const nlohmann::json plan = Row(json, "theta_x_at_instants", "joint", "plan");
-  EXPECT_EQ(plan["theta_x_deg_end_of_run"], Sig4(6.0 * sim::QuinticBlend(0.1)));
+  EXPECT_EQ(plan["theta_x_deg_end_of_run"], Fixed3(6.0 * sim::QuinticBlend(0.1)));
   EXPECT_EQ(Row(json, "theta_y_at_instants", "joint", 1)["theta_y_deg_mid_run"],
-            Sig4(-0.002 * kDeg));
+            Sig3(-0.002 * kDeg));
 
   const nlohmann::json cable2 = Row(json, "input_tension", "cable", 2);
   EXPECT_EQ(cable2["segment"], 1);

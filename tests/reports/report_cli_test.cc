@@ -140,12 +140,12 @@ TEST(ReportCli, RunReportIsCompleteAndAgreesWithItsJson) {
   // The planned θx at the end of the 2 s run: 6° · quintic(2 / 20).
   const nlohmann::json plan = RowOf(r.summary, "theta_x_at_instants", "joint", "plan");
   EXPECT_NEAR(plan["theta_x_deg_end_of_run"].get<double>(), 6.0 * ccsrm::sim::QuinticBlend(0.1),
-              5e-5);
+              5e-4);
   // Joint 1 at the end, as stored in /joint_angles.
   const double theta = run.joint_angles.at(run.frames() - 1, 0, 0) * 180.0 / M_PI;
   EXPECT_NEAR(
       RowOf(r.summary, "theta_x_at_instants", "joint", 1)["theta_x_deg_end_of_run"].get<double>(),
-      theta, 5e-4 * std::abs(theta));
+      theta, 5e-4);
 }
 
 TEST(ReportCli, ExperimentReportShowsTheStoredQualityFigures) {

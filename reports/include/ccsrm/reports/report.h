@@ -50,16 +50,17 @@ struct ReportSummary {
   std::string FullReport() const;
 };
 
-// The page of a simulation run (`source` names it on the page). Uses
-// sim::ParseConfig on run.config_yaml for the arm's segments and, for a
-// paper case, the planned motion. Draws nothing: the figures are described,
-// WriteReport renders them. Throws InputError for invalid options.
+// The page of a simulation run (`source` names it on the page and in
+// messages). Uses sim::ParseConfig on run.config_yaml for the arm's segments
+// and, for a paper case, the planned motion. Draws nothing: the figures are
+// described, WriteReport renders them. Throws InputError for invalid options
+// or an inconsistent record (datasets::ValidateRunFile).
 Document BuildRunDocument(const datasets::RunFile& run, const std::string& source,
                           const ReportOptions& options);
 
 // The page of an experiment: marker visibility and gaps, the mocap quality
 // figures, measured joint angles, inputs. Throws InputError for invalid
-// options.
+// options or an inconsistent record (datasets::ValidateExperimentFile).
 Document BuildExperimentDocument(const datasets::ExperimentFile& experiment,
                                  const std::string& source, const ReportOptions& options);
 
