@@ -1,14 +1,17 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages ccsrm needs, only those that are missing.
 # Idempotent: on a machine that has everything it prints one line and exits 0.
+# gnuplot-nox draws the reports' figures (in DejaVu Sans); chromium renders
+# them headless for the report screenshot test, which skips without it.
 set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config clang
   libeigen3-dev libceres-dev libsuitesparse-dev libopencv-dev libhdf5-dev libgsl-dev
-  libyaml-cpp-dev libcli11-dev nlohmann-json3-dev gnuplot-nox
+  libyaml-cpp-dev libcli11-dev nlohmann-json3-dev gnuplot-nox fonts-dejavu-core
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-h5py python3-numpy
+  chromium
 )
 
 missing=()

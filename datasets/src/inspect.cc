@@ -102,9 +102,7 @@ void SummariseExperiment(const ExperimentFile& experiment, FileSummary* summary)
 
 const char* FileKindName(FileKind kind) { return kind == FileKind::kRun ? "run" : "experiment"; }
 
-FileSummary InspectFile(const std::string& path) {
-  FileSummary summary;
-  summary.file = path;
+AnyFile ReadAnyFile(const std::string& path) {
   std::string schema;
   {
     internal::Hdf5Session session;
@@ -116,18 +114,29 @@ FileSummary InspectFile(const std::string& path) {
     schema = reader.ReadStringAttribute("schema");
   }
   const std::string kind = schema.substr(0, schema.find('/'));
-  if (kind == "ccsrm-run") {
-    summary.kind = FileKind::kRun;
-    SummariseRun(ReadRunFile(path), &summary);
-  } else if (kind == "ccsrm-dataset") {
-    summary.kind = FileKind::kExperiment;
-    SummariseExperiment(ReadExperimentFile(path), &summary);
+  if (kind == "ccsrm-run") return ReadRunFile(path);
+  if (kind == "ccsrm-dataset") return ReadExperimentFile(path);
+  ThrowInputError(
+      path, "attribute 'schema' is '" + schema + "'",
+      std::string("not a ccsrm file (expected ") + kRunSchema + " or " + kExperimentSchema + ")");
+}
+
+FileKind KindOf(const AnyFile& file) {
+  return std::holds_alternative<RunFile>(file) ? FileKind::kRun : FileKind::kExperiment;
+}
+
+FileSummary InspectFile(const std::string& path) {
+  FileSummary summary;
+  summary.file = path;
+  const AnyFile file = ReadAnyFile(path);
+  summary.kind = KindOf(file);
+  if (const RunFile* run = std::get_if<RunFile>(&file)) {
+    summary.schema = kRunSchema;
+    SummariseRun(*run, &summary);
   } else {
-    ThrowInputError(
-        path, "attribute 'schema' is '" + schema + "'",
-        std::string("not a ccsrm file (expected ") + kRunSchema + " or " + kExperimentSchema + ")");
+    summary.schema = kExperimentSchema;
+    SummariseExperiment(std::get<ExperimentFile>(file), &summary);
   }
-  summary.schema = schema;
   return summary;
 }
 

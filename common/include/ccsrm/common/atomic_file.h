@@ -30,6 +30,40 @@ class AtomicOutputFile {
   bool committed_ = false;
 };
 
+// Builds an output folder atomically: the writer fills temp_path(), a new
+// folder beside the target ("<target>.tmp-<pid>-<n>"), then Commit() puts it
+// in place of the target in one step. If Commit() is never called the
+// destructor removes the temporary folder, so the target is either untouched
+// or complete, never half overwritten.
+//
+// An existing target folder is replaced as a whole: Commit() swaps the two
+// folders with renameat2(RENAME_EXCHANGE) and then removes the old one. The
+// caller decides whether an existing folder may be replaced (e.g. only an
+// earlier output of the same command).
+class AtomicOutputDirectory {
+ public:
+  // Creates the temporary folder. Throws InputError when the target's parent
+  // folder does not exist, when the target exists and is not a folder, or when
+  // the temporary folder cannot be created.
+  explicit AtomicOutputDirectory(std::string target_path);
+  ~AtomicOutputDirectory();
+  AtomicOutputDirectory(const AtomicOutputDirectory&) = delete;
+  AtomicOutputDirectory& operator=(const AtomicOutputDirectory&) = delete;
+
+  const std::string& temp_path() const { return temp_path_; }
+  const std::string& target_path() const { return target_path_; }
+
+  // Moves the temporary folder onto the target (replacing an existing target
+  // folder, whose old content is then removed). Throws InputError on failure;
+  // the target is then left as it was.
+  void Commit();
+
+ private:
+  std::string target_path_;
+  std::string temp_path_;
+  bool committed_ = false;
+};
+
 // Writes text to path atomically (temporary file, then rename).
 void WriteTextFileAtomically(const std::string& path, const std::string& text);
 

@@ -4,9 +4,13 @@
 #include <cstddef>
 #include <string>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include "ccsrm/datasets/experiment_file.h"
+#include "ccsrm/datasets/run_file.h"
 
 namespace ccsrm::datasets {
 
@@ -44,8 +48,19 @@ struct FileSummary {
 // "run" / "experiment".
 const char* FileKindName(FileKind kind);
 
-// Detects the kind from the root `schema` attribute, validates the whole file
-// with ReadRunFile / ReadExperimentFile and summarises it.
+// A ccsrm file of either kind, read and validated once.
+using AnyFile = std::variant<RunFile, ExperimentFile>;
+
+// Detects the kind from the root `schema` attribute and reads the file with
+// ReadRunFile or ReadExperimentFile, for commands that take either kind.
+// Throws InputError (one line naming the file) for a missing file, a file
+// that is not HDF5, or a schema of neither kind.
+AnyFile ReadAnyFile(const std::string& path);
+
+// The kind of a file ReadAnyFile returned.
+FileKind KindOf(const AnyFile& file);
+
+// Reads the file with ReadAnyFile and summarises it.
 // Throws InputError (one line naming the file) for a missing or bad file.
 FileSummary InspectFile(const std::string& path);
 

@@ -1,0 +1,86 @@
+#pragma once
+// Reports of ccsrm's files (SPEC 8): `ccsrm report --in FILE --out DIR`
+// writes DIR/index.html (a self-contained page: tables, a short text summary
+// and gnuplot figures in DIR/figures/) and DIR/summary.json (every number the
+// page shows).
+//
+// A report reads what the commands wrote and never recomputes a figure they
+// already give: a run page shows the run file's stored solver statistics, an
+// experiment page the quality figures `ccsrm mocap process` stored under
+// /mocap/quality. What a report does compute from the arrays (values at an
+// instant, a largest or smallest value) says so in its table's caption.
+#include <string>
+#include <vector>
+
+#include "ccsrm/datasets/experiment_file.h"
+#include "ccsrm/datasets/run_file.h"
+#include "ccsrm/reports/document.h"
+#include "ccsrm/reports/figure.h"
+
+namespace ccsrm::reports {
+
+struct ReportOptions {
+  // How figures are drawn: the gnuplot program (default "gnuplot" on PATH)
+  // and the image format (default PNG).
+  PlotOptions plot;
+  // Instants [s] at which a run page tabulates joint angles, input tensions,
+  // stuck nodes and energy, and draws the tension along each cable. Empty
+  // (the default): for a paper-case run, the protocol's end of ramp,
+  // mid-hold and end of return that lie within the run, then its last frame
+  // (with the middle of the run added when that leaves fewer than two);
+  // otherwise the middle and the end of the run. Each instant is shown at the
+  // nearest frame. At most 6, each finite.
+  std::vector<double> instants_s;
+
+  bool IsValid(std::string* error) const;
+};
+
+struct ReportSummary {
+  std::string input;   // the file reported on
+  std::string output;  // the report folder
+  std::string kind;    // "run" or "experiment"
+  std::string title;
+  int figures = 0;
+  int tables = 0;
+  std::vector<std::string> notices;  // what the page says is missing
+  double wall_time_s = 0.0;          // time taken to make the report
+
+  // One line; and a few lines with the files written and the notices.
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+// The page of a simulation run (`source` names it on the page and in
+// messages). Uses sim::ParseConfig on run.config_yaml for the arm's segments
+// and, for a paper case, the planned motion. Draws nothing: the figures are
+// described, WriteReport renders them. Throws InputError for invalid options
+// or an inconsistent record (datasets::ValidateRunFile).
+Document BuildRunDocument(const datasets::RunFile& run, const std::string& source,
+                          const ReportOptions& options);
+
+// The page of an experiment: marker visibility and gaps, the mocap quality
+// figures, measured joint angles, inputs. Throws InputError for invalid
+// options or an inconsistent record (datasets::ValidateExperimentFile).
+Document BuildExperimentDocument(const datasets::ExperimentFile& experiment,
+                                 const std::string& source, const ReportOptions& options);
+
+// Renders every figure of `document` with gnuplot into <folder>/figures,
+// then writes <folder>/index.html and <folder>/summary.json, all inside a
+// temporary folder beside the target that replaces it only when complete
+// (common/AtomicOutputDirectory): an existing report is never half
+// overwritten. Sets each FigureBlock::file.
+// Throws InputError when `folder` exists and is neither empty nor an earlier
+// ccsrm report (a summary.json with schema ccsrm-report/1), or is a file, or
+// its parent does not exist; PlotError when gnuplot is missing or fails.
+void WriteReport(Document* document, const std::string& folder, const ReportOptions& options);
+
+// What `ccsrm report` does: checks the options, that gnuplot is there and
+// that the output may be written (as WriteReport; and the input must not lie
+// inside it), reads `input` once (a ccsrm-run/1 or ccsrm-dataset/1 file),
+// builds its page and writes it. Throws InputError naming the path for a
+// missing input, a folder, or a file of another kind; PlotError as
+// WriteReport.
+ReportSummary MakeReport(const std::string& input, const std::string& output_folder,
+                         const ReportOptions& options);
+
+}  // namespace ccsrm::reports

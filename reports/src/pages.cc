@@ -1,0 +1,147 @@
+#include "pages.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "ccsrm/common/error.h"
+
+namespace ccsrm::reports::internal {
+
+std::size_t NearestFrame(const std::vector<double>& time, double t) {
+  CCSRM_CHECK(!time.empty());
+  const auto after = std::lower_bound(time.begin(), time.end(), t);
+  if (after == time.begin()) return 0;
+  if (after == time.end()) return time.size() - 1;
+  const std::size_t i = static_cast<std::size_t>(after - time.begin());
+  return (time[i] - t) < (t - time[i - 1]) ? i : i - 1;
+}
+
+std::vector<double> ColumnOf(const datasets::Array& array, std::size_t k, double scale) {
+  std::vector<double> out(array.rows());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = array.at(i, k) * scale;
+  return out;
+}
+
+std::vector<double> ComponentOf(const datasets::Array& array, std::size_t k, std::size_t c,
+                                double scale) {
+  std::vector<double> out(array.rows());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = array.at(i, k, c) * scale;
+  return out;
+}
+
+Axis TimeAxis() { return Axis{"time", "s"}; }
+
+std::string FormatSeconds(double t) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.6g", t);
+  return text;
+}
+
+Figure JointAngleFigure(const std::string& name, const std::vector<double>& time,
+                        const datasets::Array& angles, int component,
+                        const std::vector<JointGroup>& segments,
+                        const std::optional<datasets::Array>& plan) {
+  Figure figure;
+  figure.name = name;
+  figure.panel_width_px = 1100;  // the whole width of the page: time detail matters
+  const std::size_t c = static_cast<std::size_t>(component);
+  for (const JointGroup& group : segments) {
+    Panel panel;
+    panel.title = group.title;
+    panel.x = TimeAxis();
+    panel.y = Axis{component == 0 ? "θx" : "θy", "deg"};
+    for (int k = 1; k <= group.joints; ++k) {
+      const std::size_t j = static_cast<std::size_t>(group.first_joint + k - 2);
+      Series s;
+      s.label = "joint " + std::to_string(j + 1);
+      s.x = time;
+      s.y = ComponentOf(angles, j, c, kDegPerRad);
+      s.color = palette::Indexed(k);
+      panel.series.push_back(std::move(s));
+    }
+    if (plan) {
+      // The paper's protocol plans the same angle for every joint: then one
+      // dashed line says it; otherwise one per joint.
+      const std::size_t j0 = static_cast<std::size_t>(group.first_joint - 1);
+      bool same = true;
+      for (std::size_t i = 0; i < plan->rows() && same; ++i) {
+        for (int k = 1; k < group.joints; ++k) {
+          if (std::abs(plan->at(i, j0 + k, c) - plan->at(i, j0, c)) > 1e-12) same = false;
+        }
+      }
+      for (int k = 0; k < (same ? 1 : group.joints); ++k) {
+        Series s;
+        s.label = k == 0 ? "plan" : "";
+        s.x = time;
+        s.y = ComponentOf(*plan, j0 + k, c, kDegPerRad);
+        s.color = palette::kPlan;
+        s.style = SeriesStyle::kDashed;
+        s.line_width = 1.2;
+        panel.series.push_back(std::move(s));
+      }
+    }
+    figure.panels.push_back(std::move(panel));
+  }
+  return figure;
+}
+
+Figure CableFigure(const std::string& name, const std::vector<double>& time,
+                   const datasets::Array& values, double scale, const Axis& y,
+                   const std::vector<JointGroup>& segments, const std::vector<int>& cable_segment,
+                   SeriesStyle style) {
+  Figure figure;
+  figure.name = name;
+  // Two segments side by side (the page is wide enough), their legends
+  // below so the plots keep their width; else stacked.
+  const bool side_by_side = segments.size() == 2;
+  if (side_by_side) {
+    figure.columns = 2;
+    figure.panel_width_px = 640;
+    figure.panel_height_px = 320;
+  } else {
+    figure.panel_width_px = 1100;
+  }
+  for (std::size_t g = 0; g < segments.size(); ++g) {
+    Panel panel;
+    panel.title =
+        segments.size() == 1 ? "Driving cables" : "Cables driving segment " + std::to_string(g + 1);
+    panel.x = TimeAxis();
+    panel.y = y;
+    for (std::size_t k = 0; k < cable_segment.size(); ++k) {
+      if (cable_segment[k] != static_cast<int>(g)) continue;
+      Series s;
+      s.label = "cable " + std::to_string(k + 1);
+      s.x = time;
+      s.y = ColumnOf(values, k, scale);
+      s.color = palette::Indexed(static_cast<int>(k) + 1);
+      s.style = style;
+      panel.series.push_back(std::move(s));
+    }
+    if (side_by_side) panel.legend = LegendPlace::kBelow;
+    figure.panels.push_back(std::move(panel));
+  }
+  return figure;
+}
+
+Table KeyValueTable(const std::string& id, const std::string& title, const std::string& caption) {
+  Table table;
+  table.id = id;
+  table.title = title;
+  table.caption = caption;
+  table.columns = {{"quantity", "quantity", "", NumberFormat::Significant(4)},
+                   {"value", "value", "", NumberFormat::Significant(4)},
+                   {"unit", "unit", "", NumberFormat::Significant(4)}};
+  return table;
+}
+
+void AddValue(Table* table, const std::string& quantity, double value, const std::string& unit,
+              NumberFormat format) {
+  table->AddRow({Cell::Text(quantity), Cell::Number(value, format), Cell::Text(unit)});
+}
+
+void AddText(Table* table, const std::string& quantity, const std::string& text) {
+  table->AddRow({Cell::Text(quantity), Cell::Text(text), Cell::Text("")});
+}
+
+}  // namespace ccsrm::reports::internal

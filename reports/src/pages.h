@@ -1,0 +1,63 @@
+#pragma once
+// Building blocks shared by the run and experiment pages, so that the same
+// quantity is drawn and tabulated the same way on every page.
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "arm_facts.h"
+#include "ccsrm/datasets/array.h"
+#include "ccsrm/reports/document.h"
+#include "ccsrm/reports/figure.h"
+
+namespace ccsrm::reports::internal {
+
+inline constexpr double kDegPerRad = 57.29577951308232;  // 180 / π
+
+// A moment of a run at which values are tabulated.
+struct Instant {
+  std::string label;    // e.g. "end of ramp"
+  double time_s = 0.0;  // time of the frame shown, s
+  std::size_t frame = 0;
+};
+
+// The frame whose time is nearest to t (time strictly increasing, not empty).
+std::size_t NearestFrame(const std::vector<double>& time, double t);
+
+// Column k of a T × N array, times `scale`.
+std::vector<double> ColumnOf(const datasets::Array& array, std::size_t k, double scale = 1.0);
+// Component c of item k of a T × N × 2 (or × 3, ...) array, times `scale`.
+std::vector<double> ComponentOf(const datasets::Array& array, std::size_t k, std::size_t c,
+                                double scale = 1.0);
+
+// Joint angles in degrees against time, one panel per segment, joints as
+// coloured lines (joint k of a segment in palette::Indexed(k)), the plan
+// (when given, T × J × 2 rad on the same time base) as dashed black lines:
+// the layout of the paper's Figs. 16 and 18–21. `component` 0 = θx, 1 = θy.
+Figure JointAngleFigure(const std::string& name, const std::vector<double>& time,
+                        const datasets::Array& angles, int component,
+                        const std::vector<JointGroup>& segments,
+                        const std::optional<datasets::Array>& plan);
+
+// One panel per segment of per-cable values against time (cable k in
+// palette::Indexed(k)); `values` is T × C.
+Figure CableFigure(const std::string& name, const std::vector<double>& time,
+                   const datasets::Array& values, double scale, const Axis& y,
+                   const std::vector<JointGroup>& segments, const std::vector<int>& cable_segment,
+                   SeriesStyle style);
+
+// The time axis every page uses.
+Axis TimeAxis();
+
+// "1–6" style joint lists and small text helpers.
+std::string FormatSeconds(double t);
+
+// A key-value table (quantity, value, unit), the shape of every summary
+// table: one row per quantity, each with its own number format.
+Table KeyValueTable(const std::string& id, const std::string& title, const std::string& caption);
+void AddValue(Table* table, const std::string& quantity, double value, const std::string& unit,
+              NumberFormat format);
+void AddText(Table* table, const std::string& quantity, const std::string& text);
+
+}  // namespace ccsrm::reports::internal

@@ -1,0 +1,179 @@
+#include "ccsrm/reports/report.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <variant>
+
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/common/clock.h"
+#include "ccsrm/common/error.h"
+#include "ccsrm/datasets/inspect.h"
+
+namespace ccsrm::reports {
+namespace {
+
+namespace fs = std::filesystem;
+
+// An existing output folder is replaced only when it is empty or an earlier
+// report: `--out` pointing at a folder of other files must not wipe them.
+// "report/" and "report" name the same folder.
+fs::path FolderPath(const std::string& folder) {
+  fs::path path = fs::path(folder).lexically_normal();
+  if (!path.has_filename() && path.has_parent_path()) path = path.parent_path();
+  return path;
+}
+
+void CheckOutputFolder(const std::string& folder) {
+  std::error_code ec;
+  const fs::path parent = FolderPath(folder).parent_path();
+  if (!parent.empty() && !fs::is_directory(parent, ec)) {
+    ThrowInputError(folder, "", "output directory '" + parent.string() + "' does not exist");
+  }
+  if (!fs::exists(folder, ec)) return;
+  if (!fs::is_directory(folder, ec)) ThrowInputError(folder, "", "exists and is not a folder");
+  if (fs::is_empty(folder, ec)) return;
+  const fs::path summary = fs::path(folder) / "summary.json";
+  bool is_report = false;
+  if (fs::is_regular_file(summary, ec)) {
+    std::ifstream in(summary);
+    const nlohmann::json json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    is_report = json.is_object() && json.value("schema", "") == kReportSchema;
+  }
+  if (!is_report) {
+    ThrowInputError(folder, "",
+                    std::string("exists and is not a ccsrm report (no summary.json with schema ") +
+                        kReportSchema + "); refusing to replace it: choose a new folder");
+  }
+}
+
+// True when `path` lies inside `folder` (both may not exist yet).
+bool IsInside(const std::string& path, const std::string& folder) {
+  std::error_code ec;
+  const fs::path p = fs::weakly_canonical(path, ec);
+  const fs::path f = fs::weakly_canonical(folder, ec);
+  auto pi = p.begin();
+  for (auto fi = f.begin(); fi != f.end(); ++fi, ++pi) {
+    if (fi->empty()) continue;  // a trailing separator
+    if (pi == p.end() || *pi != *fi) return false;
+  }
+  return true;
+}
+
+std::string Count(int n, const std::string& noun) {
+  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
+}
+
+void WriteFile(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  out.flush();
+  if (!out) ThrowInputError(path.string(), "", "cannot write");
+}
+
+}  // namespace
+
+bool ReportOptions::IsValid(std::string* error) const {
+  if (!plot.IsValid(error)) return false;
+  if (instants_s.size() > 6) {
+    if (error) *error = "at most 6 instants";
+    return false;
+  }
+  for (double t : instants_s) {
+    if (!std::isfinite(t)) {
+      if (error) *error = "instants must be finite times in s";
+      return false;
+    }
+  }
+  return true;
+}
+
+std::string ReportSummary::BriefReport() const {
+  return "report of " + kind + " " + input + " in " + output + "/ (" + Count(figures, "figure") +
+         ", " + Count(tables, "table") +
+         (notices.empty() ? "" : ", " + Count(static_cast<int>(notices.size()), "notice")) + ")";
+}
+
+std::string ReportSummary::FullReport() const {
+  std::ostringstream out;
+  char seconds[32];
+  std::snprintf(seconds, sizeof(seconds), "%.2f", wall_time_s);
+  out << "report: " << title << "\n"
+      << "  input:    " << input << " (" << kind << ")\n"
+      << "  page:     " << (fs::path(output) / "index.html").string() << "\n"
+      << "  numbers:  " << (fs::path(output) / "summary.json").string() << " ("
+      << Count(tables, "table") << ")\n"
+      << "  figures:  " << figures << " in " << (fs::path(output) / "figures").string() << "\n"
+      << "  time:     " << seconds << " s\n";
+  for (const std::string& notice : notices) out << "  note: " << notice << "\n";
+  return out.str();
+}
+
+void WriteReport(Document* document, const std::string& folder, const ReportOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) ThrowInputError("report options", "", why);
+  CheckOutputFolder(folder);
+  FindGnuplot(options.plot);
+  if (document->created.empty()) document->created = UtcTimestamp();
+
+  AtomicOutputDirectory out(folder);
+  const fs::path figures = fs::path(out.temp_path()) / "figures";
+  fs::create_directory(figures);
+  std::set<std::string> names;
+  for (Section& section : document->sections) {
+    for (Block& block : section.blocks) {
+      auto* figure = std::get_if<FigureBlock>(&block);
+      if (figure == nullptr) continue;
+      CCSRM_CHECK(names.insert(figure->figure.name).second);  // one file per figure
+      figure->file = "figures/" + RenderFigure(figure->figure, figures.string(), options.plot);
+    }
+  }
+  WriteFile(fs::path(out.temp_path()) / "index.html", ToHtml(*document));
+  WriteFile(fs::path(out.temp_path()) / "summary.json", ToJson(*document).dump(2) + "\n");
+  out.Commit();
+}
+
+ReportSummary MakeReport(const std::string& input, const std::string& output_folder,
+                         const ReportOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  std::string why;
+  if (!options.IsValid(&why)) ThrowInputError("report options", "", why);
+  std::error_code ec;
+  if (!fs::exists(input, ec)) ThrowInputError(input, "", "no such file");
+  if (fs::is_directory(input, ec)) {
+    ThrowInputError(input, "",
+                    "is a folder; expected a ccsrm-run/1 or ccsrm-dataset/1 file (reports of "
+                    "identify and loop folders are not available yet)");
+  }
+  if (IsInside(input, output_folder)) {
+    ThrowInputError(output_folder, "",
+                    "contains the input " + input +
+                        ", which replacing the folder would delete: choose another output folder");
+  }
+  CheckOutputFolder(output_folder);
+  const datasets::AnyFile file = datasets::ReadAnyFile(input);
+  FindGnuplot(options.plot);
+  Document document =
+      std::holds_alternative<datasets::RunFile>(file)
+          ? BuildRunDocument(std::get<datasets::RunFile>(file), input, options)
+          : BuildExperimentDocument(std::get<datasets::ExperimentFile>(file), input, options);
+  WriteReport(&document, output_folder, options);
+
+  ReportSummary summary;
+  summary.input = input;
+  summary.output = FolderPath(output_folder).string();
+  summary.kind = document.kind;
+  summary.title = document.title;
+  summary.figures = static_cast<int>(document.figures().size());
+  summary.tables = static_cast<int>(document.tables().size());
+  summary.notices = document.notices();
+  summary.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace ccsrm::reports
