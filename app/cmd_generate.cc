@@ -183,7 +183,7 @@ void AddGenerateCommand(CLI::App& root) {
   AddPaperRunOptions(cmd, &a->run);
   cmd->add_option("--set", a->run.sets,
                   "True parameter value, name=value (mu, mu_s, mu_c, mu_c_s, beta, c_sc, c_lc, "
-                  "T_p, T_d0); repeatable, applied after --params");
+                  "T_p, T_d0, v_s); repeatable, applied after --params");
   cmd->add_option("--params", a->run.params_path,
                   "YAML file of true parameter values (name: value, or a truth file's "
                   "'parameters:')");

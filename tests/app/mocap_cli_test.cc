@@ -156,11 +156,12 @@ TEST(Generate, RejectsUnknownParametersAndBadValuesWithOneLine) {
   EXPECT_EQ(unknown.status, 2);
   EXPECT_EQ(Lines(unknown.err), 1) << unknown.err;
   EXPECT_THAT(unknown.err, HasSubstr("unknown parameter 'mu_x' (known: mu, mu_s, mu_c, mu_c_s, "
-                                     "beta, c_sc, c_lc, T_p, T_d0)"));
+                                     "beta, c_sc, c_lc, T_p, T_d0, v_s)"));
   const Outcome bounds =
       RunCcsrm("generate --config " + Paper() + " --set mu=3 --out /tmp/ccsrm_never.h5");
   EXPECT_EQ(bounds.status, 2);
-  EXPECT_THAT(bounds.err, HasSubstr("parameter 'mu': 3 is outside [0, 2]"));
+  // The message of the one parameter table, as from a config file or --params.
+  EXPECT_EQ(bounds.err, "ccsrm: --set: parameter 'mu' = 3 is outside [0, 2] 1\n");
   const Outcome not_h5 = RunCcsrm("generate --config " + Paper() + " --out /tmp/ccsrm_never.dat");
   EXPECT_EQ(not_h5.status, 2);
   EXPECT_THAT(not_h5.err, HasSubstr("must end in .h5"));
