@@ -88,6 +88,7 @@ void AddBenchCommand(CLI::App& root) {
   cmd->add_option("--duration", a->run.duration_s,
                   "Simulated time [s] (default: the whole protocol)");
   cmd->add_option("--repeat", a->repeat, "Runs; medians are reported")->capture_default_str();
+  AddParameterOptions(cmd, &a->run);
   cmd->callback([a] { RunBench(*a); });
 }
 

@@ -181,12 +181,7 @@ void AddGenerateCommand(CLI::App& root) {
       "ccsrm-dataset/1 experiment plus <name>.truth.yaml and <name>.truth.h5");
   auto a = std::make_shared<GenerateArgs>();
   AddPaperRunOptions(cmd, &a->run);
-  cmd->add_option("--set", a->run.sets,
-                  "True parameter value, name=value (mu, mu_s, mu_c, mu_c_s, beta, c_sc, c_lc, "
-                  "T_p, T_d0, v_s); repeatable, applied after --params");
-  cmd->add_option("--params", a->run.params_path,
-                  "YAML file of true parameter values (name: value, or a truth file's "
-                  "'parameters:')");
+  AddParameterOptions(cmd, &a->run);
   cmd->add_option("--noise-mm", a->noise_mm, "Marker noise, standard deviation [mm]")
       ->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed of the noise and occlusion generator")

@@ -62,6 +62,7 @@ void AddSimulateCommand(CLI::App& root) {
       "simulate", "Simulate the arm over the paper's protocol and write a ccsrm-run/1 HDF5 file");
   auto a = std::make_shared<SimulateArgs>();
   AddPaperRunOptions(cmd, &a->run);
+  AddParameterOptions(cmd, &a->run);
   cmd->add_option("--output-rate", a->run.output_rate_hz,
                   "Output frames per second (default: solver.output_rate_hz)");
   cmd->add_option("--out", a->out, "Output run file (.h5)")->required();

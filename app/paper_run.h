@@ -10,4 +10,8 @@ namespace ccsrm::app {
 // --config, --case, --amplitude and --duration.
 void AddPaperRunOptions(CLI::App* command, sim::PaperRunOptions* options);
 
+// --params FILE and --set name=value (repeatable): named parameters (the
+// table of sim/parameters.h) applied after the case.
+void AddParameterOptions(CLI::App* command, sim::PaperRunOptions* options);
+
 }  // namespace ccsrm::app
