@@ -16,10 +16,8 @@
 namespace ccsrm::mocap {
 namespace {
 
-using testing::C3dFile;
 using testing::InputErrorOf;
 using testing::ReadBytes;
-using testing::SharedMocapFile;
 
 bool Contains(const std::string& haystack, const std::string& needle) {
   return haystack.find(needle) != std::string::npos;
@@ -53,7 +51,8 @@ std::string C3dError(const std::vector<std::uint8_t>& bytes) {
 }
 
 TEST(BadC3d, TruncatedFileNamesTheFileAndByteOffset) {
-  const std::vector<std::uint8_t> bytes = ReadBytes(C3dFile("Eb015pi.c3d"));
+  CCSRM_SHARED_FILE_OR_SKIP(eb015pi_c3d, "data/mocap/c3d/Eb015pi.c3d");
+  const std::vector<std::uint8_t> bytes = ReadBytes(eb015pi_c3d);
   for (std::size_t n :
        {std::size_t{0}, std::size_t{1}, std::size_t{100}, std::size_t{511}, std::size_t{512},
         std::size_t{515}, std::size_t{900}, std::size_t{5119}, std::size_t{5120}, std::size_t{5121},
@@ -72,14 +71,16 @@ TEST(BadC3d, TruncatedFileNamesTheFileAndByteOffset) {
 }
 
 TEST(BadC3d, WrongMagicByteIsNotAC3dFile) {
-  std::vector<std::uint8_t> bytes = ReadBytes(C3dFile("Eb015pi.c3d"));
+  CCSRM_SHARED_FILE_OR_SKIP(eb015pi_c3d, "data/mocap/c3d/Eb015pi.c3d");
+  std::vector<std::uint8_t> bytes = ReadBytes(eb015pi_c3d);
   bytes[1] = 0x51;
   const std::string error = C3dError(bytes);
   EXPECT_TRUE(Contains(error, "Eb015pi.c3d: byte 1: expected 0x50")) << error;
 }
 
 TEST(BadC3d, ParameterSectionPointerPastTheEnd) {
-  std::vector<std::uint8_t> bytes = ReadBytes(C3dFile("pc_int.c3d"));  // 85 blocks
+  CCSRM_SHARED_FILE_OR_SKIP(pc_int_c3d, "data/mocap/c3d/pc_int.c3d");
+  std::vector<std::uint8_t> bytes = ReadBytes(pc_int_c3d);  // 85 blocks
   bytes[0] = 200;
   const std::string error = C3dError(bytes);
   EXPECT_TRUE(Contains(error, "Eb015pi.c3d: byte 0: expected the parameter section at block 200"))
@@ -88,13 +89,15 @@ TEST(BadC3d, ParameterSectionPointerPastTheEnd) {
 }
 
 TEST(BadC3d, UnknownProcessorType) {
-  std::vector<std::uint8_t> bytes = ReadBytes(C3dFile("Eb015pi.c3d"));
+  CCSRM_SHARED_FILE_OR_SKIP(eb015pi_c3d, "data/mocap/c3d/Eb015pi.c3d");
+  std::vector<std::uint8_t> bytes = ReadBytes(eb015pi_c3d);
   bytes[512 + 3] = 99;
   EXPECT_TRUE(Contains(C3dError(bytes), "byte 515: expected a processor type of 84"));
 }
 
 TEST(BadC3d, ParameterDimensionsExceedingTheSection) {
-  std::vector<std::uint8_t> bytes = ReadBytes(C3dFile("Eb015pi.c3d"));
+  CCSRM_SHARED_FILE_OR_SKIP(eb015pi_c3d, "data/mocap/c3d/Eb015pi.c3d");
+  std::vector<std::uint8_t> bytes = ReadBytes(eb015pi_c3d);
   std::size_t dims_at = 0;
   ParameterDataOffset(bytes, "LABELS", &dims_at);
   bytes[dims_at] = 255;
@@ -105,7 +108,8 @@ TEST(BadC3d, ParameterDimensionsExceedingTheSection) {
 }
 
 TEST(BadC3d, FrameCountLargerThanTheDataSection) {
-  std::vector<std::uint8_t> bytes = ReadBytes(C3dFile("Eb015pi.c3d"));
+  CCSRM_SHARED_FILE_OR_SKIP(eb015pi_c3d, "data/mocap/c3d/Eb015pi.c3d");
+  std::vector<std::uint8_t> bytes = ReadBytes(eb015pi_c3d);
   const std::size_t at = ParameterDataOffset(bytes, "FRAMES");
   ASSERT_EQ(bytes[at] | (bytes[at + 1] << 8), 450);
   bytes[at] = 0xCC;  // 460 frames
@@ -116,7 +120,8 @@ TEST(BadC3d, FrameCountLargerThanTheDataSection) {
 }
 
 TEST(BadC3d, DataStartPastTheEnd) {
-  std::vector<std::uint8_t> bytes = ReadBytes(C3dFile("Eb015pi.c3d"));
+  CCSRM_SHARED_FILE_OR_SKIP(eb015pi_c3d, "data/mocap/c3d/Eb015pi.c3d");
+  std::vector<std::uint8_t> bytes = ReadBytes(eb015pi_c3d);
   const std::size_t at = ParameterDataOffset(bytes, "DATA_START");
   bytes[at] = 0x00;
   bytes[at + 1] = 0x10;  // block 4096
@@ -125,7 +130,8 @@ TEST(BadC3d, DataStartPastTheEnd) {
 }
 
 TEST(BadC3d, EveryTruncationOfASmallFileIsAnInputErrorOrAValidRead) {
-  const std::vector<std::uint8_t> bytes = ReadBytes(C3dFile("pc_int.c3d"));
+  CCSRM_SHARED_FILE_OR_SKIP(pc_int_c3d, "data/mocap/c3d/pc_int.c3d");
+  const std::vector<std::uint8_t> bytes = ReadBytes(pc_int_c3d);
   // The data ends at 12 × 512 + 89 × (36 × 8 + 64 × 2) bytes; every shorter
   // prefix must be rejected, every longer one read in full. Every length is
   // tried through the header, the parameters and the first frames, then
@@ -158,8 +164,8 @@ std::string ReplaceFirst(std::string text, const std::string& from, const std::s
 }
 
 TEST(BadText, NonNumericCsvCellNamesLineAndColumn) {
-  const std::string text = ReplaceFirst(ReadTextFile(SharedMocapFile("text/nexus_markers.csv")),
-                                        "1,0,44.1628,", "1,0,44.16x8,");
+  CCSRM_SHARED_FILE_OR_SKIP(nexus_csv, "data/mocap/text/nexus_markers.csv");
+  const std::string text = ReplaceFirst(ReadTextFile(nexus_csv), "1,0,44.1628,", "1,0,44.16x8,");
   const std::string error =
       InputErrorOf([&] { ReadNexusCsvFromString(text, "nexus_markers.csv"); });
   EXPECT_TRUE(Contains(error, "nexus_markers.csv: line 6, column 3: expected a coordinate"))
@@ -168,7 +174,8 @@ TEST(BadText, NonNumericCsvCellNamesLineAndColumn) {
 }
 
 TEST(BadText, CsvRowWithTooFewColumns) {
-  std::string text = ReadTextFile(SharedMocapFile("text/nexus_markers.csv"));
+  CCSRM_SHARED_FILE_OR_SKIP(nexus_csv, "data/mocap/text/nexus_markers.csv");
+  std::string text = ReadTextFile(nexus_csv);
   // Cut line 7 (frame 2) after its 10th cell.
   const std::size_t line7 = text.find("\n2,0,") + 1;
   std::size_t cut = line7;
@@ -179,7 +186,8 @@ TEST(BadText, CsvRowWithTooFewColumns) {
 }
 
 TEST(BadText, TrcWithMissingHeaderLine) {
-  std::string text = ReadTextFile(SharedMocapFile("text/nexus_markers.trc"));
+  CCSRM_SHARED_FILE_OR_SKIP(nexus_trc, "data/mocap/text/nexus_markers.trc");
+  std::string text = ReadTextFile(nexus_trc);
   const std::size_t line2 = text.find('\n') + 1;
   text.erase(line2, text.find('\n', line2) + 1 - line2);  // drop "DataRate,CameraRate,..."
   const std::string error = InputErrorOf([&] { ReadTrcFromString(text, "markers.trc"); });
@@ -211,12 +219,12 @@ TEST(BadText, MotiveWithoutTypeRowOrWithABadCell) {
 }
 
 TEST(BadText, EveryTruncationOfTheTextFilesIsAnInputErrorOrAValidRead) {
+  CCSRM_SHARED_FILE_OR_SKIP(nexus_trc, "data/mocap/text/nexus_markers.trc");
+  CCSRM_SHARED_FILE_OR_SKIP(nexus_csv, "data/mocap/text/nexus_markers.csv");
   // The header lines and first data rows of each file, cut at every length.
   const std::size_t kLength = 3000;
-  const std::string trc =
-      ReadTextFile(SharedMocapFile("text/nexus_markers.trc")).substr(0, kLength);
-  const std::string csv =
-      ReadTextFile(SharedMocapFile("text/nexus_markers.csv")).substr(0, kLength);
+  const std::string trc = ReadTextFile(nexus_trc).substr(0, kLength);
+  const std::string csv = ReadTextFile(nexus_csv).substr(0, kLength);
   std::size_t errors = 0;
   for (std::size_t n = 0; n <= kLength; ++n) {
     for (int reader = 0; reader < 2; ++reader) {

@@ -1,6 +1,7 @@
 #pragma once
-// Helpers shared by the mocap tests: paths of the vendor files in
-// ../shared/data/mocap (used in place, never copied) and scratch directories.
+// Helpers shared by the mocap tests: bytes of files, scratch directories and
+// InputError messages. The vendor files of ../shared/data/mocap are used in
+// place, never copied, through CCSRM_SHARED_FILE_OR_SKIP (shared_data.h).
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -11,14 +12,9 @@
 #include <vector>
 
 #include "ccsrm/common/error.h"
+#include "shared_data.h"
 
 namespace ccsrm::mocap::testing {
-
-inline std::string SharedMocapFile(const std::string& relative) {
-  return std::string(CCSRM_SHARED_DIR) + "/data/mocap/" + relative;
-}
-
-inline std::string C3dFile(const std::string& name) { return SharedMocapFile("c3d/" + name); }
 
 inline std::vector<std::uint8_t> ReadBytes(const std::string& path) {
   std::ifstream stream(path, std::ios::binary);
