@@ -4,6 +4,8 @@
 // place, never copied, through CCSRM_SHARED_FILE_OR_SKIP (shared_data.h).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -21,6 +23,14 @@ inline std::vector<std::uint8_t> ReadBytes(const std::string& path) {
   EXPECT_TRUE(stream.good()) << "cannot open " << path;
   return std::vector<std::uint8_t>((std::istreambuf_iterator<char>(stream)),
                                    std::istreambuf_iterator<char>());
+}
+
+// True when `part` equals the start of `whole`, NaN equal to NaN (a sample
+// not seen in both).
+inline bool SameStart(const std::vector<double>& part, const std::vector<double>& whole) {
+  return part.size() <= whole.size() &&
+         std::equal(part.begin(), part.end(), whole.begin(),
+                    [](double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); });
 }
 
 inline std::filesystem::path FreshTempDir(const std::string& name) {
