@@ -1,9 +1,12 @@
 #include "paper_run.h"
 
+#include <sstream>
+
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/parameters.h"
+#include "option_checks.h"
 
 namespace ccsrm::app {
 
@@ -30,6 +33,11 @@ PaperRun PreparePaperRun(const PaperRunArgs& a) {
 }
 
 void AddPaperRunOptions(CLI::App* command, PaperRunArgs* args) {
+  // Command-line values are checked here, while parsing, so that an
+  // out-of-range value is blamed on its option rather than on the
+  // configuration file it would replace. The bounds are those sim::Validate
+  // applies to the configuration keys (sim/src/config.cc), which sim does
+  // not export: keep the two in step.
   command->add_option("--config", args->config_path, "Arm configuration (YAML)")
       ->capture_default_str();
   command
@@ -37,10 +45,25 @@ void AddPaperRunOptions(CLI::App* command, PaperRunArgs* args) {
                    "Paper case: 1 no friction, 2 all friction, 3 driving cables only, 4 "
                    "connecting cables only (default: friction as configured)")
       ->check(CLI::Range(1, 4));
-  command->add_option("--amplitude", args->amplitude_deg,
-                      "Planned joint amplitude [deg] (default: protocol.amplitude_deg)");
-  command->add_option("--duration", args->duration_s,
-                      "Simulated time [s] (default: the whole protocol)");
+  command
+      ->add_option("--amplitude", args->amplitude_deg,
+                   "Planned joint amplitude [deg] (default: protocol.amplitude_deg)")
+      ->check(InRange(-60.0, 60.0, "deg"));  // protocol.amplitude_deg
+  command
+      ->add_option("--duration", args->duration_s,
+                   "Simulated time [s] (default: the whole protocol)")
+      ->check(Above(0.0, "s"));
+  // --output-rate (simulate) is registered by its command, after these; its
+  // value lands in *args, so it is checked with them once parsing is done.
+  command->parse_complete_callback([args] {
+    const double rate = args->output_rate_hz;  // solver.output_rate_hz
+    if (!std::isnan(rate) && !(rate >= 1e-3 && rate <= 1e5)) {
+      std::ostringstream found;
+      found << rate;
+      throw CLI::ValidationError("--output-rate",
+                                 "must be in [0.001, 100000] Hz, found " + found.str());
+    }
+  });
 }
 
 }  // namespace ccsrm::app
