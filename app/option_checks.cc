@@ -29,11 +29,23 @@ CLI::Validator NumberCheck(std::function<bool(double)> accept, const std::string
       rule, "");
 }
 
+std::string RangeRule(double min, double max, const std::string& unit) {
+  return WithUnit("in [" + Number(min) + ", " + Number(max) + "]", unit);
+}
+
 }  // namespace
 
 CLI::Validator InRange(double min, double max, const std::string& unit) {
   return NumberCheck([min, max](double v) { return v >= min && v <= max; },
-                     WithUnit("in [" + Number(min) + ", " + Number(max) + "]", unit));
+                     RangeRule(min, max, unit));
+}
+
+void CheckInRange(const std::string& option, double value, double min, double max,
+                  const std::string& unit) {
+  if (!(value >= min && value <= max)) {
+    throw CLI::ValidationError(option,
+                               "must be " + RangeRule(min, max, unit) + ", found " + Number(value));
+  }
 }
 
 CLI::Validator Above(double min, const std::string& unit) {

@@ -19,6 +19,12 @@ CLI::Validator Above(double min, const std::string& unit = "");
 // A number of at least `min` (NaN refused).
 CLI::Validator AtLeast(double min, const std::string& unit = "");
 
+// For a value checked once parsing is done (e.g. one whose option another
+// command registers): throws CLI::ValidationError naming `option` unless
+// `value` is in [min, max] (NaN refused), with InRange's message.
+void CheckInRange(const std::string& option, double value, double min, double max,
+                  const std::string& unit = "");
+
 // A value accepted when the options struct of the library that uses it is
 // valid with that value in `field` (Options::IsValid(std::string*)): the
 // range is written once, in IsValid, and its message names the field.
