@@ -22,6 +22,7 @@
 #include "ccsrm/sim/kinematics.h"
 #include "ccsrm/sim/model.h"
 #include "commands.h"
+#include "option_checks.h"
 
 namespace ccsrm::app {
 namespace {
@@ -40,12 +41,14 @@ std::pair<int, int> ParseBoardSize(const std::string& text, const std::string& o
   return {x, y};
 }
 
-cameras::CheckerboardTarget MakeBoard(const std::string& size, double square_mm,
-                                      const std::string& option) {
-  const auto [x, y] = ParseBoardSize(size, option);
+// The board of `size_option` (inner corners) and `square_option` (square
+// size [mm]); throws InputError naming the option at fault.
+cameras::CheckerboardTarget MakeBoard(const std::string& size, const std::string& size_option,
+                                      double square_mm, const std::string& square_option) {
+  const auto [x, y] = ParseBoardSize(size, size_option);
   cameras::CheckerboardTarget board{x, y, square_mm * 1e-3};
   std::string reason;
-  if (!board.IsValid(&reason)) ThrowInputError(option, "", reason);
+  if (!board.IsValid(&reason)) ThrowInputError(square_option, "", reason);
   return board;
 }
 
@@ -126,13 +129,19 @@ void AddRender(CLI::App& cameras) {
   auto args = std::make_shared<Args>();
   render->add_option("--in", args->in, "ccsrm-run/1 or ccsrm-dataset/1 file")->required();
   render->add_option("--rig", args->rig, "Camera file (default: the virtual rig)");
+  // Ranges from MarkerRenderOptions::IsValid, checked while parsing.
+  using cameras::MarkerRenderOptions;
   render->add_option("--noise-px", args->noise_px, "Position noise of each spot [px]")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(ValidIn(&MarkerRenderOptions::position_noise_px));
   render->add_option("--drop-probability", args->drop, "Probability that a camera drops a frame")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(ValidIn(&MarkerRenderOptions::dropped_frame_probability));
   render->add_option("--seed", args->seed, "Noise seed")->capture_default_str();
   render->add_option("--first", args->first, "First frame of the input")->capture_default_str();
-  render->add_option("--stride", args->stride, "Take every N-th frame")->capture_default_str();
+  render->add_option("--stride", args->stride, "Take every N-th frame")
+      ->capture_default_str()
+      ->check(AtLeast(1));
   render->add_option("--frames", args->frames, "At most this many frames (0 = all)")
       ->capture_default_str();
   render->add_option("--out", args->out, "Output directory (videos + cameras.yaml)")->required();
@@ -171,19 +180,25 @@ void AddRenderBoard(CLI::App& cameras) {
   render->add_option("--rig", args->rig, "Camera file (default: the virtual rig)");
   render->add_option("--board", args->board, "Hand-held board, inner corners COLSxROWS")
       ->capture_default_str();
-  render->add_option("--square-mm", args->square_mm, "Its square size [mm]")->capture_default_str();
-  render->add_option("--views", args->views, "Hand-held views per camera")->capture_default_str();
+  render->add_option("--square-mm", args->square_mm, "Its square size [mm]")
+      ->capture_default_str()
+      ->check(Above(0.0, "mm"));
+  render->add_option("--views", args->views, "Hand-held views per camera")
+      ->capture_default_str()
+      ->check(AtLeast(1));
   render->add_option("--world-board", args->world_board, "Board on the table, inner corners")
       ->capture_default_str();
   render->add_option("--world-square-mm", args->world_square_mm, "Its square size [mm]")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(Above(0.0, "mm"));
   render->add_option("--seed", args->seed, "Seed of the poses and noise")->capture_default_str();
   render->add_option("--out", args->out, "Output directory")->required();
   render->callback([args] {
     const cameras::CameraRig rig = RigFromOption(args->rig);
-    const cameras::CheckerboardTarget board = MakeBoard(args->board, args->square_mm, "--board");
+    const cameras::CheckerboardTarget board =
+        MakeBoard(args->board, "--board", args->square_mm, "--square-mm");
     const cameras::CheckerboardTarget world =
-        MakeBoard(args->world_board, args->world_square_mm, "--world-board");
+        MakeBoard(args->world_board, "--world-board", args->world_square_mm, "--world-square-mm");
     const auto [R_WG, p_WG] = cameras::DefaultWorldBoardPose(world);
     MakeOutputDirectory(args->out);
     for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
@@ -229,12 +244,15 @@ void AddCalibrate(CLI::App& cameras) {
   board_cmd->add_option("--name", b->name, "Camera name")->capture_default_str();
   board_cmd->add_option("--images", b->images, "Images of the hand-held board")->required();
   board_cmd->add_option("--board", b->board, "Inner corners COLSxROWS")->capture_default_str();
-  board_cmd->add_option("--square-mm", b->square_mm, "Square size [mm]")->capture_default_str();
+  board_cmd->add_option("--square-mm", b->square_mm, "Square size [mm]")
+      ->capture_default_str()
+      ->check(Above(0.0, "mm"));
   board_cmd->add_option("--world-image", b->world_image, "Image of the board lying on the table");
   board_cmd->add_option("--world-board", b->world_board, "Its inner corners")
       ->capture_default_str();
   board_cmd->add_option("--world-square-mm", b->world_square_mm, "Its square size [mm]")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(Above(0.0, "mm"));
   board_cmd
       ->add_option(
           "--world-origin", b->world_origin,
@@ -245,7 +263,8 @@ void AddCalibrate(CLI::App& cameras) {
                         "Camera file to update (the camera of this name is replaced or added)");
   board_cmd->add_option("--out", b->out, "Camera file to write")->required();
   board_cmd->callback([b] {
-    const cameras::CheckerboardTarget board = MakeBoard(b->board, b->square_mm, "--board");
+    const cameras::CheckerboardTarget board =
+        MakeBoard(b->board, "--board", b->square_mm, "--square-mm");
     std::vector<cv::Mat> images;
     for (const std::string& path : b->images) images.push_back(ReadGrayImage(path));
     cameras::IntrinsicCalibrationOptions options;
@@ -255,7 +274,8 @@ void AddCalibrate(CLI::App& cameras) {
       result = cameras::CalibrateIntrinsics(images, b->images, board, b->name, options);
     } else {
       cameras::WorldBoardView world;
-      world.board = MakeBoard(b->world_board, b->world_square_mm, "--world-board");
+      world.board =
+          MakeBoard(b->world_board, "--world-board", b->world_square_mm, "--world-square-mm");
       world.image = ReadGrayImage(b->world_image);
       world.name = b->world_image;
       std::tie(world.R_WG, world.p_WG) = cameras::DefaultWorldBoardPose(world.board);
@@ -316,7 +336,8 @@ void AddCalibrate(CLI::App& cameras) {
   markers_cmd->add_option("--config", m->config, "Arm configuration (marker layout, straight arm)")
       ->required();
   markers_cmd->add_option("--frames", m->frames, "Frames at the start to use (arm at rest)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(AtLeast(1));
   markers_cmd->add_flag("--base-only", m->base_only,
                         "Use only the ground markers (the arm may move)");
   markers_cmd->add_option("--out", m->out, "Camera file to write")->required();

@@ -23,6 +23,7 @@
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
 #include "commands.h"
+#include "option_checks.h"
 
 namespace ccsrm::app {
 namespace {
@@ -273,15 +274,20 @@ void AddMocapCommands(CLI::App& root) {
   process->add_option("--inputs", a->inputs,
                       "Run or experiment file whose /input (cable length changes) the output "
                       "experiment records");
+  // Ranges from ProcessingOptions::IsValid, checked while parsing.
+  using mocap::ProcessingOptions;
   process->add_option("--cutoff-hz", a->options.cutoff_hz, "Low-pass cutoff [Hz], 0 = no filter")
-      ->default_val(defaults.cutoff_hz);
+      ->default_val(defaults.cutoff_hz)
+      ->check(ValidIn(&ProcessingOptions::cutoff_hz));
   process->add_option("--order", a->options.filter_order, "Butterworth order per pass (1..8)")
-      ->default_val(defaults.filter_order);
+      ->default_val(defaults.filter_order)
+      ->check(ValidIn(&ProcessingOptions::filter_order));
   process
       ->add_option("--max-spline-gap", a->options.max_spline_gap_frames,
                    "Longest gap filled by a spline [frames]; longer gaps are filled from the "
                    "link's other markers")
-      ->default_val(defaults.max_spline_gap_frames);
+      ->default_val(defaults.max_spline_gap_frames)
+      ->check(ValidIn(&ProcessingOptions::max_spline_gap_frames));
   process->add_flag("--no-rigid-fill", a->no_rigid_fill,
                     "Do not fill gaps from the link's other markers");
   process->add_option("--out", a->out, "Output experiment (.h5)")->required();

@@ -1,7 +1,8 @@
 #pragma once
-// Each group of subcommands registers itself on the root CLI11 app. A
-// command's callback throws ccsrm::InputError for bad input; main() prints
-// the message as one line on stderr and exits with status 2.
+// Each group of subcommands registers itself on the root CLI11 app. Range
+// checks of options run while parsing (option_checks.h); a command's
+// callback throws ccsrm::InputError for bad input. main() prints either as
+// one line on stderr and exits with status 2.
 #include <CLI/CLI.hpp>
 
 namespace ccsrm::app {

@@ -1,9 +1,32 @@
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/version.h"
 #include "commands.h"
+
+namespace {
+
+// A command-line error is bad input like any other (docs/conventions.md):
+// one line on stderr, status 2, whichever subcommand and option it concerns.
+// --help and --version print what was asked for (status 0), and a command
+// that ends with its own status (CLI::RuntimeError, e.g. 3 for a diverged
+// simulation) keeps it: both go through CLI11.
+int ExitOnParseError(const CLI::App& root, const CLI::ParseError& e) {
+  if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success) ||
+      e.get_name() == "RuntimeError") {
+    return root.exit(e);
+  }
+  std::string message = e.what();
+  for (char& c : message) {
+    if (c == '\n') c = ' ';
+  }
+  std::fprintf(stderr, "ccsrm: %s\n", message.c_str());
+  return 2;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App root{"ccsrm: simulate, measure and identify cable-driven continuum manipulators"};
@@ -20,7 +43,7 @@ int main(int argc, char** argv) {
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return root.exit(e);
+    return ExitOnParseError(root, e);
   } catch (const ccsrm::InputError& e) {
     std::fprintf(stderr, "ccsrm: %s\n", e.what());
     return 2;

@@ -1,8 +1,18 @@
 #include "paper_run.h"
 
+#include <cmath>
+
+#include "option_checks.h"
+
 namespace ccsrm::app {
 
 void AddPaperRunOptions(CLI::App* command, sim::PaperRunOptions* args) {
+  // Command-line values are checked here, while parsing, so that an
+  // out-of-range value is blamed on its option rather than on the
+  // configuration file it would replace (and NaN, which PaperRunOptions
+  // reads as "not given", is refused). sim::PreparePaperRun checks them
+  // again with the configuration's own rules (sim/src/config.cc), naming the
+  // option too; keep the bounds here in step with those.
   command->add_option("--config", args->config_path, "Arm configuration (YAML)")
       ->capture_default_str();
   command
@@ -10,10 +20,20 @@ void AddPaperRunOptions(CLI::App* command, sim::PaperRunOptions* args) {
                    "Paper case: 1 no friction, 2 all friction, 3 driving cables only, 4 "
                    "connecting cables only (default: friction as configured)")
       ->check(CLI::Range(1, 4));
-  command->add_option("--amplitude", args->amplitude_deg,
-                      "Planned joint amplitude [deg] (default: protocol.amplitude_deg)");
-  command->add_option("--duration", args->duration_s,
-                      "Simulated time [s] (default: the whole protocol)");
+  command
+      ->add_option("--amplitude", args->amplitude_deg,
+                   "Planned joint amplitude [deg] (default: protocol.amplitude_deg)")
+      ->check(InRange(-60.0, 60.0, "deg"));  // protocol.amplitude_deg
+  command
+      ->add_option("--duration", args->duration_s,
+                   "Simulated time [s] (default: the whole protocol)")
+      ->check(Above(0.0, "s"));
+  // --output-rate (simulate) is registered by its command, after these; its
+  // value lands in *args, so it is checked with them once parsing is done.
+  command->parse_complete_callback([args] {
+    if (std::isnan(args->output_rate_hz)) return;                          // not given
+    CheckInRange("--output-rate", args->output_rate_hz, 1e-3, 1e5, "Hz");  // solver.output_rate_hz
+  });
 }
 
 void AddParameterOptions(CLI::App* command, sim::PaperRunOptions* args) {

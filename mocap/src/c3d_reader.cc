@@ -20,7 +20,9 @@
 //     samples of that frame (same storage).
 //
 // Every read is checked against the end of the buffer (and, for parameters,
-// against the end of the parameter section) before it happens.
+// against the data start) before it happens. Counts the file can get wrong
+// (the parameter block count, the frame count) are checked against what its
+// bytes hold: the reader reads what is there and warns (mocap/README.md).
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -77,33 +79,36 @@ class ByteReader {
   }
 
   // Throws unless bytes [offset, offset + count) lie before `limit` (itself at
-  // most the file size); `what` names what was being read.
-  void Need(std::uint64_t offset, std::uint64_t count, std::uint64_t limit,
-            const std::string& what) const {
+  // most the file size); `what` names what was being read, `limit_is` what
+  // lies at `limit` ("the file ends at byte 900").
+  void Need(std::uint64_t offset, std::uint64_t count, std::uint64_t limit, const std::string& what,
+            const std::string& limit_is) const {
     if (offset > limit || count > limit - offset) {
-      const bool file_end = limit >= size();
-      Fail(offset, "expected " + std::to_string(count) + " byte(s) of " + what + ", but the " +
-                       (file_end ? "file" : "parameter section") + " ends at byte " +
-                       std::to_string(limit));
+      Fail(offset,
+           "expected " + std::to_string(count) + " byte(s) of " + what + ", but " + limit_is);
     }
   }
+  void Need(std::uint64_t offset, std::uint64_t count, const std::string& what) const {
+    Need(offset, count, size(), what, FileEnd());
+  }
+  std::string FileEnd() const { return "the file ends at byte " + std::to_string(size()); }
 
   std::uint8_t U8(std::uint64_t offset, const std::string& what) const {
-    Need(offset, 1, size(), what);
+    Need(offset, 1, what);
     return bytes_[offset];
   }
   std::int8_t I8(std::uint64_t offset, const std::string& what) const {
     return static_cast<std::int8_t>(U8(offset, what));
   }
   std::uint16_t U16(std::uint64_t offset, const std::string& what) const {
-    Need(offset, 2, size(), what);
+    Need(offset, 2, what);
     return internal::DecodeU16(&bytes_[offset], processor_);
   }
   std::int16_t I16(std::uint64_t offset, const std::string& what) const {
     return static_cast<std::int16_t>(U16(offset, what));
   }
   float F32(std::uint64_t offset, const std::string& what) const {
-    Need(offset, 4, size(), what);
+    Need(offset, 4, what);
     return internal::DecodeF32(&bytes_[offset], processor_);
   }
   // Unchecked variants for the data section, whose extent is checked once.
@@ -135,11 +140,29 @@ struct Parameter {
   std::string full_name() const { return group + ":" + name; }
 };
 
+// The bytes the parameter records may occupy: from `begin` (after the
+// section's 4-byte header) to `end`, where `end_is` says what lies
+// ("the data section starts at byte 5120 (block 11, header word 9)").
+struct SectionBounds {
+  std::uint64_t first_block = 0;      // header byte 0
+  std::uint64_t declared_blocks = 0;  // byte 2 of the section: a hint only
+  std::uint64_t begin = 0;
+  std::uint64_t end = 0;
+  std::string end_is;
+};
+
 class ParameterSection {
  public:
-  ParameterSection(const ByteReader& in, std::uint64_t begin, std::uint64_t end) : in_(in) {
-    Parse(begin, end);
+  ParameterSection(const ByteReader& in, SectionBounds bounds)
+      : in_(in), bounds_(std::move(bounds)) {
+    Parse(bounds_);
   }
+
+  const SectionBounds& bounds() const { return bounds_; }
+
+  // One past the last byte the records use (names, offsets, types,
+  // dimensions and data; descriptions are not read).
+  std::uint64_t records_end() const { return records_end_; }
 
   const Parameter* Find(const std::string& group, const std::string& name) const {
     for (const Parameter& p : parameters_) {
@@ -188,24 +211,30 @@ class ParameterSection {
   }
 
  private:
-  void Parse(std::uint64_t begin, std::uint64_t end) {
+  void Parse(const SectionBounds& bounds) {
+    const std::uint64_t end = bounds.end;
+    auto need = [&](std::uint64_t offset, std::uint64_t count, const std::string& what) {
+      in_.Need(offset, count, end, what, bounds.end_is);
+      records_end_ = std::max(records_end_, offset + count);
+    };
     struct RawParameter {
       int group_id;
       Parameter parameter;
     };
     std::vector<RawParameter> raw;
     std::vector<std::pair<int, std::string>> groups;
-    std::uint64_t at = begin;
+    std::uint64_t at = bounds.begin;
+    records_end_ = bounds.begin;
     // Each record moves `at` strictly forward (the offset is unsigned and
     // non-zero), so the loop ends.
     while (at < end) {
-      in_.Need(at, 2, end, "a parameter record header (name length, group id)");
+      need(at, 2, "a parameter record header (name length, group id)");
       const int name_length = std::abs(static_cast<int>(in_.I8(at, "name length")));
       const int id = in_.I8(at + 1, "group id");
       if (name_length == 0 || id == 0) break;  // end of the parameter list
       const std::uint64_t name_at = at + 2;
-      in_.Need(name_at, static_cast<std::uint64_t>(name_length) + 2, end,
-               "a parameter name and next-record offset");
+      need(name_at, static_cast<std::uint64_t>(name_length) + 2,
+           "a parameter name and next-record offset");
       const std::string name = Upper(in_.Chars(name_at, name_length));
       const std::uint64_t offset_at = name_at + name_length;
       const std::uint16_t next = in_.U16(offset_at, "next-record offset");
@@ -216,7 +245,7 @@ class ParameterSection {
         Parameter& p = r.parameter;
         p.name = name;
         p.record_offset = at;
-        in_.Need(offset_at + 2, 2, end, "the type and dimension count of parameter " + name);
+        need(offset_at + 2, 2, "the type and dimension count of parameter " + name);
         p.type = in_.I8(offset_at + 2, "parameter type");
         if (p.type != -1 && p.type != 1 && p.type != 2 && p.type != 4) {
           in_.Fail(offset_at + 2, "parameter " + name +
@@ -225,8 +254,8 @@ class ParameterSection {
         }
         const int dim_count = in_.U8(offset_at + 3, "dimension count");
         const std::uint64_t dims_at = offset_at + 4;
-        in_.Need(dims_at, dim_count, end, "the dimensions of parameter " + name);
-        const std::uint64_t limit = end - begin;  // no parameter can hold more values
+        need(dims_at, dim_count, "the dimensions of parameter " + name);
+        const std::uint64_t limit = end - bounds.begin;  // no parameter can hold more values
         for (int d = 0; d < dim_count; ++d) {
           const std::uint64_t dim = in_.U8(dims_at + d, "a dimension");
           p.dims.push_back(dim);
@@ -239,9 +268,9 @@ class ParameterSection {
         for (std::size_t d = 0; d < p.dims.size(); ++d) {
           shape += (d == 0 ? "" : "x") + std::to_string(p.dims[d]);
         }
-        in_.Need(p.data_offset, bytes, end,
-                 "data of parameter " + name + " (dimensions " +
-                     (shape.empty() ? "scalar" : shape) + ")");
+        need(p.data_offset, bytes,
+             "data of parameter " + name + " (dimensions " + (shape.empty() ? "scalar" : shape) +
+                 ")");
         raw.push_back(std::move(r));
       }
       if (next == 0) break;  // last record
@@ -261,7 +290,9 @@ class ParameterSection {
   }
 
   const ByteReader& in_;
+  SectionBounds bounds_;
   std::vector<Parameter> parameters_;
+  std::uint64_t records_end_ = 0;
 };
 
 // POINT:UNITS in lower case without spaces ("MM " → "mm").
@@ -362,8 +393,32 @@ void ReadAnalogLayout(const ParameterSection& params, const ByteReader& in, Layo
   }
 }
 
+// The frames to read when the frame count cannot be trusted: the complete
+// frames of the data section, but in a file of whole 512-byte blocks none
+// that starts in the last block. Writers pad that block after the last frame
+// with zeros or whatever their buffer held (Eb015pi.c3d of the c3d.org
+// samples holds leftover text there), which would read as markers seen at
+// made-up positions; a recording cut at a block boundary loses at most the
+// frames of that block. `*last_block_dropped` says whether any was dropped.
+std::uint64_t FramesHeld(const ByteReader& in, const Layout& layout, bool* last_block_dropped) {
+  const std::uint64_t complete =
+      layout.frame_bytes == 0 ? 0 : (in.size() - layout.data_offset) / layout.frame_bytes;
+  std::uint64_t held = complete;
+  if (in.size() % kC3dBlockSize == 0 && complete > 0) {
+    const std::uint64_t last_block_at = in.size() - kC3dBlockSize;
+    const std::uint64_t before =
+        last_block_at <= layout.data_offset
+            ? 0
+            : (last_block_at - layout.data_offset + layout.frame_bytes - 1) / layout.frame_bytes;
+    held = std::min(complete, before);
+  }
+  *last_block_dropped = held < complete;
+  return held;
+}
+
 // Stage 4: the frame count and first frame number, checked against the data
-// section's size.
+// section's size. A count larger than the data holds (a recording cut short)
+// gives the complete frames there are, with a warning, as other readers do.
 void ReadFrameCount(const ParameterSection& params, const ByteReader& in, Layout* layout,
                     std::vector<std::string>* warnings) {
   const std::uint16_t header_first = in.U16(6, "header word 4 (first frame)");
@@ -378,10 +433,12 @@ void ReadFrameCount(const ParameterSection& params, const ByteReader& in, Layout
       have_trial ? static_cast<std::int64_t>(TrialField(params, in, *trial_start)) : header_first;
 
   std::uint64_t frames = 0;
+  std::string count_from = "POINT:FRAMES";
   if (const Parameter* p = params.Find("POINT", "FRAMES")) {
     frames = CountParameter(params, in, *p);
   } else {
     frames = header_last >= header_first ? header_last - header_first + 1u : 0u;
+    count_from = "header words 4-5";
     warnings->push_back("POINT:FRAMES is missing; the frame count comes from the header");
   }
   // POINT:FRAMES is a 16-bit word in most files: 65535 means "look elsewhere"
@@ -391,6 +448,7 @@ void ReadFrameCount(const ParameterSection& params, const ByteReader& in, Layout
       frames = long_frames->type == 4
                    ? WholeCount(in, *long_frames, params.Number(*long_frames, 0, false))
                    : TrialField(params, in, *long_frames);
+      count_from = "POINT:LONG_FRAMES";
     } else if (have_trial) {
       const std::uint64_t last = TrialField(params, in, *trial_end);
       const auto first = static_cast<std::uint64_t>(layout->first_frame);
@@ -400,22 +458,37 @@ void ReadFrameCount(const ParameterSection& params, const ByteReader& in, Layout
                                               std::to_string(first) + ")");
       }
       frames = last - first + 1;
+      count_from = "TRIAL:ACTUAL_START_FIELD/ACTUAL_END_FIELD";
     } else if (frames_that_fit > 65535) {
-      frames = frames_that_fit;
+      bool dropped = false;
+      frames = FramesHeld(in, *layout, &dropped);
       warnings->push_back("POINT:FRAMES is 65535 with no LONG_FRAMES or TRIAL parameters; the " +
-                          std::to_string(frames) + " frames the data section holds were read");
+                          std::to_string(frames) + " frames the data section holds were read" +
+                          (dropped ? " (not the last block, which may be padding)" : ""));
     }
   }
   if (layout->frame_bytes > 0 && frames > frames_that_fit) {
-    in.Fail(layout->data_offset, "expected " + std::to_string(frames) + " frames of " +
-                                     std::to_string(layout->frame_bytes) +
-                                     " bytes in the data section, but the file (" +
-                                     std::to_string(in.size()) + " bytes) holds only " +
-                                     std::to_string(frames_that_fit) + " complete frame(s)");
+    bool dropped = false;
+    const std::uint64_t held = FramesHeld(in, *layout, &dropped);
+    const std::string what = std::to_string(frames) + " frames of " +
+                             std::to_string(layout->frame_bytes) + " bytes from byte " +
+                             std::to_string(layout->data_offset) + " (" + count_from +
+                             "), but the file (" + std::to_string(in.size()) + " bytes) holds ";
+    const std::string where = dropped ? " before its last block (which may be padding)" : "";
+    if (held == 0) in.Fail(layout->data_offset, "expected " + what + "no complete frame" + where);
+    warnings->push_back("the data section should hold " + what + "only " + std::to_string(held) +
+                        " complete frame(s)" + where + "; read those (a recording cut short?)");
+    frames = held;
   }
   layout->frames = frames;
 }
 
+// The names of the `points` points (POINT:USED, which sets the data layout):
+// POINT:LABELS, then LABELS2, LABELS3, ... (255 names each) until there are
+// enough. Names beyond POINT:USED have no data and are dropped silently:
+// writers allocate spare names (the c3d.org samples hold 48 names for 26
+// points, 75 for 36). Points beyond the names are named point_<n>, with a
+// warning.
 std::vector<std::string> ReadLabels(const ParameterSection& params, std::uint64_t points,
                                     std::vector<std::string>* warnings) {
   std::vector<std::string> labels;
@@ -482,18 +555,63 @@ ParameterSection ReadParameterSection(const std::vector<std::uint8_t>& bytes, By
                "(MIPS), found " +
                    std::to_string(processor_code));
   }
-  const std::uint8_t parameter_blocks = bytes[parameters_at + 2];
-  std::uint64_t parameters_end = in->size();  // when the block count is 0 (unset)
-  if (parameter_blocks > 0) {
-    parameters_end = parameters_at + parameter_blocks * kC3dBlockSize;
-    if (parameters_end > in->size()) {
-      in->Fail(parameters_at + 2, "expected a parameter section of " +
-                                      std::to_string(parameter_blocks) + " blocks (to byte " +
-                                      std::to_string(parameters_end) +
-                                      "), but the file ends at byte " + std::to_string(in->size()));
-    }
+  // The records are bounded by what the file holds, not by the block count
+  // the section declares in its byte 2: some writers declare fewer blocks
+  // than their parameters fill, and established readers follow the chain of
+  // records up to the data. The bound is the data start of header word 9
+  // when it lies after the section's first block and within the file, else
+  // the end of the file; CheckParameterExtent compares the three once
+  // POINT:DATA_START is known.
+  SectionBounds bounds;
+  bounds.first_block = parameter_block;
+  bounds.declared_blocks = bytes[parameters_at + 2];
+  bounds.begin = parameters_at + 4;
+  const std::uint64_t data_block = in->U16(16, "header word 9 (data start block)");
+  const std::uint64_t data_at = data_block == 0 ? 0 : (data_block - 1) * kC3dBlockSize;
+  if (data_block > parameter_block && data_at <= in->size()) {
+    bounds.end = data_at;
+    bounds.end_is = "the data section starts at byte " + std::to_string(data_at) + " (block " +
+                    std::to_string(data_block) + ", header word 9)";
+  } else {
+    bounds.end = in->size();
+    bounds.end_is = in->FileEnd();
   }
-  return ParameterSection(*in, parameters_at + 4, parameters_end);
+  return ParameterSection(*in, std::move(bounds));
+}
+
+// The parameter records must end before the data starts (data_block, read
+// at byte data_start_at); the block count the section declares is a hint,
+// and a count that disagrees with the records or the data start is
+// reported, not refused.
+void CheckParameterExtent(const ParameterSection& params, const ByteReader& in,
+                          std::uint64_t data_block, std::uint64_t data_start_at,
+                          std::vector<std::string>* warnings) {
+  const std::uint64_t data_at = (data_block - 1) * kC3dBlockSize;
+  const std::uint64_t records_end = params.records_end();
+  if (records_end > data_at) {
+    in.Fail(data_start_at,
+            "POINT:DATA_START: expected the data section after the parameter "
+            "records, which end at byte " +
+                std::to_string(records_end) + ", found block " + std::to_string(data_block) +
+                " (byte " + std::to_string(data_at) + ")");
+  }
+  const SectionBounds& b = params.bounds();
+  const std::uint64_t section_at = (b.first_block - 1) * kC3dBlockSize;
+  const std::uint64_t declared_end = section_at + b.declared_blocks * kC3dBlockSize;
+  const std::string declared = "the parameter section (byte " + std::to_string(section_at + 2) +
+                               ") declares " + std::to_string(b.declared_blocks) + " block(s)";
+  if (declared_end < records_end) {
+    const std::uint64_t last_block = (records_end - 1) / kC3dBlockSize + 1;
+    warnings->push_back(
+        declared + ", but its records fill blocks " + std::to_string(b.first_block) + "-" +
+        std::to_string(last_block) + " (to byte " + std::to_string(records_end) +
+        "); read them all (the data starts at block " + std::to_string(data_block) + ")");
+  } else if (declared_end > data_at) {
+    warnings->push_back(declared + ", to byte " + std::to_string(declared_end) +
+                        ", past the data start (block " + std::to_string(data_block) + ", byte " +
+                        std::to_string(data_at) + "); its records end at byte " +
+                        std::to_string(records_end) + ", before the data");
+  }
 }
 
 // Stage 2: points, storage, scale, rate, units and the data start, from the
@@ -504,8 +622,14 @@ Layout ReadPointLayout(const ParameterSection& params, const ByteReader& in,
   std::uint64_t points_at = 2;
   layout.points = in.U16(2, "header word 2 (number of points)");
   if (const Parameter* p = params.Find("POINT", "USED")) {
+    const std::uint64_t header_points = layout.points;
     layout.points = CountParameter(params, in, *p);
     points_at = p->record_offset;
+    if (layout.points != header_points) {
+      warnings->push_back("header word 2 gives " + std::to_string(header_points) +
+                          " points, POINT:USED " + std::to_string(layout.points) +
+                          "; used POINT:USED");
+    }
   }
   if (layout.points > 65535) {
     in.Fail(points_at,
@@ -537,10 +661,16 @@ Layout ReadPointLayout(const ParameterSection& params, const ByteReader& in,
   layout.rate_hz = rate;
 
   std::uint64_t data_start_at = 16;
-  std::uint64_t data_block = in.U16(16, "header word 9 (data start block)");
+  const std::uint64_t header_data_block = in.U16(16, "header word 9 (data start block)");
+  std::uint64_t data_block = header_data_block;
   if (const Parameter* p = params.Find("POINT", "DATA_START")) {
     data_block = CountParameter(params, in, *p);
     data_start_at = p->record_offset;
+    if (data_block != header_data_block) {
+      warnings->push_back("header word 9 gives the data start as block " +
+                          std::to_string(header_data_block) + ", POINT:DATA_START as block " +
+                          std::to_string(data_block) + "; used POINT:DATA_START");
+    }
   }
   if (data_block < 2) {
     in.Fail(data_start_at,
@@ -553,6 +683,7 @@ Layout ReadPointLayout(const ParameterSection& params, const ByteReader& in,
                 " (byte " + std::to_string(layout.data_offset) + "), past the end of the file (" +
                 std::to_string(in.size()) + " bytes)");
   }
+  CheckParameterExtent(params, in, data_block, data_start_at, warnings);
 
   if (const Parameter* p = params.Find("POINT", "UNITS")) {
     const std::vector<std::string> units = params.Strings(*p);

@@ -298,6 +298,9 @@ ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<doub
 
   ProcessingResult result;
   ProcessingSummary& summary = result.summary;
+  // What the reader noticed (a recording cut short, a missing unit) stays in
+  // sight of whoever reads only the summary.
+  for (const std::string& w : table.warnings) summary.warnings.push_back(source + ": " + w);
   double rate_hz = 0.0;
   result.time = TimeBase(table, time, source, &rate_hz);
   summary.frames = F;
@@ -681,7 +684,8 @@ std::string ProcessingSummary::BriefReport() const {
                 frames, rate_hz, markers.size(), spline, rigid, lost, lost_body.empty() ? "" : " (",
                 lost_body.c_str(), lost_body.empty() ? "" : ")", Mm(worst_rms).c_str(),
                 worst_twist * kRadToDeg);
-  return buffer;
+  if (warnings.empty()) return buffer;
+  return std::string(buffer) + "; " + std::to_string(warnings.size()) + " warning(s)";
 }
 
 std::string ProcessingSummary::FullReport() const {

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <string>
 
+#include "c3d_test_files.h"
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/datasets/run_file.h"
@@ -22,9 +23,6 @@ using ::testing::HasSubstr;
 using Outcome = ccsrm::testing::CommandOutcome;
 
 std::string Paper() { return std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml"; }
-std::string SharedC3d(const std::string& name) {
-  return std::string(CCSRM_SHARED_DIR) + "/data/mocap/c3d/" + name;
-}
 
 fs::path FreshDir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("ccsrm_mocap_cli_" + name);
@@ -51,20 +49,6 @@ const fs::path& Generated() {
     return d;
   }();
   return dir;
-}
-
-TEST(MocapInspect, JsonOfAC3dFileHasTheDocumentedKeys) {
-  const Outcome o = RunCcsrm("mocap inspect --json " + SharedC3d("pc_real.c3d"));
-  ASSERT_EQ(o.status, 0) << o.err;
-  const nlohmann::json j = nlohmann::json::parse(o.out);
-  for (const char* key : {"format", "frames", "rate_hz", "labels", "units_in_file",
-                          "invalid_points", "longest_gap_frames", "first_frame"}) {
-    EXPECT_TRUE(j.contains(key)) << key;
-  }
-  EXPECT_EQ(j["format"], "c3d");
-  EXPECT_GT(j["frames"].get<int>(), 0);
-  const std::string text = RunCcsrm("mocap inspect " + SharedC3d("pc_real.c3d")).out;
-  EXPECT_THAT(text, HasSubstr("longest gap"));
 }
 
 TEST(MocapInspect, ReadsOurHdf5ExperimentAndRun) {
@@ -220,15 +204,16 @@ TEST(MocapProcess, ConfigOrRigidBodiesFileGiveTheSimulatedAngles) {
     EXPECT_NEAR(a.measured_joint_angles->values[i], truth.joint_angles.values[i], 2e-4) << i;
     EXPECT_NEAR(b.measured_joint_angles->values[i], truth.joint_angles.values[i], 2e-4) << i;
   }
-  // A real vendor file whose labels are not the arm's: one line, exit 2.
-  o = RunCcsrm("mocap process --in " + SharedC3d("pc_real.c3d") + " --config " + Paper() +
-               " --out " + (dir / "x.h5").string());
+  // A C3D file whose labels are not the arm's: one line, exit 2.
+  const std::string other = (dir / "other_labels.c3d").string();
+  ccsrm::mocap::WriteC3d(other, ccsrm::testing::LongLabelTable(8, 20));
+  o = RunCcsrm("mocap process --in " + other + " --config " + Paper() + " --out " +
+               (dir / "x.h5").string());
   EXPECT_EQ(o.status, 2);
   EXPECT_EQ(Lines(o.err), 1) << o.err;
   EXPECT_THAT(o.err, HasSubstr("no marker of the rigid bodies"));
   // Neither rigid bodies nor a configuration for a C3D file.
-  o = RunCcsrm("mocap process --in " + SharedC3d("pc_real.c3d") + " --out " +
-               (dir / "x.h5").string());
+  o = RunCcsrm("mocap process --in " + other + " --out " + (dir / "x.h5").string());
   EXPECT_EQ(o.status, 2);
   EXPECT_THAT(o.err, HasSubstr("give --rigid-bodies FILE or --config FILE"));
 }

@@ -1,4 +1,6 @@
-// The C3D reader against the real vendor files of ../shared/data/mocap/c3d.
+// The C3D reader against the real vendor files of ../shared/data/mocap/c3d
+// (skipped, naming the file, where that folder is missing).
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -7,13 +9,12 @@
 #include <string>
 #include <vector>
 
+#include "c3d_test_files.h"
 #include "ccsrm/mocap/c3d.h"
 #include "mocap_test_util.h"
 
 namespace ccsrm::mocap {
 namespace {
-
-using testing::C3dFile;
 
 struct Agreement {
   double max_position_deviation_m = 0.0;
@@ -65,13 +66,15 @@ struct Variant {
 // and camera masks.
 void ExpectAllFormatsAgree(const std::vector<Variant>& variants, const std::string& reference,
                            std::size_t frames, std::size_t markers, double rate_hz) {
-  const MarkerTable ref = ReadC3d(C3dFile(reference));
+  CCSRM_SHARED_FILE_OR_SKIP(reference_path, "data/mocap/c3d/" + reference);
+  const MarkerTable ref = ReadC3d(reference_path);
   ASSERT_EQ(ref.frames(), frames);
   ASSERT_EQ(ref.markers(), markers);
   EXPECT_DOUBLE_EQ(ref.rate_hz, rate_hz);
   for (const Variant& v : variants) {
     SCOPED_TRACE(v.file);
-    const MarkerTable t = ReadC3d(C3dFile(v.file));
+    CCSRM_SHARED_FILE_OR_SKIP(path, "data/mocap/c3d/" + v.file);
+    const MarkerTable t = ReadC3d(path);
     EXPECT_EQ(t.format, "c3d");
     EXPECT_EQ(t.processor, v.processor);
     EXPECT_EQ(t.storage, v.storage);
@@ -121,7 +124,8 @@ TEST(C3dReader, Sample02DecodesToOneTrialInAllProcessorAndStorageFormats) {
 }
 
 TEST(C3dReader, Eb015HeaderValuesAndFirstFrameAreInMetres) {
-  const MarkerTable t = ReadC3d(C3dFile("Eb015vr.c3d"));  // DEC floats in the parameters too
+  CCSRM_SHARED_FILE_OR_SKIP(path, "data/mocap/c3d/Eb015vr.c3d");
+  const MarkerTable t = ReadC3d(path);  // DEC floats in the parameters too
   EXPECT_NEAR(t.point_scale_m, 0.0833333e-3, 1e-9);
   EXPECT_EQ(t.first_frame_number, 1);
   EXPECT_EQ(t.labels.front(), "RFT1");  // "RFT1" padded with spaces in the file
@@ -136,7 +140,8 @@ TEST(C3dReader, Eb015HeaderValuesAndFirstFrameAreInMetres) {
 }
 
 TEST(C3dReader, ResidualWordSplitsIntoCameraMaskAndResidual) {
-  const MarkerTable t = ReadC3d(C3dFile("Eb015pi.c3d"));
+  CCSRM_SHARED_FILE_OR_SKIP(path, "data/mocap/c3d/Eb015pi.c3d");
+  const MarkerTable t = ReadC3d(path);
   std::size_t valid = 0;
   for (std::size_t i = 0; i < t.frames() * t.markers(); ++i) {
     const bool seen = std::isfinite(t.positions_m[3 * i]);
@@ -164,7 +169,8 @@ TEST(C3dReader, ResidualWordSplitsIntoCameraMaskAndResidual) {
 }
 
 TEST(C3dReader, OptiTrackSprintHasAboutThirtyNinePercentInvalidPoints) {
-  const MarkerTable t = ReadC3d(C3dFile("optitrack_basket_sprint.c3d"));
+  CCSRM_SHARED_FILE_OR_SKIP(path, "data/mocap/c3d/optitrack_basket_sprint.c3d");
+  const MarkerTable t = ReadC3d(path);
   EXPECT_EQ(t.frames(), 3678u);
   EXPECT_EQ(t.markers(), 26u);
   EXPECT_DOUBLE_EQ(t.rate_hz, 120.0);
@@ -189,6 +195,100 @@ TEST(C3dReader, OptiTrackSprintHasAboutThirtyNinePercentInvalidPoints) {
     sum += v;
   }
   EXPECT_NEAR(1.0 - sum / t.markers(), stats.invalid_fraction, 1e-12);
+}
+
+// ---- Files that disagree with themselves -----------------------------------------
+
+using ccsrm::testing::DataStartBlock;
+using ccsrm::testing::LongLabelTable;
+using ccsrm::testing::ParameterBlock;
+using ccsrm::testing::WithDeclaredParameterBlocks;
+using ::testing::HasSubstr;
+
+bool Contains(const std::vector<std::string>& warnings, const std::string& text) {
+  return std::any_of(warnings.begin(), warnings.end(),
+                     [&](const std::string& w) { return w.find(text) != std::string::npos; });
+}
+
+// Same frames, labels, rate, first frame number and samples (NaN where not
+// seen in both).
+void ExpectSameTrial(const MarkerTable& a, const MarkerTable& b) {
+  EXPECT_EQ(a.frames(), b.frames());
+  EXPECT_EQ(a.labels, b.labels);
+  EXPECT_EQ(a.rate_hz, b.rate_hz);
+  EXPECT_EQ(a.first_frame_number, b.first_frame_number);
+  EXPECT_EQ(a.positions_m.size(), b.positions_m.size());
+  EXPECT_TRUE(testing::SameStart(a.positions_m, b.positions_m));
+  EXPECT_TRUE(testing::SameStart(a.residual_m, b.residual_m));
+}
+
+// The defect seen in the field: the section declares 3 blocks, the header's
+// data start (block 8) leaves blocks 2-7 to parameters, and POINT:LABELS
+// runs to block 6. Readers that follow the records up to the data read the
+// file; the declared count is only a hint, reported in a warning.
+TEST(C3dSelfDisagreement, TooFewDeclaredParameterBlocksReadLikeTheCorrectFile) {
+  const std::vector<std::uint8_t> correct = EncodeC3d(LongLabelTable(128, 40));
+  ASSERT_EQ(ParameterBlock(correct), 2);
+  ASSERT_EQ(DataStartBlock(correct), 8);
+  const MarkerTable reference = ReadC3dFromMemory(correct, "correct.c3d");
+  EXPECT_TRUE(reference.warnings.empty()) << reference.warnings.front();
+
+  const MarkerTable t =
+      ReadC3dFromMemory(WithDeclaredParameterBlocks(correct, 3), "three_blocks.c3d");
+  ExpectSameTrial(reference, t);
+  EXPECT_EQ(t.labels[127], "arm:plate_marker_127");
+  EXPECT_EQ(t.position(0, 127), reference.position(0, 127));
+  ASSERT_EQ(t.warnings.size(), 1u);
+  EXPECT_THAT(t.warnings[0], HasSubstr("the parameter section (byte 514) declares 3 block(s), but "
+                                       "its records fill blocks 2-7"));
+  EXPECT_THAT(t.warnings[0], HasSubstr("the data starts at block 8"));
+  // No block count at all (0) reads the same way.
+  const MarkerTable none = ReadC3dFromMemory(WithDeclaredParameterBlocks(correct, 0), "zero.c3d");
+  ExpectSameTrial(reference, none);
+  EXPECT_TRUE(Contains(none.warnings, "declares 0 block(s)"));
+}
+
+TEST(C3dSelfDisagreement, DeclaredBlocksOverlappingTheDataAreReadUpToTheDataStart) {
+  const std::vector<std::uint8_t> correct = EncodeC3d(LongLabelTable(128, 40));
+  const MarkerTable t = ReadC3dFromMemory(WithDeclaredParameterBlocks(correct, 9), "nine.c3d");
+  ExpectSameTrial(ReadC3dFromMemory(correct, "correct.c3d"), t);
+  ASSERT_EQ(t.warnings.size(), 1u);
+  EXPECT_THAT(t.warnings[0], HasSubstr("declares 9 block(s), to byte 5120, past the data start "
+                                       "(block 8, byte 3584)"));
+}
+
+TEST(C3dSelfDisagreement, ParametersRunningPastTheDataStartAreStillRefused) {
+  const std::vector<std::uint8_t> correct = EncodeC3d(LongLabelTable(128, 40));
+  // Header word 9 puts the data at block 4, in the middle of POINT:LABELS.
+  std::vector<std::uint8_t> bytes = correct;
+  bytes[16] = 4;
+  std::string error = testing::InputErrorOf([&] { ReadC3dFromMemory(bytes, "early.c3d"); });
+  EXPECT_THAT(error, HasSubstr("early.c3d: byte "));
+  EXPECT_THAT(error, HasSubstr("of data of parameter LABELS (dimensions 20x128), but the data "
+                               "section starts at byte 1536 (block 4, header word 9)"));
+  // POINT:DATA_START alone does the same (header word 9 left at block 8).
+  bytes = correct;
+  const std::string name = "DATA_START";
+  const auto record = std::search(bytes.begin(), bytes.end(), name.begin(), name.end());
+  ASSERT_NE(record, bytes.end());
+  const std::size_t data_at = (record - bytes.begin()) + name.size() + 2 + 2;  // offset, type, dims
+  ASSERT_EQ(bytes[data_at], 8);
+  bytes[data_at] = 4;
+  error = testing::InputErrorOf([&] { ReadC3dFromMemory(bytes, "early.c3d"); });
+  EXPECT_THAT(error, HasSubstr("POINT:DATA_START: expected the data section after the parameter "
+                               "records, which end at byte "));
+  EXPECT_THAT(error, HasSubstr("found block 4 (byte 1536)"));
+}
+
+// The same defect in a real vendor file.
+TEST(C3dSelfDisagreement, Eb015DeclaringThreeOfItsNineBlocksReadsLikeTheOriginal) {
+  CCSRM_SHARED_FILE_OR_SKIP(path, "data/mocap/c3d/Eb015pi.c3d");
+  const std::vector<std::uint8_t> bytes = testing::ReadBytes(path);
+  const MarkerTable original = ReadC3dFromMemory(bytes, path);
+  const MarkerTable t = ReadC3dFromMemory(WithDeclaredParameterBlocks(bytes, 3), path);
+  ExpectSameTrial(original, t);
+  EXPECT_EQ(t.warnings.size(), original.warnings.size() + 1);
+  EXPECT_TRUE(Contains(t.warnings, "declares 3 block(s), but its records fill blocks 2-"));
 }
 
 TEST(MarkerStatistics, LongestGapCountsRunsAtTheEdgesAndWholeAbsence) {

@@ -16,7 +16,6 @@ namespace ccsrm::mocap {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::C3dFile;
 using testing::FreshTempDir;
 using testing::InputErrorOf;
 
@@ -66,8 +65,9 @@ void RenameParameter(std::vector<std::uint8_t>* bytes, const std::string& from,
 }
 
 TEST(C3dWriter, Eb015RoundTripIsIdenticalWithinFloatPrecision) {
+  CCSRM_SHARED_FILE_OR_SKIP(vendor_file, "data/mocap/c3d/Eb015pr.c3d");
   const fs::path dir = FreshTempDir("c3d_round_trip");
-  const MarkerTable original = ReadC3d(C3dFile("Eb015pr.c3d"));
+  const MarkerTable original = ReadC3d(vendor_file);
   const std::string path = (dir / "copy.c3d").string();
   WriteC3d(path, original);
   // Only the finished file is left (the temporary was renamed).
@@ -93,7 +93,8 @@ TEST(C3dWriter, Eb015RoundTripIsIdenticalWithinFloatPrecision) {
 }
 
 TEST(C3dWriter, IntegerFileRoundTripsThroughFloatStorageInMetres) {
-  const MarkerTable original = ReadC3d(C3dFile("sgi_int.c3d"));
+  CCSRM_SHARED_FILE_OR_SKIP(vendor_file, "data/mocap/c3d/sgi_int.c3d");
+  const MarkerTable original = ReadC3d(vendor_file);
   C3dWriteOptions options;
   options.units = "m";
   const MarkerTable copy = ReadC3dFromMemory(EncodeC3d(original, options), "memory");

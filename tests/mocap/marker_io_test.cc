@@ -12,16 +12,18 @@ namespace ccsrm::mocap {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::C3dFile;
 using testing::FreshTempDir;
 using testing::InputErrorOf;
-using testing::SharedMocapFile;
 using testing::WriteFile;
 
 TEST(ReadMarkerFile, ChoosesTheReaderByExtensionAndFirstLine) {
-  EXPECT_EQ(ReadMarkerFile(C3dFile("Eb015pi.c3d")).format, "c3d");
-  EXPECT_EQ(ReadMarkerFile(SharedMocapFile("text/nexus_markers.trc")).format, "trc");
-  EXPECT_EQ(ReadMarkerFile(SharedMocapFile("text/nexus_markers.csv")).format, "nexus-csv");
+  CCSRM_SHARED_FILE_OR_SKIP(eb015pi_c3d, "data/mocap/c3d/Eb015pi.c3d");
+  CCSRM_SHARED_FILE_OR_SKIP(nexus_trc, "data/mocap/text/nexus_markers.trc");
+  CCSRM_SHARED_FILE_OR_SKIP(nexus_csv, "data/mocap/text/nexus_markers.csv");
+  CCSRM_SHARED_FILE_OR_SKIP(pc_real_c3d, "data/mocap/c3d/pc_real.c3d");
+  EXPECT_EQ(ReadMarkerFile(eb015pi_c3d).format, "c3d");
+  EXPECT_EQ(ReadMarkerFile(nexus_trc).format, "trc");
+  EXPECT_EQ(ReadMarkerFile(nexus_csv).format, "nexus-csv");
 
   const fs::path dir = FreshTempDir("dispatch");
   WriteFile(dir / "take.csv",
@@ -31,7 +33,7 @@ TEST(ReadMarkerFile, ChoosesTheReaderByExtensionAndFirstLine) {
   EXPECT_EQ(ReadMarkerFile((dir / "take.csv").string()).format, "motive-csv");
 
   // The extension is case-insensitive (a link, not a copy, of the shared file).
-  fs::create_symlink(C3dFile("pc_real.c3d"), dir / "UPPER.C3D");
+  fs::create_symlink(pc_real_c3d, dir / "UPPER.C3D");
   EXPECT_EQ(ReadMarkerFile((dir / "UPPER.C3D").string()).processor, "intel");
 }
 
@@ -51,7 +53,8 @@ TEST(ReadMarkerFile, UnknownExtensionOrCsvFlavourIsAnInputError) {
 }
 
 TEST(Inspect, JsonSummaryOfAC3dFileHasTheDocumentedKeys) {
-  const nlohmann::json j = InspectJson(ReadMarkerFile(C3dFile("Eb015pi.c3d")));
+  CCSRM_SHARED_FILE_OR_SKIP(eb015pi_c3d, "data/mocap/c3d/Eb015pi.c3d");
+  const nlohmann::json j = InspectJson(ReadMarkerFile(eb015pi_c3d));
   for (const char* key : {"format",
                           "frames",
                           "markers",
@@ -87,7 +90,8 @@ TEST(Inspect, JsonSummaryOfAC3dFileHasTheDocumentedKeys) {
 }
 
 TEST(Inspect, JsonOfATextFileHasNoC3dKeysAndTextIsReadable) {
-  const MarkerTable t = ReadMarkerFile(SharedMocapFile("text/nexus_markers.csv"));
+  CCSRM_SHARED_FILE_OR_SKIP(nexus_csv, "data/mocap/text/nexus_markers.csv");
+  const MarkerTable t = ReadMarkerFile(nexus_csv);
   const nlohmann::json j = InspectJson(t);
   EXPECT_FALSE(j.contains("processor"));
   EXPECT_NEAR(j["first_frame"]["boite:gauche_ext"][2].get<double>(), 0.675697, 1e-12);

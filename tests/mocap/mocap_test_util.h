@@ -1,8 +1,11 @@
 #pragma once
-// Helpers shared by the mocap tests: paths of the vendor files in
-// ../shared/data/mocap (used in place, never copied) and scratch directories.
+// Helpers shared by the mocap tests: bytes of files, scratch directories and
+// InputError messages. The vendor files of ../shared/data/mocap are used in
+// place, never copied, through CCSRM_SHARED_FILE_OR_SKIP (shared_data.h).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -11,20 +14,23 @@
 #include <vector>
 
 #include "ccsrm/common/error.h"
+#include "shared_data.h"
 
 namespace ccsrm::mocap::testing {
-
-inline std::string SharedMocapFile(const std::string& relative) {
-  return std::string(CCSRM_SHARED_DIR) + "/data/mocap/" + relative;
-}
-
-inline std::string C3dFile(const std::string& name) { return SharedMocapFile("c3d/" + name); }
 
 inline std::vector<std::uint8_t> ReadBytes(const std::string& path) {
   std::ifstream stream(path, std::ios::binary);
   EXPECT_TRUE(stream.good()) << "cannot open " << path;
   return std::vector<std::uint8_t>((std::istreambuf_iterator<char>(stream)),
                                    std::istreambuf_iterator<char>());
+}
+
+// True when `part` equals the start of `whole`, NaN equal to NaN (a sample
+// not seen in both).
+inline bool SameStart(const std::vector<double>& part, const std::vector<double>& whole) {
+  return part.size() <= whole.size() &&
+         std::equal(part.begin(), part.end(), whole.begin(),
+                    [](double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); });
 }
 
 inline std::filesystem::path FreshTempDir(const std::string& name) {

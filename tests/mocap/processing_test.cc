@@ -286,6 +286,17 @@ TEST(ProcessMarkers, MatchesViconSubjectPrefixesAndReportsMissingMarkers) {
   EXPECT_NE(result.summary.warnings[0].find("L01_B"), std::string::npos);
 }
 
+TEST(ProcessMarkers, WarningsOfTheMarkerFileReachTheSummary) {
+  const MarkerLayout layout = DefaultMarkerLayout(PaperModel());
+  MarkerTable table = Record(layout, 10);
+  table.warnings = {"holds only 10 complete frame(s)"};
+  const ProcessingSummary summary =
+      ProcessMarkers(table, {}, layout, Unfiltered(), "cut.c3d").summary;
+  EXPECT_EQ(summary.warnings, std::vector<std::string>{"cut.c3d: holds only 10 complete frame(s)"});
+  EXPECT_NE(summary.BriefReport().find("; 1 warning(s)"), std::string::npos);
+  EXPECT_NE(summary.FullReport().find("warning: cut.c3d: holds only 10"), std::string::npos);
+}
+
 TEST(ProcessMarkers, RejectsBadOptionsTimeBasesAndTablesWithoutLayoutMarkers) {
   using testing::InputErrorOf;
   const MarkerLayout layout = DefaultMarkerLayout(PaperModel());

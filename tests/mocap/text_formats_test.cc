@@ -12,7 +12,6 @@ namespace ccsrm::mocap {
 namespace {
 
 using testing::FreshTempDir;
-using testing::SharedMocapFile;
 using testing::WriteFile;
 
 // The eight markers on the rigid box of the pyomeca trial.
@@ -21,7 +20,8 @@ const std::vector<std::string> kBoxMarkers = {"gauche_ext",    "gauche_int",    
                                               "arriere_droit", "arriere_gauche"};
 
 TEST(NexusCsv, FirstFrameOfBoiteGaucheExtIsTheRecordedPosition) {
-  const MarkerTable t = ReadNexusCsv(SharedMocapFile("text/nexus_markers.csv"));
+  CCSRM_SHARED_FILE_OR_SKIP(nexus_csv, "data/mocap/text/nexus_markers.csv");
+  const MarkerTable t = ReadNexusCsv(nexus_csv);
   EXPECT_EQ(t.format, "nexus-csv");
   EXPECT_EQ(t.markers(), 51u);
   EXPECT_EQ(t.frames(), 580u);
@@ -37,14 +37,16 @@ TEST(NexusCsv, FirstFrameOfBoiteGaucheExtIsTheRecordedPosition) {
 }
 
 TEST(NexusCsv, EmptyCellsAreMarkersNotSeen) {
-  const MarkerTable t = ReadNexusCsv(SharedMocapFile("text/nexus_markers.csv"));
+  CCSRM_SHARED_FILE_OR_SKIP(nexus_csv, "data/mocap/text/nexus_markers.csv");
+  const MarkerTable t = ReadNexusCsv(nexus_csv);
   // 915 empty cells in the file = 305 samples × 3 coordinates.
   EXPECT_EQ(Summarize(t).invalid_points, 305u);
   EXPECT_TRUE(t.warnings.empty());
 }
 
 TEST(Trc, FirstFrameAndLabelsOfTheCommaSeparatedNexusExport) {
-  const MarkerTable t = ReadTrc(SharedMocapFile("text/nexus_markers.trc"));
+  CCSRM_SHARED_FILE_OR_SKIP(nexus_trc, "data/mocap/text/nexus_markers.trc");
+  const MarkerTable t = ReadTrc(nexus_trc);
   EXPECT_EQ(t.format, "trc");
   EXPECT_EQ(t.markers(), 51u);
   EXPECT_DOUBLE_EQ(t.rate_hz, 100.0);
@@ -68,8 +70,10 @@ TEST(Trc, FirstFrameAndLabelsOfTheCommaSeparatedNexusExport) {
 // README) of the same rigid box: the distances between its eight markers must
 // agree, which checks that both readers pair names and columns correctly.
 TEST(Trc, BoxGeometryMatchesTheNexusCsvOfTheSameSetup) {
-  const MarkerTable trc = ReadTrc(SharedMocapFile("text/nexus_markers.trc"));
-  const MarkerTable csv = ReadNexusCsv(SharedMocapFile("text/nexus_markers.csv"));
+  CCSRM_SHARED_FILE_OR_SKIP(nexus_trc, "data/mocap/text/nexus_markers.trc");
+  CCSRM_SHARED_FILE_OR_SKIP(nexus_csv, "data/mocap/text/nexus_markers.csv");
+  const MarkerTable trc = ReadTrc(nexus_trc);
+  const MarkerTable csv = ReadNexusCsv(nexus_csv);
   for (std::size_t i = 0; i < kBoxMarkers.size(); ++i) {
     for (std::size_t j = i + 1; j < kBoxMarkers.size(); ++j) {
       const std::size_t ti = *trc.index_of("boite_" + kBoxMarkers[i]);

@@ -6,7 +6,10 @@
 // and float storage, and the residual word of every point (negative = the
 // point was not seen → NaN position). Analog samples are skipped. Every read
 // is bounds-checked: a malformed file throws ccsrm::InputError whose one-line
-// message names the file, the byte offset and what was expected.
+// message names the file, the byte offset and what was expected. A file that
+// contradicts itself (a parameter block count, a frame count larger than the
+// data) is read as far as it really goes, with a warning in
+// MarkerTable::warnings (mocap/README.md lists the cases).
 #include <cstdint>
 #include <string>
 #include <vector>

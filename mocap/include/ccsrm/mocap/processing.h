@@ -113,6 +113,9 @@ struct ProcessingSummary {
   std::vector<BodyQuality> bodies;      // layout order
   std::vector<JointQuality> joints;     // joint 1..J
   std::size_t input_labels_unused = 0;  // columns of the input no layout marker matched
+  // The input table's own warnings (MarkerTable::warnings, each prefixed with
+  // the source's name), then those of processing. BriefReport counts them,
+  // FullReport lists them.
   std::vector<std::string> warnings;
 
   // One line; and the quality figures of SPEC 5 as a table.
