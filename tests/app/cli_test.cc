@@ -26,16 +26,7 @@ using Outcome = ccsrm::testing::CommandOutcome;
 std::string Paper() { return std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml"; }
 
 fs::path FreshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("ccsrm_cli_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-int Lines(const std::string& text) {
-  int n = 0;
-  for (char c : text) n += c == '\n';
-  return n;
+  return ccsrm::testing::ScratchDirectory("cli_" + name);
 }
 
 TEST(Cli, ConfigCheckAcceptsThePaperConfiguration) {
@@ -54,7 +45,7 @@ TEST(Cli, ConfigCheckRejectsATypoWithOneLine) {
   ccsrm::WriteTextFileAtomically(bad, text);
   const Outcome o = RunCcsrm("config check " + bad);
   EXPECT_EQ(o.status, 2);
-  EXPECT_EQ(Lines(o.err), 1) << o.err;
+  EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
   EXPECT_THAT(o.err, HasSubstr(bad + ": line "));
   EXPECT_THAT(o.err, HasSubstr("driving_cables.pretensoin_n"));
 }
@@ -165,7 +156,7 @@ TEST(Cli, OutOfRangeOptionsOfEveryCommandExitTwoWithOneLineNamingTheOption) {
     SCOPED_TRACE(c.args);
     const Outcome o = RunCcsrm(c.args);
     EXPECT_EQ(o.status, 2);
-    EXPECT_EQ(Lines(o.err), 1) << o.err;
+    EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
     EXPECT_EQ(o.err.rfind("ccsrm: " + c.option + ": ", 0), 0u) << o.err;
     // The value came from the command line, not from the configuration.
     EXPECT_THAT(o.err, ::testing::Not(HasSubstr("paper.yaml"))) << o.err;
@@ -182,7 +173,7 @@ TEST(Cli, ParseErrorsAreOneLineWithStatusTwoAndHelpStillWorks) {
     SCOPED_TRACE(args);
     const Outcome o = RunCcsrm(args);
     EXPECT_EQ(o.status, 2);
-    EXPECT_EQ(Lines(o.err), 1) << o.err;
+    EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
     EXPECT_EQ(o.err.rfind("ccsrm: ", 0), 0u) << o.err;
   }
   EXPECT_THAT(RunCcsrm(simulate).err, HasSubstr("--out"));  // the missing option
@@ -251,7 +242,7 @@ TEST(Cli, DatasetInspectRejectsANonHdf5File) {
   ccsrm::WriteTextFileAtomically(fake, "not an hdf5 file\n");
   const Outcome o = RunCcsrm("dataset inspect " + fake);
   EXPECT_EQ(o.status, 2);
-  EXPECT_EQ(Lines(o.err), 1) << o.err;
+  EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
   EXPECT_THAT(o.err, HasSubstr(fake));
 }
 

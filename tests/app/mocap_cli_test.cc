@@ -25,16 +25,7 @@ using Outcome = ccsrm::testing::CommandOutcome;
 std::string Paper() { return std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml"; }
 
 fs::path FreshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("ccsrm_mocap_cli_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-int Lines(const std::string& text) {
-  int n = 0;
-  for (char c : text) n += c == '\n';
-  return n;
+  return ccsrm::testing::ScratchDirectory("mocap_cli_" + name);
 }
 
 // A short generated experiment (0.3 s of case 1), made once (the suite runs
@@ -138,7 +129,7 @@ TEST(Generate, RejectsUnknownParametersAndBadValuesWithOneLine) {
   const Outcome unknown =
       RunCcsrm("generate --config " + Paper() + " --set mu_x=0.1 --out /tmp/ccsrm_never.h5");
   EXPECT_EQ(unknown.status, 2);
-  EXPECT_EQ(Lines(unknown.err), 1) << unknown.err;
+  EXPECT_EQ(ccsrm::testing::CountLines(unknown.err), 1) << unknown.err;
   EXPECT_THAT(unknown.err, HasSubstr("unknown parameter 'mu_x' (known: mu, mu_s, mu_c, mu_c_s, "
                                      "beta, c_sc, c_lc, T_p, T_d0, v_s)"));
   const Outcome bounds =
@@ -210,7 +201,7 @@ TEST(MocapProcess, ConfigOrRigidBodiesFileGiveTheSimulatedAngles) {
   o = RunCcsrm("mocap process --in " + other + " --config " + Paper() + " --out " +
                (dir / "x.h5").string());
   EXPECT_EQ(o.status, 2);
-  EXPECT_EQ(Lines(o.err), 1) << o.err;
+  EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
   EXPECT_THAT(o.err, HasSubstr("no marker of the rigid bodies"));
   // Neither rigid bodies nor a configuration for a C3D file.
   o = RunCcsrm("mocap process --in " + other + " --out " + (dir / "x.h5").string());
@@ -261,7 +252,7 @@ TEST(MocapProcess, BadRigidBodiesFileIsOneLineNamingLineAndKey) {
   const Outcome o = RunCcsrm("mocap process --in " + (Generated() / "exp.h5").string() +
                              " --rigid-bodies " + rb + " --out " + (dir / "x.h5").string());
   EXPECT_EQ(o.status, 2);
-  EXPECT_EQ(Lines(o.err), 1) << o.err;
+  EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
   EXPECT_THAT(o.err, HasSubstr(rb + ": line 5, key 'bodies[0].colour': unknown key"));
   EXPECT_FALSE(fs::exists(dir / "x.h5"));
 }

@@ -10,6 +10,7 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "report_test_util.h"
+#include "run_ccsrm.h"
 
 namespace ccsrm::reports {
 namespace {
@@ -17,10 +18,7 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
 fs::path FreshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("ccsrm_reports_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return ccsrm::testing::ScratchDirectory("reports_" + name);
 }
 
 Figure TwoPanels() {

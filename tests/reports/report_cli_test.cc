@@ -30,16 +30,7 @@ namespace rt = ccsrm::reports::testing;
 std::string Paper() { return std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml"; }
 
 fs::path FreshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("ccsrm_report_cli_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-int Lines(const std::string& text) {
-  int n = 0;
-  for (char c : text) n += c == '\n';
-  return n;
+  return ccsrm::testing::ScratchDirectory("report_cli_" + name);
 }
 
 // Inputs made once by the program itself (the suite is one process): 2 s of
@@ -180,7 +171,7 @@ TEST(ReportCli, UnprocessedExperimentSaysSo) {
 
 void ExpectOneLineError(const Outcome& o, const std::string& what) {
   EXPECT_EQ(o.status, 2) << o.out << o.err;
-  EXPECT_EQ(Lines(o.err), 1) << o.err;
+  EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
   EXPECT_THAT(o.err, HasSubstr(what));
 }
 

@@ -45,4 +45,19 @@ inline CommandOutcome RunCcsrm(const std::string& args) {
   return outcome;
 }
 
+// An empty scratch directory <tmp>/ccsrm_<name> (whatever was there is removed).
+inline std::filesystem::path ScratchDirectory(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("ccsrm_" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+// Lines of a program's output (a one-line error is "...\n": 1).
+inline int CountLines(const std::string& text) {
+  int n = 0;
+  for (char c : text) n += c == '\n';
+  return n;
+}
+
 }  // namespace ccsrm::testing
