@@ -12,4 +12,5 @@ void AddBenchCommand(CLI::App& root);
 void AddMocapCommands(CLI::App& root);
 void AddGenerateCommand(CLI::App& root);
 void AddCamerasCommands(CLI::App& root);
+void AddDerivativesCommand(CLI::App& root);
 }  // namespace ccsrm::app

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   ccsrm::app::AddMocapCommands(root);
   ccsrm::app::AddGenerateCommand(root);
   ccsrm::app::AddCamerasCommands(root);
+  ccsrm::app::AddDerivativesCommand(root);
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
