@@ -33,6 +33,7 @@ struct DerivativesArgs {
   std::string parameters;
   std::string steps = "1e-2,3e-3";
   std::string threads = std::to_string(identify::DefaultThreads());
+  std::string negligible;
   std::string sweep;
   std::string points;
   std::string span;
@@ -83,7 +84,8 @@ int ParseCount(const std::string& text, const std::string& option) {
       {"threads", "--threads"},
       {"points", "--points"},
       {"span", "--span"},
-      {"parameter", "--sweep"}};
+      {"parameter", "--sweep"},
+      {"negligible_change_deg", "--negligible-deg"}};
   for (const auto& [field, option] : options) {
     if (error.rfind(field + ": ", 0) == 0)
       ThrowInputError(option, "", error.substr(field.size() + 2));
@@ -126,6 +128,9 @@ int RunDerivatives(const DerivativesArgs& a) {
   const bool sweep = !a.sweep.empty();
   if (!sweep && !a.points.empty()) ThrowInputError("--points", "", "needs --sweep");
   if (!sweep && !a.span.empty()) ThrowInputError("--span", "", "needs --sweep");
+  if (sweep && !a.negligible.empty()) {
+    ThrowInputError("--negligible-deg", "", "cannot be combined with --sweep");
+  }
   if (sweep && !a.parameters.empty()) {
     ThrowInputError("--parameters", "", "cannot be combined with --sweep");
   }
@@ -146,6 +151,9 @@ int RunDerivatives(const DerivativesArgs& a) {
       check.relative_steps.push_back(ParseNumber(s, "--steps"));
     }
     check.threads = threads;
+    if (!a.negligible.empty()) {
+      check.negligible_change_deg = ParseNumber(a.negligible, "--negligible-deg");
+    }
     check.progress = Progress(a.quiet);
     if (!check.IsValid(&error)) ThrowOptionError(error);
   }
@@ -208,6 +216,10 @@ void AddDerivativesCommand(CLI::App& root) {
   cmd->add_option("--steps", a->steps, "Relative steps, comma-separated, at least two")
       ->capture_default_str();
   cmd->add_option("--threads", a->threads, "Runs at a time")->capture_default_str();
+  cmd->add_option("--negligible-deg", a->negligible,
+                  "A derivative is negligible (does not fail) when a 1 % change moves the angles "
+                  "by less than this, RMS [deg] (default 0.003, a tenth of the mocap noise "
+                  "floor; 0: none)");
   cmd->add_option("--sweep", a->sweep,
                   "Instead of derivatives: sweep this parameter and fit a cubic to every angle");
   cmd->add_option("--points", a->points, "Values in the sweep (default 21)");

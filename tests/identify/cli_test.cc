@@ -86,6 +86,7 @@ TEST(DerivativesCommand, BadOptionsExitWithOneLineNamingTheOption) {
       {"--sweep mu --span 1.5", "--span"},
       {"--span 0.05", "--span"},
       {"--sweep mu --parameters mu", "--parameters"},
+      {"--negligible-deg -1", "--negligible-deg"},
       {"--set mu=-1", "--set"},
       {"--json /nonexistent-dir/d.json", "does not exist"},
   };
