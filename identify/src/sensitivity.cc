@@ -340,14 +340,20 @@ DerivativeCheckSummary DerivativeCheck(const sim::ArmModel& model, const sim::Ar
 
 std::string DerivativeCheckSummary::BriefReport() const {
   int counts[5] = {0, 0, 0, 0, 0};
-  for (const ParameterDerivative& p : parameters) ++counts[static_cast<int>(p.status)];
-  char text[320];
+  int negligible_beyond = 0;  // negligible, but beyond the tolerance
+  for (const ParameterDerivative& p : parameters) {
+    ++counts[static_cast<int>(p.status)];
+    negligible_beyond +=
+        p.status == DerivativeStatus::kNegligible && !(p.max_disagreement <= tolerance);
+  }
+  char text[360];
   std::snprintf(text, sizeof(text),
-                "derivative check %s: %zu parameters, %d agree within %g %%, %d negligible, %d "
-                "disagree, %d with failed runs, %d not checked (%zu runs, %.1f s wall)",
+                "derivative check %s: %zu parameters, %d agree within %g %%, %d negligible (%d of "
+                "them beyond it), %d disagree, %d with failed runs, %d not checked (%zu runs, "
+                "%.1f s wall)",
                 passed() ? "passed" : "FAILED", parameters.size(),
                 counts[static_cast<int>(DerivativeStatus::kAgrees)], 100.0 * tolerance,
-                counts[static_cast<int>(DerivativeStatus::kNegligible)],
+                counts[static_cast<int>(DerivativeStatus::kNegligible)], negligible_beyond,
                 counts[static_cast<int>(DerivativeStatus::kDisagrees)],
                 counts[static_cast<int>(DerivativeStatus::kRunFailed)],
                 counts[static_cast<int>(DerivativeStatus::kNotChecked)], runs, wall_time_s);
@@ -399,7 +405,10 @@ std::string DerivativeCheckSummary::FullReport() const {
       std::snprintf(line, sizeof(line), "  %13s  %12s  %s\n", "-", "-", StatusName(p.status));
     } else {
       std::snprintf(line, sizeof(line), "  %9.3g deg  %10.3g %%  %s\n", p.change_per_percent_deg(),
-                    100.0 * p.max_disagreement, StatusName(p.status));
+                    100.0 * p.max_disagreement,
+                    p.status == DerivativeStatus::kNegligible && !(p.max_disagreement <= tolerance)
+                        ? "negligible (beyond tolerance)"
+                        : StatusName(p.status));
     }
     out << line;
   }
