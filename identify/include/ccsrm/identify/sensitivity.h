@@ -32,7 +32,7 @@ namespace ccsrm::identify {
 struct RunProgress {
   std::size_t finished = 0;  // runs finished so far, this one included
   std::size_t total = 0;
-  std::string label;  // which run, e.g. "mu = 0.2121 (+1e-2)"
+  std::string label;  // which run, e.g. "mu = 0.2121 (step 0.01)"
   sim::SimulationSummary summary;
 };
 using ProgressCallback = std::function<void(const RunProgress&)>;
