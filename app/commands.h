@@ -14,4 +14,5 @@ void AddMocapCommands(CLI::App& root);
 void AddGenerateCommand(CLI::App& root);
 void AddCamerasCommands(CLI::App& root);
 void AddReportCommand(CLI::App& root);
+void AddDerivativesCommand(CLI::App& root);
 }  // namespace ccsrm::app

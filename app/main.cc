@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
   ccsrm::app::AddGenerateCommand(root);
   ccsrm::app::AddCamerasCommands(root);
   ccsrm::app::AddReportCommand(root);
+  ccsrm::app::AddDerivativesCommand(root);
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,102 @@
+// `ccsrm derivatives` as a user runs it: the table, the JSON file, and one
+// line naming the option for every bad value, before any run starts.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "ccsrm/common/atomic_file.h"
+#include "run_ccsrm.h"
+
+namespace {
+namespace fs = std::filesystem;
+using ccsrm::testing::RunCcsrm;
+using ::testing::HasSubstr;
+using Outcome = ccsrm::testing::CommandOutcome;
+
+std::string Paper() { return std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml"; }
+
+fs::path FreshDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("ccsrm_identify_cli_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+int Lines(const std::string& text) {
+  int n = 0;
+  for (char c : text) n += c == '\n';
+  return n;
+}
+
+// 0.05 s of case 3: quick runs; mu_c and mu_c_s are 0 there, so they are
+// stepped relative to the configuration's 0.21.
+TEST(DerivativesCommand, PrintsTheTableAndWritesJson) {
+  const fs::path dir = FreshDir("table");
+  const std::string json_path = (dir / "d.json").string();
+  const Outcome o = RunCcsrm("derivatives --config " + Paper() +
+                             " --case 3 --duration 0.05 --parameters mu,mu_c,T_p --threads 2 "
+                             "--set mu_s=0.25 --quiet --json " +
+                             json_path);
+  ASSERT_TRUE(o.status == 0 || o.status == 4) << o.all();
+  EXPECT_THAT(o.out, HasSubstr("case 3"));
+  EXPECT_THAT(o.out, HasSubstr("--set mu_s=0.25"));
+  EXPECT_THAT(o.out, HasSubstr("derivative check"));
+  EXPECT_THAT(o.out, HasSubstr("T_p "));
+  EXPECT_THAT(o.out, HasSubstr("value 0, steps relative to s = 0.21"));
+  const nlohmann::json json = nlohmann::json::parse(ccsrm::ReadTextFile(json_path));
+  EXPECT_EQ(json["schema"], "ccsrm-derivatives/1");
+  ASSERT_EQ(json["parameters"].size(), 3u);
+  EXPECT_EQ(json["parameters"][1]["name"], "mu_c");
+  EXPECT_EQ(json["parameters"][1]["steps"][0]["scheme"], "forward");
+  EXPECT_EQ(json["run"]["case"], 3);
+  EXPECT_EQ(json["runs"], 1 + 3 * 2 * 2);
+  EXPECT_EQ(o.status == 0, json["passed"].get<bool>());
+  // Only the JSON file in the output directory.
+  int entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++entries;
+  EXPECT_EQ(entries, 1);
+}
+
+TEST(DerivativesCommand, SweepsOneParameter) {
+  const Outcome o = RunCcsrm("derivatives --config " + Paper() +
+                             " --case 2 --duration 0.05 --sweep T_d0 --points 5 --span 0.02 "
+                             "--threads 2 --quiet");
+  ASSERT_EQ(o.status, 0) << o.all();
+  EXPECT_THAT(o.out, HasSubstr("sweep of T_d0"));
+  EXPECT_THAT(o.out, HasSubstr("5 values from 98 to 102"));
+  EXPECT_THAT(o.out, HasSubstr("residual to the cubics"));
+}
+
+TEST(DerivativesCommand, BadOptionsExitWithOneLineNamingTheOption) {
+  const std::string run = "derivatives --config " + Paper() + " --case 2 --duration 0.05 ";
+  const struct {
+    std::string args, option;
+  } cases[] = {
+      {"--steps 1e-2", "--steps"},
+      {"--steps 1e-2,x", "--steps"},
+      {"--steps 1e-2,,3e-3", "--steps"},
+      {"--parameters mu,friction", "--parameters"},
+      {"--threads 0", "--threads"},
+      {"--threads two", "--threads"},
+      {"--sweep friction", "--sweep"},
+      {"--sweep mu --points 3", "--points"},
+      {"--sweep mu --span 1.5", "--span"},
+      {"--span 0.05", "--span"},
+      {"--sweep mu --parameters mu", "--parameters"},
+      {"--negligible-deg -1", "--negligible-deg"},
+      {"--set mu=-1", "--set"},
+      {"--json /nonexistent-dir/d.json", "does not exist"},
+  };
+  for (const auto& c : cases) {
+    const Outcome o = RunCcsrm(run + c.args);
+    EXPECT_EQ(o.status, 2) << c.args << "\n" << o.all();
+    EXPECT_EQ(Lines(o.err), 1) << c.args << "\n" << o.err;
+    EXPECT_THAT(o.err, HasSubstr(c.option)) << c.args;
+    EXPECT_EQ(o.out, "") << c.args << ": nothing may run before the options are checked";
+  }
+}
+
+}  // namespace
