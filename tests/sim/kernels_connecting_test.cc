@@ -17,7 +17,7 @@ ModifiedCoulombParams Table1Friction() {
   f.mu_kinetic = 0.21;
   f.mu_static = 0.21;
   f.v_static_mps = 1e-4;
-  f.v_dynamic_mps = 2e-4;
+  f.stribeck_velocity_mps = 1e-4;  // the paper's v_d = 2e-4 m/s
   return f;
 }
 
@@ -60,7 +60,7 @@ TEST(ConnectingCables, FrictionlessLargeSIsSmallSBitwise) {
   std::uniform_real_distribution<double> u(-0.2, 0.2);
   for (int trial = 0; trial < 100; ++trial) {
     const double ti = u(rng), tj = u(rng), wi = u(rng), wj = u(rng);
-    const LargeSResult l = LargeSMoments(large, ti, tj, wi, wj);
+    const LargeSResult l = LargeSMoments(large, ti, tj, wi, wj, u(rng) + 0.5);
     const ConnectingMoments s = SmallSMoments(small, ti, tj, wi, wj);
     EXPECT_EQ(l.friction_i, 0.0);
     EXPECT_EQ(l.friction_j, 0.0);
@@ -75,7 +75,8 @@ TEST(ConnectingCables, ModifiedCoulombIsContinuousAndOdd) {
   ModifiedCoulombParams f = Table1Friction();
   f.mu_static = 0.3;  // distinct static and kinetic values exercise correction (a)
   const double eps = 1e-12;
-  for (double v : {f.v_static_mps, f.v_dynamic_mps, -f.v_static_mps, -f.v_dynamic_mps, 0.0}) {
+  for (double v : {f.v_static_mps, (f.v_static_mps + f.stribeck_velocity_mps), -f.v_static_mps,
+                   -(f.v_static_mps + f.stribeck_velocity_mps), 0.0}) {
     const double lo = ModifiedCoulomb(f, v - eps * 1e-4);
     const double hi = ModifiedCoulomb(f, v + eps * 1e-4);
     EXPECT_NEAR(lo, hi, 1e-10) << "v " << v;
@@ -83,7 +84,7 @@ TEST(ConnectingCables, ModifiedCoulombIsContinuousAndOdd) {
   EXPECT_EQ(ModifiedCoulomb(f, 0.0), 0.0);
   EXPECT_NEAR(ModifiedCoulomb(f, f.v_static_mps), -f.mu_static, 1e-15);
   EXPECT_NEAR(ModifiedCoulomb(f, -f.v_static_mps), f.mu_static, 1e-15);
-  EXPECT_NEAR(ModifiedCoulomb(f, f.v_dynamic_mps), -f.mu_kinetic, 1e-15);
+  EXPECT_NEAR(ModifiedCoulomb(f, (f.v_static_mps + f.stribeck_velocity_mps)), -f.mu_kinetic, 1e-15);
   EXPECT_EQ(ModifiedCoulomb(f, 1.0), -f.mu_kinetic);
   std::mt19937 rng(32);
   std::uniform_real_distribution<double> u(-3e-4, 3e-4);
@@ -109,7 +110,8 @@ TEST(ConnectingCables, ModifiedCoulombMiddleBranchBlendsStaticIntoKinetic) {
   };
   for (int i = 0; i <= 100; ++i) {
     const double x = i / 100.0;
-    const double v = f.v_static_mps + x * (f.v_dynamic_mps - f.v_static_mps);
+    const double v =
+        f.v_static_mps + x * ((f.v_static_mps + f.stribeck_velocity_mps) - f.v_static_mps);
     EXPECT_NEAR(ModifiedCoulomb(f, v), papers_middle_branch(1.0 - x), 1e-15) << "x " << x;
     EXPECT_NEAR(ModifiedCoulomb(f, -v), -papers_middle_branch(1.0 - x), 1e-15) << "x " << x;
   }
@@ -123,7 +125,8 @@ TEST(ConnectingCables, ModifiedCoulombMiddleBranchBlendsStaticIntoKinetic) {
   EXPECT_NEAR(ModifiedCoulomb(f, f.v_static_mps * (1.0 - 1e-6)), -mu_cs, 1e-11);
   // |mu_m| falls monotonically from mu'_c to mu_c across the band.
   double previous = std::abs(ModifiedCoulomb(f, f.v_static_mps));
-  for (double v = f.v_static_mps + 1e-6; v <= f.v_dynamic_mps; v += 1e-6) {
+  for (double v = f.v_static_mps + 1e-6; v <= (f.v_static_mps + f.stribeck_velocity_mps);
+       v += 1e-6) {
     const double magnitude = std::abs(ModifiedCoulomb(f, v));
     EXPECT_LE(magnitude, previous) << "v " << v;
     previous = magnitude;
@@ -131,7 +134,8 @@ TEST(ConnectingCables, ModifiedCoulombMiddleBranchBlendsStaticIntoKinetic) {
   // SPEC 3: with mu_c = mu'_c the corrected law is the paper's.
   f.mu_static = f.mu_kinetic;
   for (double x : {0.0, 0.25, 0.5, 0.75, 1.0}) {
-    const double v = f.v_static_mps + x * (f.v_dynamic_mps - f.v_static_mps);
+    const double v =
+        f.v_static_mps + x * ((f.v_static_mps + f.stribeck_velocity_mps) - f.v_static_mps);
     EXPECT_NEAR(ModifiedCoulomb(f, v), -f.mu_kinetic, 1e-15);
   }
 }
@@ -155,12 +159,12 @@ TEST(ConnectingCables, LargeSFrictionMomentsDissipate) {
   LargeSParams p = Table1LargeS();
   p.friction.mu_static = 0.3;
   std::mt19937 rng(33);
-  std::uniform_real_distribution<double> rate(-0.05, 0.05), angle(-0.1, 0.1);
+  std::uniform_real_distribution<double> rate(-0.05, 0.05), angle(-0.1, 0.1), memory(0.0, 1.0);
   for (int trial = 0; trial < 10000; ++trial) {
-    // Rates both small (inside the v_s band) and large.
+    // Rates both small (inside the v_s band) and large, any frictional memory.
     const double scale = (trial % 2 == 0) ? 1.0 : 1e-3;
     const double wi = scale * rate(rng), wj = scale * rate(rng);
-    const LargeSResult r = LargeSMoments(p, angle(rng), angle(rng), wi, wj);
+    const LargeSResult r = LargeSMoments(p, angle(rng), angle(rng), wi, wj, memory(rng));
     EXPECT_LE(r.friction_i * wi + r.friction_j * wj, 0.0);
     // The friction moments oppose the pair's common rotation.
     EXPECT_LE(r.friction_i * (wi + wj), 0.0);
@@ -171,8 +175,9 @@ TEST(ConnectingCables, LargeSFrictionMomentsDissipate) {
 
 TEST(ConnectingCables, LargeSSlidingMomentHasTable1Scale) {
   const LargeSParams p = Table1LargeS();
-  // Both joints rotating at 0.05 rad/s: |v_tau| = 8e-4 m/s > v_d, sliding.
-  const LargeSResult r = LargeSMoments(p, 0.0, 0.0, 0.05, 0.05);
+  // Both joints rotating at 0.05 rad/s: |v_tau| = 8e-4 m/s > v_d, sliding
+  // (the memory's target there is 0, the kinetic coefficient).
+  const LargeSResult r = LargeSMoments(p, 0.0, 0.0, 0.05, 0.05, 0.0);
   const double expected = p.pretension_n * p.pulley_radius_m * 0.21 * p.wrap_angle_rad;
   EXPECT_NEAR(std::abs(r.friction_i), expected, 1e-12);
   EXPECT_NEAR(std::abs(r.friction_i), 0.54, 0.005);
@@ -182,6 +187,56 @@ TEST(ConnectingCables, LargeSSlidingMomentHasTable1Scale) {
   const double a = 0.21 * p.wrap_angle_rad;
   const double k0 = kEcAc * 0.016 * 0.016 / 0.109;
   EXPECT_NEAR(r.stiffness_i, k0 * a / std::tanh(a / 2.0), 1e-9 * r.stiffness_i);
+}
+
+TEST(ConnectingCables, MemoryAtItsTargetIsEquation45AndStaticExcessScalesWithIt) {
+  ModifiedCoulombParams f = Table1Friction();
+  f.mu_static = 0.25;
+  for (double v = -3e-4; v <= 3e-4; v += 1.3e-6) {
+    const double target = ConduitMemoryTarget(f, std::abs(v), nullptr);
+    EXPECT_GE(target, 0.0);
+    EXPECT_LE(target, 1.0);
+    // ModifiedCoulomb is defined through the memory; check it against the
+    // printed branches directly.
+    const double speed = std::abs(v), sign = v > 0.0 ? 1.0 : -1.0;
+    double expected = -f.mu_kinetic * sign;
+    if (speed < f.v_static_mps) {
+      const double u = (v + f.v_static_mps) / (2.0 * f.v_static_mps);
+      expected = f.mu_static - 2.0 * f.mu_static * u * u * (3.0 - 2.0 * u);
+    } else if (speed <= (f.v_static_mps + f.stribeck_velocity_mps)) {
+      const double x =
+          (speed - f.v_static_mps) / ((f.v_static_mps + f.stribeck_velocity_mps) - f.v_static_mps);
+      expected = -(f.mu_static + (f.mu_kinetic - f.mu_static) * x * x * (3.0 - 2.0 * x)) * sign;
+    }
+    EXPECT_NEAR(ModifiedCoulombWithMemory(f, v, target, nullptr), expected, 1e-15) << v;
+    // Beyond the band the memory alone sets the coefficient: mu_c at 0, mu'_c at 1.
+    if (speed > f.v_static_mps) {
+      EXPECT_NEAR(ModifiedCoulombWithMemory(f, v, 0.0, nullptr), -f.mu_kinetic * sign, 1e-15);
+      EXPECT_NEAR(ModifiedCoulombWithMemory(f, v, 1.0, nullptr), -f.mu_static * sign, 1e-15);
+    }
+  }
+}
+
+TEST(ConnectingCables, ConduitDampingIsTheFrictionMomentsRateDerivativeAtFixedMemory) {
+  LargeSParams p = Table1LargeS();
+  p.friction.mu_static = 0.25;
+  std::mt19937 rng(37);
+  std::uniform_real_distribution<double> rate(-0.02, 0.02), memory(0.0, 1.0);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const double wi = rate(rng), wj = rate(rng), z = memory(rng);
+    const LargeSResult r = LargeSMoments(p, 0.01, -0.02, wi, wj, z);
+    EXPECT_GE(r.conduit_damping, 0.0);
+    const double dw = 1e-9;
+    const double up = LargeSMoments(p, 0.01, -0.02, wi + dw, wj, z).friction_i;
+    const double down = LargeSMoments(p, 0.01, -0.02, wi - dw, wj, z).friction_i;
+    const double fd = -(up - down) / (2.0 * dw);
+    // Near the band's edges the slope is only continuous: skip those.
+    const double speed = std::abs(r.slip_velocity_1);
+    if (std::abs(speed - p.friction.v_static_mps) < 1e-7) continue;
+    EXPECT_NEAR(r.conduit_damping, fd, 1e-5 * std::abs(fd) + 1e-6) << wi << " " << wj;
+    // Dependent on theta_dot_i + theta_dot_j only.
+    EXPECT_NEAR(LargeSMoments(p, 0.01, -0.02, wj, wi, z).friction_i, r.friction_i, 1e-12);
+  }
 }
 
 }  // namespace

@@ -112,21 +112,26 @@ TEST(HoleFriction, SmoothedFrictionIsTheCapstanValueBeyondTheStickBandAndDissipa
   // Beyond the band it is eq. 9 with the Stribeck coefficient.
   for (double v : {5e-6, 4e-4, 2e-3, -3e-5, -1e-2}) {
     const double mu = HoleFrictionCoefficient(law, v, nullptr);
-    EXPECT_NEAR(SmoothedHoleFriction(law, t_b, theta, v).force, HoleSlipFriction(t_b, mu, theta, v),
-                1e-12)
+    const double target = HoleMemoryTarget(law, v, nullptr);
+    EXPECT_NEAR(law.mu_kinetic + (law.mu_static - law.mu_kinetic) * target, mu, 1e-15) << v;
+    EXPECT_NEAR(SmoothedHoleFriction(law, t_b, theta, v, target).force,
+                HoleSlipFriction(t_b, mu, theta, v), 1e-12)
         << v;
   }
-  // Zero at rest, odd in sign, dissipative, and its slope is the derivative.
-  EXPECT_EQ(SmoothedHoleFriction(law, t_b, theta, 0.0).force, 0.0);
+  // Zero at rest, odd in sign, dissipative, and its slope is the derivative
+  // at fixed memory.
+  EXPECT_EQ(SmoothedHoleFriction(law, t_b, theta, 0.0, 1.0).force, 0.0);
   std::mt19937 rng(5);
-  std::uniform_real_distribution<double> t(-20.0, 200.0), th(0.0, kPi), v(-3e-3, 3e-3);
+  std::uniform_real_distribution<double> t(-20.0, 200.0), th(0.0, kPi), v(-3e-3, 3e-3),
+      memory(0.0, 1.0);
   for (int trial = 0; trial < 2000; ++trial) {
-    const double s_dot = v(rng), tension = t(rng), angle = th(rng);
-    const HoleFrictionForce f = SmoothedHoleFriction(law, tension, angle, s_dot);
+    const double s_dot = v(rng), tension = t(rng), angle = th(rng), z = memory(rng);
+    const HoleFrictionForce f = SmoothedHoleFriction(law, tension, angle, s_dot, z);
     EXPECT_LE(f.force * s_dot, 0.0);
+    EXPECT_LE(f.slope, 0.0);
     const double dv = 1e-10;
-    const double fd = (SmoothedHoleFriction(law, tension, angle, s_dot + dv).force -
-                       SmoothedHoleFriction(law, tension, angle, s_dot - dv).force) /
+    const double fd = (SmoothedHoleFriction(law, tension, angle, s_dot + dv, z).force -
+                       SmoothedHoleFriction(law, tension, angle, s_dot - dv, z).force) /
                       (2.0 * dv);
     // Skip the band's edges, where the slope is only continuous (C1 law).
     if (std::abs(std::abs(s_dot) - 1e-6) < 1e-9) continue;
@@ -134,8 +139,8 @@ TEST(HoleFriction, SmoothedFrictionIsTheCapstanValueBeyondTheStickBandAndDissipa
   }
   // Inside the stick band a node holds up to the static capstan value: at
   // the band's edge the force reaches T_b expm1(-mu' theta).
-  EXPECT_NEAR(SmoothedHoleFriction(law, t_b, theta, 1e-6).force, t_b * std::expm1(-0.25 * theta),
-              1e-12);
+  EXPECT_NEAR(SmoothedHoleFriction(law, t_b, theta, 1e-6, 1.0).force,
+              t_b * std::expm1(-0.25 * theta), 1e-12);
 }
 
 }  // namespace

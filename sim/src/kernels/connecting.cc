@@ -29,22 +29,34 @@ ConnectingMoments SmallSMoments(const SmallSParams& params, double theta_i, doub
   return m;
 }
 
-double ModifiedCoulomb(const ModifiedCoulombParams& params, double v) {
-  const double speed = std::abs(v);
-  const double sign = v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0);
-  if (speed > params.v_dynamic_mps) return -params.mu_kinetic * sign;
-  if (speed >= params.v_static_mps) {
-    // SPEC §3 (a): smooth step from mu'_c at v_s to mu_c at v_d. The paper's
-    // printed branch swaps mu_c and mu'_c, which makes mu_m jump at both ends
-    // unless mu_c = mu'_c.
-    const double x = (speed - params.v_static_mps) / (params.v_dynamic_mps - params.v_static_mps);
-    return -(params.mu_static + (params.mu_kinetic - params.mu_static) * x * x * (3.0 - 2.0 * x)) *
-           sign;
-  }
-  // Paper's lower branch (eq. 45): a cubic through +mu'_c at -v_s, 0 at 0 and
-  // -mu'_c at v_s with zero slope at both ends.
+double ConduitMemoryTarget(const ModifiedCoulombParams& params, double speed, double* slope) {
+  if (slope != nullptr) *slope = 0.0;
+  if (speed <= params.v_static_mps) return 1.0;
+  const double width = params.stribeck_velocity_mps;
+  if (speed >= params.v_static_mps + width) return 0.0;
+  // SPEC §3 (a): a smooth step from mu'_c at v_s to mu_c at v_s + v_c_s
+  // (the paper's v_d). The paper's printed branch swaps mu_c and mu'_c,
+  // which makes mu_m jump at both ends unless mu_c = mu'_c.
+  const double x = (speed - params.v_static_mps) / width;
+  if (slope != nullptr) *slope = -6.0 * x * (1.0 - x) / width;
+  return 1.0 - x * x * (3.0 - 2.0 * x);
+}
+
+double ModifiedCoulombWithMemory(const ModifiedCoulombParams& params, double v, double memory,
+                                 double* slope) {
+  const double mu = params.mu_kinetic + (params.mu_static - params.mu_kinetic) * memory;
+  if (slope != nullptr) *slope = 0.0;
+  if (std::abs(v) >= params.v_static_mps) return v > 0.0 ? -mu : mu;
+  // Paper's lower branch (eq. 45) over mu'_c: a cubic through +1 at -v_s, 0
+  // at 0 and -1 at v_s with zero slope at both ends.
   const double u = (v + params.v_static_mps) / (2.0 * params.v_static_mps);
-  return params.mu_static - 2.0 * params.mu_static * u * u * (3.0 - 2.0 * u);
+  if (slope != nullptr) *slope = -mu * 6.0 * u * (1.0 - u) / params.v_static_mps;
+  return mu * (1.0 - 2.0 * u * u * (3.0 - 2.0 * u));
+}
+
+double ModifiedCoulomb(const ModifiedCoulombParams& params, double v) {
+  return ModifiedCoulombWithMemory(params, v, ConduitMemoryTarget(params, std::abs(v), nullptr),
+                                   nullptr);
 }
 
 double CapstanFactor(double x) {
@@ -55,14 +67,18 @@ double CapstanFactor(double x) {
 }
 
 LargeSResult LargeSMoments(const LargeSParams& params, double theta_i, double theta_j,
-                           double theta_i_dot, double theta_j_dot) {
+                           double theta_i_dot, double theta_j_dot, double memory) {
   LargeSResult out;
   // Sliding speeds of the couple in the conduit; sign chosen so that the
   // friction moments dissipate (see the header).
   out.slip_velocity_1 = -0.5 * params.pulley_radius_m * (theta_i_dot + theta_j_dot);
   const double v2 = -out.slip_velocity_1;
-  const double a1 = ModifiedCoulomb(params.friction, out.slip_velocity_1) * params.wrap_angle_rad;
-  const double a2 = ModifiedCoulomb(params.friction, v2) * params.wrap_angle_rad;
+  double slope = 0.0;
+  const double a1 =
+      ModifiedCoulombWithMemory(params.friction, out.slip_velocity_1, memory, &slope) *
+      params.wrap_angle_rad;
+  const double a2 =
+      ModifiedCoulombWithMemory(params.friction, v2, memory, nullptr) * params.wrap_angle_rad;
 
   // Tension factors at the i ends (eqs. 46-47: T_i = (EA dl / l) phi(a)) and
   // at the j ends (T_j = T_i e^{-a} = (EA dl / l) phi(-a)).
@@ -78,6 +94,9 @@ LargeSResult LargeSMoments(const LargeSParams& params, double theta_i, double th
   out.stiffness_i = k0 * (phi_2 + phi_1);     // eq. 50
   out.friction_j = tp_r * (phi_m1 - phi_m2);  // eq. 53
   out.stiffness_j = k0 * (phi_m1 + phi_m2);   // eq. 53
+
+  // M_p = -T_p r Theta mu_m(v_tau1), d v_tau1 / d theta_dot = -r / 2.
+  out.conduit_damping = -0.5 * tp_r * params.pulley_radius_m * params.wrap_angle_rad * slope;
 
   const double c = params.damping_nmsprad;
   out.moments.on_i = out.friction_i + out.stiffness_i * (theta_j - theta_i) +

@@ -32,20 +32,40 @@ ConnectingMoments SmallSMoments(const SmallSParams& params, double theta_i, doub
 
 // Modified Coulomb friction law of eq. 45 with SPEC §3 correction (a).
 struct ModifiedCoulombParams {
-  double mu_kinetic = 0.0;     // mu_c
-  double mu_static = 0.0;      // mu'_c
-  double v_static_mps = 0.0;   // v_s > 0
-  double v_dynamic_mps = 0.0;  // v_d > v_s
+  double mu_kinetic = 0.0;    // mu_c
+  double mu_static = 0.0;     // mu'_c
+  double v_static_mps = 0.0;  // v_s > 0: the stick band
+  // v_c_s >= 0: mu'_c falls to mu_c between v_s and v_s + v_c_s (the
+  // paper's v_d - v_s, a numerical tolerance there; a physical Stribeck
+  // velocity here, docs/model-notes.md). 0: at once.
+  double stribeck_velocity_mps = 0.0;
 };
 
 // mu_m(v) [1], an odd function of v with mu_m(v) v <= 0 (when mu_c, mu'_c >= 0):
 //   |v| > v_d:        -mu_c sgn v
 //   v_s <= |v| <= v_d: -[mu'_c + (mu_c - mu'_c) x^2 (3 - 2x)] sgn v,
 //                      x = (|v| - v_s) / (v_d - v_s)     (corrected, continuous)
+// with v_d = v_s + v_c_s.
 //   |v| < v_s:        mu'_c - 2 mu'_c u^2 (3 - 2u), u = (v + v_s) / (2 v_s)
 //                      (the paper's lower branch: +mu'_c at -v_s, 0 at 0, -mu'_c at v_s).
-// Continuous and C1 at |v| = v_s and |v| = v_d. Preconditions: 0 < v_s < v_d.
+// Continuous and C1 at |v| = v_s and |v| = v_d (v_c_s > 0). Preconditions: v_s > 0,
+// v_c_s >= 0.
+// It is ModifiedCoulombWithMemory at the memory's steady value.
 double ModifiedCoulomb(const ModifiedCoulombParams& params, double v);
+
+// The same law split in two (docs/model-notes.md, "frictional memory"): a
+// band shape rho(v) that takes the sign of v across the stick band (the
+// paper's lower branch divided by -mu'_c, +-1 beyond v_s), and a memory
+// z in [0, 1] of how static the contact is:
+//   mu_m(v, z) = -[mu_c + (mu'_c - mu_c) z] rho(v).
+// z's steady value at slip speed |v| is ConduitMemoryTarget: 1 up to v_s,
+// falling as 1 - x^2 (3 - 2x) to 0 at v_d, so that mu_m(v, target(|v|)) is
+// eq. 45 exactly. With mu_c = mu'_c the memory has no effect.
+// *slope (may be null) is d mu_m / dv at fixed z [s/m], <= 0.
+double ModifiedCoulombWithMemory(const ModifiedCoulombParams& params, double v, double memory,
+                                 double* slope);
+// *slope (may be null) is d target / d|v| [s/m], <= 0.
+double ConduitMemoryTarget(const ModifiedCoulombParams& params, double speed, double* slope);
 
 // phi(x) = x / (1 - e^{-x}) [1], evaluated as -x / expm1(-x) so it is accurate
 // for small |x|; phi(0) = 1 exactly (the frictionless limit of eqs. 46-53).
@@ -60,7 +80,7 @@ struct LargeSParams {
   double wrap_angle_rad = 0.0;     // Theta_lc
   double pretension_n = 0.0;       // T_p
   double damping_nmsprad = 0.0;    // c_lc [N m s/rad]
-  ModifiedCoulombParams friction;  // mu_c, mu'_c, v_s, v_d
+  ModifiedCoulombParams friction;  // mu_c, mu'_c, v_s, v_c_s
 };
 
 // Moments and the intermediate quantities of eqs. 49-53.
@@ -71,18 +91,26 @@ struct LargeSResult {
   double stiffness_i = 0.0;      // k_lci (eq. 50) [N m/rad]
   double stiffness_j = 0.0;      // k_lcj (eq. 53) [N m/rad]
   double slip_velocity_1 = 0.0;  // v_tau1 [m/s] (v_tau2 = -v_tau1)
+  // -dM_pi/d(theta_dot_i) at fixed memory, equal for both joints' rates and
+  // both moments (M_pi = M_pj depends on theta_dot_i + theta_dot_j only):
+  // T_p r_lc^2 Theta |d mu_m/dv| / 2 >= 0 [N m s/rad], the conduit's
+  // damping across the stick band.
+  double conduit_damping = 0.0;
 };
 
 // Evaluates eqs. 45-53 with the sliding speeds
-//   v_tau1 = -r_lc (theta_i_dot + theta_j_dot) / 2,  v_tau2 = -v_tau1.
+//   v_tau1 = -r_lc (theta_i_dot + theta_j_dot) / 2,  v_tau2 = -v_tau1,
+// and mu_m = ModifiedCoulombWithMemory(v, memory) (the memory is a property
+// of the contact, so the same for both speeds; eq. 45 as printed is memory
+// = ConduitMemoryTarget(|v_tau1|)).
 // The minus sign (SPEC §3 correction (b) prints +) is the one that makes the
 // friction moments dissipate with eqs. 50 and 53 as written: since
 // phi(x) - phi(-x) = x and mu_m is odd, M_pi = M_pj = -T_p r_lc Theta mu_m(v_tau1),
 // and with v_tau1 = -r (theta_i_dot + theta_j_dot)/2 their power is
 // 2 T_p Theta mu_m(v_tau1) v_tau1 <= 0. With mu_c = mu'_c = 0 the result is
 // the small-S law with k = 2 E_c A_c r_lc^2 / l_lc bitwise.
-// Preconditions: l_lc > 0, 0 < v_s < v_d.
+// Preconditions: l_lc > 0, v_s > 0, v_c_s >= 0, memory in [0, 1].
 LargeSResult LargeSMoments(const LargeSParams& params, double theta_i, double theta_j,
-                           double theta_i_dot, double theta_j_dot);
+                           double theta_i_dot, double theta_j_dot, double memory);
 
 }  // namespace ccsrm::sim::internal

@@ -44,8 +44,19 @@ double HoleFrictionCoefficient(const HoleFrictionLaw& law, double speed, double*
   return law.mu_kinetic + excess * decay;
 }
 
+double HoleMemoryTarget(const HoleFrictionLaw& law, double speed, double* slope) {
+  if (slope != nullptr) *slope = 0.0;
+  const double beyond = std::abs(speed) - law.stick_velocity_mps;
+  if (beyond <= 0.0) return 1.0;
+  if (!(law.stribeck_velocity_mps > 0.0)) return 0.0;
+  const double x = beyond / law.stribeck_velocity_mps;
+  const double decay = std::exp(-x * x);
+  if (slope != nullptr) *slope = -2.0 * x * decay / law.stribeck_velocity_mps;
+  return decay;
+}
+
 HoleFrictionForce SmoothedHoleFriction(const HoleFrictionLaw& law, double tension_before,
-                                       double wrap_angle, double s_dot) {
+                                       double wrap_angle, double s_dot, double memory) {
   HoleFrictionForce out;
   const double t_b = std::max(0.0, tension_before);
   if (t_b == 0.0 || wrap_angle == 0.0) return out;
@@ -55,13 +66,10 @@ HoleFrictionForce SmoothedHoleFriction(const HoleFrictionLaw& law, double tensio
     r = 1.5 * u - 0.5 * u * u * u;
     dr_dv = 1.5 * (1.0 - u * u) / law.stick_velocity_mps;
   }
-  double dmu_dspeed = 0.0;
-  const double mu = HoleFrictionCoefficient(law, s_dot, &dmu_dspeed);
+  const double mu = law.mu_kinetic + (law.mu_static - law.mu_kinetic) * memory;
   const double exponent = -mu * wrap_angle * r;
   out.force = t_b * std::expm1(exponent);
-  // d|v|/dv = sgn(v); r sgn(v) = |r|.
-  const double dexponent_dv = -wrap_angle * (dmu_dspeed * std::abs(r) + mu * dr_dv);
-  out.slope = t_b * std::exp(exponent) * dexponent_dv;
+  out.slope = -t_b * std::exp(exponent) * wrap_angle * mu * dr_dv;
   return out;
 }
 

@@ -65,21 +65,31 @@ struct HoleFrictionLaw {
 // mu(|v|) of the law above [1]; *slope (may be null) is d mu / d|v| [s/m].
 double HoleFrictionCoefficient(const HoleFrictionLaw& law, double speed, double* slope);
 
-// Friction on s_i as one smooth function of the slip speed v = s_i_dot, for
-// the smoothed treatment of stick-slip (docs/model-notes.md): the capstan
-// force of eq. 9 with the coefficient mu(|v|) and the direction sgn(v)
-// replaced by r(v), which rises from 0 to +-1 across the stick band,
-// r = 1.5 u - 0.5 u^3 for u = v / v_eps in [-1, 1] (C1 at the band's edges):
-//   F = T_b expm1(-mu(|v|) theta r(v)).
+// The same law split in two (docs/model-notes.md, "frictional memory"): a
+// memory z in [0, 1] of how static the contact is, with the coefficient
+// mu + (mu' - mu) z. Its steady value at slip speed |v| is this target: 1
+// inside the stick band, exp(-((|v| - v_eps) / v_s)^2) beyond it (0 when
+// v_s = 0), so that at the target the coefficient is HoleFrictionCoefficient.
+// *slope (may be null) is d target / d|v| [s/m], <= 0.
+double HoleMemoryTarget(const HoleFrictionLaw& law, double speed, double* slope);
+
+// Friction on s_i as one smooth function of the slip speed v = s_i_dot and
+// the memory z, for the smoothed treatment of stick-slip
+// (docs/model-notes.md): the capstan force of eq. 9 with the coefficient
+// mu + (mu' - mu) z and the direction sgn(v) replaced by r(v), which rises
+// from 0 to +-1 across the stick band, r = 1.5 u - 0.5 u^3 for u = v / v_eps
+// in [-1, 1] (C1 at the band's edges):
+//   F = T_b expm1(-(mu + (mu' - mu) z) theta r(v)).
 // A node loaded below its static limit so creeps at |v| < v_eps, the SPEC's
-// definition of stuck; beyond the band it is eq. 9 with the Stribeck
-// coefficient. `slope` is dF/dv [N s/m], for model smoothing.
-// Preconditions: law.stick_velocity_mps > 0, theta >= 0.
+// definition of stuck; beyond the band, at the memory's target, it is eq. 9
+// with the Stribeck coefficient. `slope` is dF/dv at fixed z [N s/m], <= 0,
+// for model smoothing.
+// Preconditions: law.stick_velocity_mps > 0, theta >= 0, z in [0, 1].
 struct HoleFrictionForce {
   double force = 0.0;  // F [N], right-hand-side signed, F v <= 0
   double slope = 0.0;  // dF/dv [N s/m]
 };
 HoleFrictionForce SmoothedHoleFriction(const HoleFrictionLaw& law, double tension_before,
-                                       double wrap_angle, double s_dot);
+                                       double wrap_angle, double s_dot, double memory);
 
 }  // namespace ccsrm::sim::internal
