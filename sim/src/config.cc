@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -73,6 +74,9 @@ class MapReader {
     }
     return Number(key);
   }
+
+  bool Has(const std::string& key) const { return node_[key].IsDefined(); }
+  YAML::Node Node(const std::string& key) const { return node_[key]; }
 
   int Integer(const std::string& key) {
     const YAML::Node node = Require(key);
@@ -339,10 +343,6 @@ void CheckSolver(const SolverConfig& s, const Checker& check) {
   check.Positive("solver.stick_velocity_tolerance_mps", s.stick_velocity_tolerance_mps);
   check.Positive("solver.stick_force_tolerance_n", s.stick_force_tolerance_n);
   check.Positive("solver.large_s_static_velocity_mps", s.large_s_static_velocity_mps);
-  if (!(s.large_s_dynamic_velocity_mps > s.large_s_static_velocity_mps)) {
-    check.Fail("solver.large_s_dynamic_velocity_mps",
-               "must exceed solver.large_s_static_velocity_mps");
-  }
   check.InRange("solver.relative_tolerance", s.relative_tolerance, 1e-14, 1e-1);
   check.InRange("solver.absolute_tolerance", s.absolute_tolerance, 1e-16, 1e-1);
   check.InRange("solver.velocity_tolerance_time_s", s.velocity_tolerance_time_s, 1e-6, 1e3);
@@ -411,6 +411,7 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
   c.source_name = source_name;
   c.source_yaml = yaml_text;
   MapReader top(root, "", source_name, &lines);
+  bool has_conduit_stribeck = false;  // connecting_cables.stribeck_velocity_mps given
 
   const std::string schema = top.String("schema");
   if (schema != kSchema) {
@@ -468,6 +469,7 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
     ConnectingCableConfig& cc = c.arm.connecting;
     cc.youngs_modulus_pa = k.Number("youngs_modulus_pa");
     cc.cross_section_m2 = k.Number("cross_section_m2");
+    has_conduit_stribeck = k.Has("stribeck_velocity_mps");
     ReadParameters(k, &c.parameters);
     k.Finish();
   }
@@ -484,7 +486,22 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
     sc.stick_velocity_tolerance_mps = s.Number("stick_velocity_tolerance_mps");
     sc.stick_force_tolerance_n = s.Number("stick_force_tolerance_n");
     sc.large_s_static_velocity_mps = s.Number("large_s_static_velocity_mps");
-    sc.large_s_dynamic_velocity_mps = s.Number("large_s_dynamic_velocity_mps");
+    // Before the conduits had a Stribeck velocity (v_c_s), the paper's v_d
+    // closed their static-to-kinetic fall: such a file means v_c_s = v_d - v_s.
+    const double legacy_v_d =
+        s.OptionalNumber("large_s_dynamic_velocity_mps", std::numeric_limits<double>::quiet_NaN());
+    if (!std::isnan(legacy_v_d)) {
+      if (has_conduit_stribeck) {
+        s.Fail("solver.large_s_dynamic_velocity_mps", s.Node("large_s_dynamic_velocity_mps"),
+               "replaced by connecting_cables.stribeck_velocity_mps; give only that");
+      }
+      const double width = legacy_v_d - sc.large_s_static_velocity_mps;
+      if (!(width > 0.0)) {
+        s.Fail("solver.large_s_dynamic_velocity_mps", s.Node("large_s_dynamic_velocity_mps"),
+               "must exceed solver.large_s_static_velocity_mps");
+      }
+      c.parameters.v_c_s = width;
+    }
     sc.relative_tolerance = s.Number("relative_tolerance");
     sc.absolute_tolerance = s.Number("absolute_tolerance");
     sc.velocity_tolerance_time_s = s.Number("velocity_tolerance_time_s");
@@ -602,8 +619,6 @@ std::string ToYaml(const Config& c) {
       << s.stick_velocity_tolerance_mps;
   out << YAML::Key << "stick_force_tolerance_n" << YAML::Value << s.stick_force_tolerance_n;
   out << YAML::Key << "large_s_static_velocity_mps" << YAML::Value << s.large_s_static_velocity_mps;
-  out << YAML::Key << "large_s_dynamic_velocity_mps" << YAML::Value
-      << s.large_s_dynamic_velocity_mps;
   out << YAML::Key << "relative_tolerance" << YAML::Value << s.relative_tolerance;
   out << YAML::Key << "absolute_tolerance" << YAML::Value << s.absolute_tolerance;
   out << YAML::Key << "velocity_tolerance_time_s" << YAML::Value << s.velocity_tolerance_time_s;

@@ -50,6 +50,7 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
   ale_.rayleigh_beta_s = parameters_.beta;
   ale_.smoothing_step_s = solver_.smoothing_step_s;
   const double connecting_ea = arm.connecting.youngs_modulus_pa * arm.connecting.cross_section_m2;
+  num_memory_ = static_cast<int>(layout_.holes().size());
   for (const ConnectingPairModel& pair : model_.connecting_pairs()) {
     PairKernel k;
     k.kind = pair.kind;
@@ -66,7 +67,9 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
       k.large.friction.mu_kinetic = parameters_.mu_c;
       k.large.friction.mu_static = parameters_.mu_c_s;
       k.large.friction.v_static_mps = solver_.large_s_static_velocity_mps;
-      k.large.friction.v_dynamic_mps = solver_.large_s_dynamic_velocity_mps;
+      k.large.friction.stribeck_velocity_mps = parameters_.v_c_s;
+      k.memory = num_memory_;
+      num_memory_ += 2;
     }
     pair_kernels_.push_back(k);
   }
@@ -74,6 +77,7 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
   const std::size_t holes = layout_.holes().size();
   modes_.assign(holes, has_stick_slip() ? HoleMode::kStuck : HoleMode::kSlipUp);
   reports_.assign(holes, HoleReport{});
+  memory_rate_.assign(num_memory_, 0.0);
   rows_.resize(m_);
   force_.resize(n_);
   tension_.resize(model_.num_cables());
@@ -98,6 +102,30 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
     const HoleNodeRef& hole = layout_.holes()[h];
     stuck_s_[h] = y0[model_.node_offset(hole.cable, hole.node) + 3];
   }
+}
+
+std::vector<double> ArmDynamics::ErrorScales() const {
+  // Coordinates get absolute_tolerance; velocities that over
+  // velocity_tolerance_time_s (an error that moves a position by
+  // absolute_tolerance over that time).
+  std::vector<double> scale(state_size(), 1.0);
+  for (int k = n_; k < 2 * n_; ++k) scale[k] = 1.0 / solver_.velocity_tolerance_time_s;
+  // The smoothed hole friction is a function of the slip speed across a stick
+  // band of v_eps (1e-6 m/s): the slip speeds are resolved to a tenth of it,
+  // or the friction force follows the step sequence rather than the state.
+  if (solver_.hole_friction == HoleFrictionModel::kSmoothed) {
+    const double slip_scale =
+        0.1 * solver_.stick_velocity_tolerance_mps / solver_.absolute_tolerance;
+    for (const HoleNodeRef& hole : layout_.holes()) {
+      double& s = scale[n_ + model_.node_offset(hole.cable, hole.node) + 3];
+      s = std::min(s, slip_scale);
+    }
+  }
+  // A memory z in [0, 1] weighs the static excess mu' - mu (~0.1 or less):
+  // an error of 1e3 absolute_tolerance in z moves a friction coefficient by
+  // ~1e-5 relative, the relative tolerance of everything else.
+  for (int k = memory_offset(); k < state_size(); ++k) scale[k] = 1e3;
+  return scale;
 }
 
 Eigen::VectorXd ArmDynamics::InitialState() const {
@@ -125,6 +153,8 @@ Eigen::VectorXd ArmDynamics::InitialState() const {
       previous = p;
     }
   }
+  // At rest every contact has its full static friction.
+  y.tail(num_memory_).setOnes();
   return y;
 }
 
@@ -137,14 +167,14 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
   force_.setZero();
   dissipation_ = kinetic_ = elastic_ = 0.0;
 
-  ComputeLinkKinematics(q, qd);                // eqs. 21-22, 26
-  if (!AddCableElements(q, qd)) return false;  // eqs. 1-6, 13, 17-20
-  AddHoleFriction(q, qd);                      // eqs. 8-12, stick-slip
-  ComputeJointAngles();                        // eqs. 23-29
-  AddConnectingMoments(q);                     // eqs. 38-58
-  AddLinkInertia(q, qd);                       // eqs. 30-34
-  AddConstraints(t, q, qd);                    // eqs. 35-37, 61-63
-  if (!SolveAugmentedSystem()) return false;   // eqs. 64-68
+  ComputeLinkKinematics(q, qd);                  // eqs. 21-22, 26
+  if (!AddCableElements(q, qd)) return false;    // eqs. 1-6, 13, 17-20
+  AddHoleFriction(q, qd, y + memory_offset());   // eqs. 8-12, stick-slip
+  ComputeJointAngles();                          // eqs. 23-29
+  AddConnectingMoments(q, y + memory_offset());  // eqs. 38-58
+  AddLinkInertia(q, qd);                         // eqs. 30-34
+  AddConstraints(t, q, qd);                      // eqs. 35-37, 61-63
+  if (!SolveAugmentedSystem()) return false;     // eqs. 64-68
   return FinishDerivative(qd, ydot);
 }
 
@@ -215,10 +245,12 @@ bool ArmDynamics::AddCableElements(const double* q, const double* qd) {
 // every node the wrap angle (eq. 12) and limiting static friction (eq. 10).
 // kEvents: on every slipping node; a stuck node's friction is its stick
 // constraint's reaction, known after the solve. kSmoothed: one smooth law
-// of the slip speed on every node, whose slope is smoothed over h like the
-// elastic forces (eqs. 14-16): the moment sees the slip speed averaged over
-// the step, v + (h/2) v_dot, which adds -(h/2) dF/dv to the node's mass.
-void ArmDynamics::AddHoleFriction(const double* q, const double* qd) {
+// of the slip speed and the frictional memory on every node (its memory
+// follows the Stribeck target over tau_f; with tau_f = 0 it is the target),
+// whose slope is smoothed over h like the elastic forces (eqs. 14-16): the
+// force sees the slip speed averaged over the step, v + (h/2) v_dot, which
+// adds -(h/2) dF/dv to the node's mass.
+void ArmDynamics::AddHoleFriction(const double* q, const double* qd, const double* memory) {
   const std::vector<HoleNodeRef>& holes = layout_.holes();
   const HoleFrictionLaw law{parameters_.mu, parameters_.mu_s, parameters_.v_s,
                             solver_.stick_velocity_tolerance_mps};
@@ -237,15 +269,30 @@ void ArmDynamics::AddHoleFriction(const double* q, const double* qd) {
     report.friction_limit =
         LimitingStaticFriction(t_before, t_after, parameters_.mu_s, report.wrap_angle);
     report.required_friction = 0.0;
+    memory_rate_[h] = 0.0;
     const double v = qd[o + 3];
     if (solver_.hole_friction == HoleFrictionModel::kSmoothed) {
-      const HoleFrictionForce f = SmoothedHoleFriction(law, t_before, report.wrap_angle, v);
+      double target_slope = 0.0;
+      const double target = HoleMemoryTarget(law, v, &target_slope);
+      const bool remembers = parameters_.tau_f > 0.0;
+      const double z = remembers ? memory[h] : target;
+      if (remembers) memory_rate_[h] = (target - z) / parameters_.tau_f;
+      const HoleFrictionForce f = SmoothedHoleFriction(law, t_before, report.wrap_angle, v, z);
       report.required_friction = f.force;
       force_[o + 3] += f.force;
       dissipation_ -= f.force * v;
-      // Only a falling force (dF/dv < 0) is smoothed: where the Stribeck
-      // transition makes it rise, a negative added mass would be unphysical.
-      const double added_mass = -0.5 * solver_.smoothing_step_s * std::min(0.0, f.slope);
+      // dF/dv at fixed memory falls across the stick band (dissipative).
+      // Without memory the Stribeck fall adds dF/dz dz/dv, which rises; a
+      // negative added mass would be unphysical, so only a falling total is
+      // smoothed.
+      double slope = f.slope;
+      if (!remembers && target_slope != 0.0) {
+        const double dforce_dz = (f.force + std::max(0.0, t_before)) *
+                                 -(law.mu_static - law.mu_kinetic) * report.wrap_angle *
+                                 (v > 0.0 ? 1.0 : -1.0);
+        slope += dforce_dz * target_slope * (v > 0.0 ? 1.0 : -1.0);
+      }
+      const double added_mass = -0.5 * solver_.smoothing_step_s * std::min(0.0, slope);
       if (added_mass > 0.0) {
         values[layout_.hole_material_diagonal(static_cast<int>(h))] += added_mass;
         hole_smoothing_power_.push_back({o + 3, added_mass * v});
@@ -278,36 +325,10 @@ void ArmDynamics::ComputeJointAngles() {
   }
 }
 
-Eigen::Matrix2d ArmDynamics::ConnectingFrictionSmoothing(const LargeSParams& large, double th_i,
-                                                         double th_j, double rt_i,
-                                                         double rt_j) const {
-  // Model smoothing of the conduit friction (interpretation beyond the
-  // paper, as eqs. 14-16 do for strain): the moments see the rates averaged
-  // over h, theta_dot + (h/2) theta_dd. Linearised, that adds (h/2) J^T C J
-  // to the mass, C = -dM/d(theta_dot), and takes the microsecond time
-  // constant of eq. 45's steep slope out of the explicit integration.
-  const double delta = 1e-3 * large.friction.v_static_mps / large.pulley_radius_m;
-  const ConnectingMoments pi = LargeSMoments(large, th_i, th_j, rt_i + delta, rt_j).moments;
-  const ConnectingMoments mi = LargeSMoments(large, th_i, th_j, rt_i - delta, rt_j).moments;
-  const ConnectingMoments pj = LargeSMoments(large, th_i, th_j, rt_i, rt_j + delta).moments;
-  const ConnectingMoments mj = LargeSMoments(large, th_i, th_j, rt_i, rt_j - delta).moments;
-  Eigen::Matrix2d d;
-  d << pi.on_i - mi.on_i, pj.on_i - mj.on_i, pi.on_j - mi.on_j, pj.on_j - mj.on_j;
-  d /= 2.0 * delta;
-  // Only the dissipative part is kept: the rate dependence of the capstan
-  // stiffness (through mu_m) makes -sym(d) indefinite once the two joints
-  // differ (det = -g^2), and a negative added mass of order (h/2) g^2 / F
-  // dwarfs the link inertia. Clipping the eigenvalues at zero keeps the
-  // smoothing positive semidefinite.
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(-0.5 * (d + d.transpose()));
-  return (0.5 * solver_.smoothing_step_s) * eig.eigenvectors() *
-         eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
-}
-
 // Small-S and large-S moments on both joints of every pair and axis, their
 // model smoothing (added mass), and the joint moments mapped onto the two
 // links' quaternions (eqs. 54-58).
-void ArmDynamics::AddConnectingMoments(const double* q) {
+void ArmDynamics::AddConnectingMoments(const double* q, const double* memory) {
   double* values = system_.values();
   const double h = solver_.smoothing_step_s;
   const std::vector<Eigen::Matrix3d>& rel = relative_rotation_;
@@ -342,14 +363,42 @@ void ArmDynamics::AddConnectingMoments(const double* q) {
         k_conservative = k_now = SmallSStiffness(pair.small);
         damping = pair.small.damping_nmsprad;
       } else {
-        const LargeSResult large = LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j);
+        // The conduit's frictional memory follows eq. 45's static-to-kinetic
+        // target over tau_c_f; with tau_c_f = 0 it is the target (eq. 45).
+        const ModifiedCoulombParams& law = pair.large.friction;
+        const double speed = 0.5 * pair.large.pulley_radius_m * std::abs(rt_i + rt_j);
+        double target_slope = 0.0;
+        const double target = ConduitMemoryTarget(law, speed, &target_slope);
+        const bool remembers = parameters_.tau_c_f > 0.0;
+        const int z_index = pair.memory + axis;
+        const double z = remembers ? memory[z_index] : target;
+        memory_rate_[z_index] = remembers ? (target - z) / parameters_.tau_c_f : 0.0;
+        const LargeSResult large = LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j, z);
         m = large.moments;
         k_conservative = SmallSStiffness({pair.large.axial_stiffness_n, pair.large.pulley_radius_m,
                                           pair.large.cable_length_m, 0.0});
         k_now = large.stiffness_i;
         damping = pair.large.damping_nmsprad;
         if (solver_.smooth_connecting_friction && h > 0.0) {
-          friction_smoothing = ConnectingFrictionSmoothing(pair.large, th_i, th_j, rt_i, rt_j);
+          // Model smoothing of the conduit friction (interpretation beyond
+          // the paper, as eqs. 14-16 do for strain): the friction moments
+          // M_pi = M_pj see the rates averaged over h, theta_dot + (h/2)
+          // theta_dd. Linearised, that adds (h/2) c [1 1; 1 1] to the mass on
+          // (theta_dot_i, theta_dot_j), c = -dM_p/d(theta_dot), and takes the
+          // microsecond time constant of eq. 45's stick band out of the
+          // explicit integration. At fixed memory c >= 0; without memory the
+          // static-to-kinetic fall adds a negative part, and only a
+          // dissipative total is smoothed (a negative added mass is
+          // unphysical). The rate dependence of the capstan stiffness k_lc is
+          // not smoothed: its form is not symmetric and vanishes with mu_m.
+          double c = large.conduit_damping;
+          if (!remembers) {
+            const double tp_r_theta =
+                pair.large.pretension_n * pair.large.pulley_radius_m * pair.large.wrap_angle_rad;
+            c += 0.5 * tp_r_theta * pair.large.pulley_radius_m * (law.mu_static - law.mu_kinetic) *
+                 target_slope;
+          }
+          friction_smoothing.setConstant(0.5 * h * std::max(0.0, c));
         }
       }
       // Model smoothing of the connecting spring and damper (interpretation
@@ -465,7 +514,7 @@ bool ArmDynamics::SolveAugmentedSystem() {
   return true;
 }
 
-// ydot = (q_dot, q_dd, dissipated power); the stuck nodes' required
+// ydot = (q_dot, q_dd, dissipated power, memory rates); the stuck nodes' required
 // friction from their multipliers.
 bool ArmDynamics::FinishDerivative(const double* qd, double* ydot) {
   const Eigen::VectorXd& solution = system_.solution();
@@ -486,6 +535,7 @@ bool ArmDynamics::FinishDerivative(const double* qd, double* ydot) {
   }
   for (const auto& [col, weight] : hole_smoothing_power_) dissipation_ += weight * solution[col];
   ydot[2 * n_] = dissipation_;
+  std::copy(memory_rate_.begin(), memory_rate_.end(), ydot + memory_offset());
 
   // Friction a stuck node needs: the reaction of its constraint, -lambda.
   const std::vector<ConstraintRowLayout>& layout_rows = layout_.rows();
@@ -493,7 +543,7 @@ bool ArmDynamics::FinishDerivative(const double* qd, double* ydot) {
     const int hole = layout_rows[r].hole;
     if (hole >= 0 && rows_[r].active) reports_[hole].required_friction = -solution[n_ + r];
   }
-  for (int k = 0; k < 2 * n_ + 1; ++k) {
+  for (int k = 0; k < state_size(); ++k) {
     if (!std::isfinite(ydot[k])) {
       failure_ = "non-finite acceleration";
       return false;

@@ -6,8 +6,10 @@
 // dynamics.cc); the index bookkeeping of the sparse system lives in
 // sparse_system.h.
 //
-// State y = [q (n), q_dot (n), dissipated energy (1)]; q follows eq. 59:
-// every cable node (x, y, z, s) then every link (x, y, z, e0..e3).
+// State y = [q (n), q_dot (n), dissipated energy (1), frictional memory];
+// q follows eq. 59: every cable node (x, y, z, s) then every link (x, y, z,
+// e0..e3); the memory z in [0, 1] of every hole node, then of every large-S
+// pair's x and y conduit (kernels/hole_friction.h, kernels/connecting.h).
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>
@@ -46,8 +48,16 @@ class ArmDynamics {
               const SolverConfig& solver);
 
   int num_coordinates() const { return n_; }
-  int state_size() const { return 2 * n_ + 1; }
+  int state_size() const { return 2 * n_ + 1 + num_memory_; }
+  // The frictional memory states follow the coordinates, velocities and
+  // dissipated energy.
+  int memory_offset() const { return 2 * n_ + 1; }
+  int num_memory_states() const { return num_memory_; }
   const SolverConfig& solver() const { return solver_; }
+
+  // Per state entry, the factor of solver.absolute_tolerance in the step
+  // control's error bound (GSL's scale_abs).
+  std::vector<double> ErrorScales() const;
 
   // Straight arm at rest, driving cables uniformly strained to T_d0.
   Eigen::VectorXd InitialState() const;
@@ -81,9 +91,9 @@ class ArmDynamics {
   // The stages of Evaluate, in order.
   void ComputeLinkKinematics(const double* q, const double* qd);
   bool AddCableElements(const double* q, const double* qd);
-  void AddHoleFriction(const double* q, const double* qd);
+  void AddHoleFriction(const double* q, const double* qd, const double* memory);
   void ComputeJointAngles();
-  void AddConnectingMoments(const double* q);
+  void AddConnectingMoments(const double* q, const double* memory);
   void AddLinkInertia(const double* q, const double* qd);
   void AddConstraints(double t, const double* q, const double* qd);
   bool SolveAugmentedSystem();
@@ -92,23 +102,22 @@ class ArmDynamics {
   // Phi, its Baumgarte right-hand side b and (with_jacobian) Phi_q of every
   // row (eqs. 35-37, 61-63); needs the link rotations.
   void FillConstraints(double t, const double* q, const double* qd, bool with_jacobian);
-  // (h/2) C of one large-S pair and axis: the smoothing of its conduit friction.
-  Eigen::Matrix2d ConnectingFrictionSmoothing(const LargeSParams& large, double th_i, double th_j,
-                                              double rt_i, double rt_j) const;
 
   const ArmModel& model_;
   const SparseLayout& layout_;
   const CableInputs& inputs_;
   const ArmParameters parameters_;
   const SolverConfig solver_;
-  int n_ = 0;  // coordinates
-  int m_ = 0;  // constraint rows
+  int n_ = 0;           // coordinates
+  int m_ = 0;           // constraint rows
+  int num_memory_ = 0;  // frictional memory states
 
   // Element and connecting-pair kernel parameters of this run.
   AleElementParams ale_;
   struct PairKernel {
     ConnectingKind kind = ConnectingKind::kSmallS;
     int joint_i = 0;  // 1-based; the other joint is joint_i + 1
+    int memory = -1;  // large S: index of its x conduit's memory (y: memory + 1)
     SmallSParams small;
     LargeSParams large;
   };
@@ -117,7 +126,8 @@ class ArmDynamics {
   std::vector<HoleMode> modes_;
   std::vector<double> stuck_s_;
   std::vector<HoleReport> reports_;
-  std::vector<double> initial_s_;  // per cable node, s at t = 0
+  std::vector<double> initial_s_;    // per cable node, s at t = 0
+  std::vector<double> memory_rate_;  // dz/dt of every memory state [1/s]
 
   // Per constraint row: its values at the current state.
   struct RowValues {

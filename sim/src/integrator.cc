@@ -31,10 +31,7 @@ class Rkf45Integrator : public Integrator {
         error_(dim_) {
     UseGslErrorCodes();
     step_ = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rkf45, dim_);
-    // State layout: n coordinates, n velocities, dissipated energy.
-    std::vector<double> scale(dim_, 1.0);
-    const std::size_t n = (dim_ - 1) / 2;
-    for (std::size_t k = n; k < 2 * n; ++k) scale[k] = 1.0 / solver.velocity_tolerance_time_s;
+    const std::vector<double> scale = dynamics->ErrorScales();
     control_ = gsl_odeiv2_control_scaled_new(solver.absolute_tolerance, solver.relative_tolerance,
                                              1.0, 0.0, scale.data(), dim_);
   }

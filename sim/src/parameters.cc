@@ -75,6 +75,20 @@ const std::vector<ParameterInfo>& Parameters() {
       {"v_s", "driving_cables.stribeck_velocity_mps", "m/s", 0.0, 0.1,
        "Stribeck velocity of the holes: the static coefficient falls to the kinetic one over it",
        &P::v_s, 0.0},
+      // Absent: the paper's v_d - v_s (eq. 45's tolerances, 2e-4 - 1e-4 m/s).
+      {"v_c_s", "connecting_cables.stribeck_velocity_mps", "m/s", 0.0, 0.1,
+       "Stribeck velocity of the large-S conduits: the static coefficient falls to the kinetic "
+       "one over it",
+       &P::v_c_s, 1e-4},
+      // 0 is the memoryless law; 1 s is far slower than any frictional lag
+      // reported for dry or lubricated contacts (milliseconds to tens of ms).
+      {"tau_f", "driving_cables.friction_memory_s", "s", 0.0, 1.0,
+       "frictional memory of the holes: time for the coefficient to follow the slip speed",
+       &P::tau_f, 0.0},
+      {"tau_c_f", "connecting_cables.friction_memory_s", "s", 0.0, 1.0,
+       "frictional memory of the large-S conduits: time for the coefficient to follow the slip "
+       "speed",
+       &P::tau_c_f, 0.0},
   };
   return parameters;
 }

@@ -204,6 +204,8 @@ class StepLoop {
     s.rejected_steps = rejected_;
     s.rhs_evaluations = dynamics_.evaluations();
     s.stick_slip_switches = stick_slip_->switches();
+    s.failed_releases = stick_slip_->failed_releases();
+    s.largest_threshold_raise_n = stick_slip_->largest_threshold_raise_n();
     s.max_constraint_violation = sampler_.max_constraint_violation();
     result.trajectory = sampler_.Take();
     return result;
@@ -295,6 +297,12 @@ std::string SimulationSummary::FullReport() const {
   std::snprintf(line, sizeof(line), "  stick-slip switches:       %lld\n",
                 static_cast<long long>(stick_slip_switches));
   out << line;
+  if (failed_releases > 0) {
+    std::snprintf(line, sizeof(line),
+                  "  failed releases:           %lld (threshold raised by up to %.3g N)\n",
+                  static_cast<long long>(failed_releases), largest_threshold_raise_n);
+    out << line;
+  }
   std::snprintf(line, sizeof(line), "  max constraint violation:  %.3g\n",
                 max_constraint_violation);
   out << line;

@@ -89,6 +89,8 @@ class TrialAndError : public StickSlipTreatment {
   }
 
   std::int64_t switches() const override { return switches_; }
+  std::int64_t failed_releases() const override { return failed_releases_; }
+  double largest_threshold_raise_n() const override { return largest_raise_n_; }
   const std::string& failure() const override { return failure_; }
 
  private:
@@ -187,6 +189,8 @@ class TrialAndError : public StickSlipTreatment {
         if (release_time_[h] >= 0.0 &&
             t - release_time_[h] <= kFailedReleaseWindow * solver_.switch_time_tolerance_s) {
           pinned_excess_[h] = release_excess_[h] + solver_.stick_force_tolerance_n;
+          ++failed_releases_;
+          largest_raise_n_ = std::max(largest_raise_n_, pinned_excess_[h]);
         }
       }
     }
@@ -300,6 +304,8 @@ class TrialAndError : public StickSlipTreatment {
   const std::size_t dim_;
   std::vector<double> scratch_;
   std::int64_t switches_ = 0;
+  std::int64_t failed_releases_ = 0;
+  double largest_raise_n_ = 0.0;
   std::string failure_;
   int stalled_events_ = 0;
   double last_event_t_ = -1.0;

@@ -35,6 +35,11 @@ class StickSlipTreatment {
                             double* y) = 0;
 
   virtual std::int64_t switches() const = 0;  // stick-slip switches so far
+  // Releases undone at once, after which a node's release threshold was
+  // raised (the failed-release rule, docs/model-notes.md row 16), and the
+  // largest such raise above f_max [N]. 0 where there is no such rule.
+  virtual std::int64_t failed_releases() const = 0;
+  virtual double largest_threshold_raise_n() const = 0;
   virtual const std::string& failure() const = 0;
 };
 

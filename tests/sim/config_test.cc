@@ -59,8 +59,11 @@ TEST(Config, PaperConfigurationHoldsTable1) {
   EXPECT_DOUBLE_EQ(c.arm.driving.youngs_modulus_pa, 2.6e10);
   EXPECT_DOUBLE_EQ(c.parameters.T_p, 50.0);
   EXPECT_DOUBLE_EQ(c.parameters.mu_s, 0.21);
-  EXPECT_EQ(c.solver.hole_friction, HoleFrictionModel::kEvents);
-  EXPECT_DOUBLE_EQ(c.parameters.v_s, 1e-3);
+  EXPECT_EQ(c.solver.hole_friction, HoleFrictionModel::kSmoothed);
+  EXPECT_DOUBLE_EQ(c.parameters.v_s, 5e-3);
+  EXPECT_DOUBLE_EQ(c.parameters.v_c_s, 5e-3);
+  EXPECT_DOUBLE_EQ(c.parameters.tau_f, 0.01);
+  EXPECT_DOUBLE_EQ(c.parameters.tau_c_f, 0.01);
   EXPECT_DOUBLE_EQ(c.solver.smoothing_step_s, 0.01);
   EXPECT_DOUBLE_EQ(c.protocol.duration_s(), 48.0);
   EXPECT_EQ(c.arm.segment_of_link(6), 0);
@@ -121,21 +124,38 @@ TEST(Config, YamlRoundTripKeepsEveryValue) {
 }
 
 TEST(Config, KeysAddedLaterMayBeLeftOutAndMeanThePapersLaw) {
-  // `solver.hole_friction` and `driving_cables.stribeck_velocity_mps` came
-  // after ccsrm-config/1 was first published; a run file's config_yaml from
-  // before them still parses, with the paper's trial and error and no
-  // Stribeck transition.
-  std::string old = Edited("  hole_friction: events\n", "");
-  old.replace(old.find("  stribeck_velocity_mps: 1.0e-3\n"), 32, "");
+  // `solver.hole_friction`, the Stribeck velocities and the frictional
+  // memories came after ccsrm-config/1 was first published; a run file's
+  // config_yaml from before them still parses, with the paper's trial and
+  // error, no Stribeck transition in the holes, no memory, and the conduits'
+  // fall closed by the paper's v_d (so v_c_s = v_d - v_s).
+  std::string old = Edited("  hole_friction: smoothed\n", "");
+  for (const std::string line :
+       {"  stribeck_velocity_mps: 5.0e-3\n", "  friction_memory_s: 0.01\n",
+        "  stribeck_velocity_mps: 5.0e-3\n", "  friction_memory_s: 0.01\n"}) {
+    old.replace(old.find(line), line.size(), "");
+  }
+  const std::string v_s_line = "  large_s_static_velocity_mps: 1.0e-4";
+  const std::string with_v_d = old;
+  old.insert(old.find(v_s_line), "  large_s_dynamic_velocity_mps: 3.0e-4\n");
   const Config c = ParseConfig(old, "old.yaml");
   EXPECT_EQ(c.solver.hole_friction, HoleFrictionModel::kEvents);
   EXPECT_EQ(c.parameters.v_s, 0.0);
-  EXPECT_EQ(ParseConfig(Edited("hole_friction: events", "hole_friction: smoothed"), "s.yaml")
+  EXPECT_EQ(c.parameters.tau_f, 0.0);
+  EXPECT_EQ(c.parameters.tau_c_f, 0.0);
+  EXPECT_NEAR(c.parameters.v_c_s, 2.0e-4, 1e-18);
+  EXPECT_EQ(ParseConfig(with_v_d, "no_v_d.yaml").parameters.v_c_s, 1.0e-4);
+  EXPECT_EQ(ParseConfig(Edited("hole_friction: smoothed", "hole_friction: events"), "s.yaml")
                 .solver.hole_friction,
-            HoleFrictionModel::kSmoothed);
-  EXPECT_THAT(ErrorOf(Edited("hole_friction: events", "hole_friction: sticky")),
+            HoleFrictionModel::kEvents);
+  EXPECT_THAT(ErrorOf(Edited("hole_friction: smoothed", "hole_friction: sticky")),
               HasSubstr("key 'solver.hole_friction': expected one of 'events', 'smoothed', 'off', "
                         "found 'sticky'"));
+  // The old key and the new one together are ambiguous.
+  std::string both = PaperText();
+  both.insert(both.find(v_s_line), "  large_s_dynamic_velocity_mps: 2.0e-4\n");
+  EXPECT_THAT(ErrorOf(both), HasSubstr("key 'solver.large_s_dynamic_velocity_mps': replaced by "
+                                       "connecting_cables.stribeck_velocity_mps"));
 }
 
 TEST(Config, ValidateRejectsConfigBuiltInCode) {

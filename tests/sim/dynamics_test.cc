@@ -117,6 +117,7 @@ TEST(ArmDynamics, EnergyIsConservedWithoutDissipation) {
   SwitchOffDissipation(&c.parameters);
   c.parameters.T_d0 = 1.0;  // strain 2.9e-3, as T_d0 gives the real cable
   c.solver.smoothing_step_s = 0.0;
+  c.solver.hole_friction = HoleFrictionModel::kOff;  // frictionless holes
   c.solver.relative_tolerance = 1e-9;
   c.solver.absolute_tolerance = 1e-12;
   c.solver.max_step_s = 1e-4;

@@ -104,7 +104,6 @@ struct SolverConfig {
   double stick_velocity_tolerance_mps = 1e-6;
   double stick_force_tolerance_n = 1e-3;
   double large_s_static_velocity_mps = 1e-4;
-  double large_s_dynamic_velocity_mps = 2e-4;
   double relative_tolerance = 1e-5;
   double absolute_tolerance = 1e-7;
   // Velocities get the absolute tolerance absolute_tolerance / this time: a

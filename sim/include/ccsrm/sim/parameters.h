@@ -27,6 +27,13 @@ struct ArmParameters {
   double T_p = 0.0;     // pre-tension of the connecting cables [N]
   double T_d0 = 0.0;    // pre-tension of the driving cables [N]
   double v_s = 0.0;     // Stribeck velocity of the holes: mu' falls to mu over it [m/s]
+  double v_c_s =
+      0.0;  // Stribeck velocity of the large-S conduits: mu'_c falls to mu_c over it [m/s]
+  // Frictional memory: how long the holes' (tau_f) and the conduits'
+  // (tau_c_f) friction takes to follow a change of slip speed between its
+  // static and kinetic values [s]; 0 follows at once.
+  double tau_f = 0.0;
+  double tau_c_f = 0.0;
 
   // False (with the table's message in *error) when a value is outside its
   // bounds or not finite.
@@ -48,7 +55,7 @@ struct ParameterInfo {
 };
 
 // Every named parameter: SPEC 6's nine in its order (mu, mu_s, mu_c,
-// mu_c_s, beta, c_sc, c_lc, T_p, T_d0), then v_s.
+// mu_c_s, beta, c_sc, c_lc, T_p, T_d0), then v_s, v_c_s, tau_f, tau_c_f.
 const std::vector<ParameterInfo>& Parameters();
 
 // The entry of `name`. Throws InputError("<where>: unknown parameter 'x'

@@ -91,7 +91,11 @@ struct SimulationSummary {
   std::int64_t steps = 0;         // accepted steps
   std::int64_t rejected_steps = 0;
   std::int64_t rhs_evaluations = 0;
-  std::int64_t stick_slip_switches = 0;
+  std::int64_t stick_slip_switches = 0;  // solver.hole_friction: events only
+  // Events: releases undone at once, each raising that node's release
+  // threshold above f_max (docs/model-notes.md row 16), and the largest raise.
+  std::int64_t failed_releases = 0;
+  double largest_threshold_raise_n = 0.0;
   double max_constraint_violation = 0.0;  // largest |Phi| over the sampled frames
 
   // One line; and the one-screen summary of SPEC 3.
