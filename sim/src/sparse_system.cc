@@ -1,6 +1,8 @@
 #include "sparse_system.h"
 
+#include <Eigen/OrderingMethods>
 #include <algorithm>
+#include <memory>
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/sim/model.h"
@@ -24,7 +26,10 @@ SparseLayout::SparseLayout(const ArmModel& model) : n_(model.num_coordinates()) 
   }
 
   // Constraint rows.
-  auto add_row = [&](const std::vector<int>& cols, int hole) {
+  // `owner`: a coordinate of the block the row is eliminated with (see
+  // InterleavedBlockOrder).
+  auto add_row = [&](const std::vector<int>& cols, int hole, int owner) {
+    row_owner_.push_back(owner);
     ConstraintRowLayout row;
     CCSRM_CHECK(static_cast<int>(cols.size()) <= ConstraintRowLayout::kMaxColumns);
     for (int col : cols) row.cols[row.count++] = col;
@@ -45,29 +50,29 @@ SparseLayout::SparseLayout(const ArmModel& model) : n_(model.num_coordinates()) 
       for (int a = 0; a < 3; ++a) {
         std::vector<int> cols{o + a};
         if (cable.nodes[k].link > 0) link_cols(cable.nodes[k].link, a, &cols);
-        add_row(cols, -1);
+        add_row(cols, -1, o + a);
       }
       const bool is_hole = cable.nodes[k].kind == CableNodeModel::Kind::kHole;
-      add_row({o + 3}, is_hole ? hole++ : -1);
+      add_row({o + 3}, is_hole ? hole++ : -1, o + 3);
     }
   }
   for (int i = 1; i <= model.num_links(); ++i) {
     const int o = model.link_offset(i);
-    add_row({o + 3, o + 4, o + 5, o + 6}, -1);
+    add_row({o + 3, o + 4, o + 5, o + 6}, -1, o + 3);
   }
   for (int j = 1; j <= model.num_joints(); ++j) {
     for (int a = 0; a < 3; ++a) {
       std::vector<int> cols;
       if (j > 1) link_cols(j - 1, a, &cols);
       link_cols(j, a, &cols);
-      add_row(cols, -1);
+      add_row(cols, -1, model.link_offset(j) + a);
     }
     std::vector<int> cols;
     for (int link : {j - 1, j}) {
       if (link < 1) continue;
       for (int k = 3; k < 7; ++k) cols.push_back(model.link_offset(link) + k);
     }
-    add_row(cols, -1);
+    add_row(cols, -1, model.link_offset(j) + 3);
   }
   m_ = static_cast<int>(rows_.size());
 
@@ -115,22 +120,14 @@ SparseLayout::SparseLayout(const ArmModel& model) : n_(model.num_coordinates()) 
     }
     pattern.emplace_back(n_ + r, n_ + r, 0.0);
   }
-  {
-    // AMD on the pattern, in the convention of Eigen's own ordering step:
-    // the ordering yields the inverse permutation.
-    Eigen::SparseMatrix<double> model_order(n_ + m_, n_ + m_);
-    model_order.setFromTriplets(pattern.begin(), pattern.end());
-    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> inverse;
-    Eigen::AMDOrdering<int>()(model_order, inverse);
-    const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> order = inverse.inverse();
-    order_.assign(order.indices().data(), order.indices().data() + n_ + m_);
-    for (auto& entry : pattern) {
-      entry = Eigen::Triplet<double>(order_[entry.row()], order_[entry.col()], 0.0);
-    }
+  order_ = InterleavedBlockOrder(model, pattern);
+  for (auto& entry : pattern) {
+    entry = Eigen::Triplet<double>(order_[entry.row()], order_[entry.col()], 0.0);
   }
   pattern_.resize(n_ + m_, n_ + m_);
   pattern_.setFromTriplets(pattern.begin(), pattern.end());
   pattern_.makeCompressed();
+  factorisation_ = std::make_unique<const SupernodalStructure>(pattern_);
 
   for (int c = 0; c < model.num_cables(); ++c) {
     for (int e = 0; e < model.cables()[c].num_elements(); ++e) {
@@ -170,6 +167,87 @@ SparseLayout::SparseLayout(const ArmModel& model) : n_(model.num_coordinates()) 
   }
 }
 
+// The elimination order. Under a scalar fill-reducing order the multiplier
+// rows, having the fewest neighbours, come first and are pivoted on their
+// own -delta = -1e-10 diagonal; the resulting growth cost q_dd five digits.
+// Here the unknowns are grouped into blocks (a cable node's 4 coordinates, a
+// link's 7), each constraint row joins the block of the coordinate it is
+// written for (a cable node's rows their node, a link's unit-quaternion row
+// and a joint's rows the child link), and every block is eliminated
+// coordinates first, rows after. A row's pivot is then -delta minus the
+// Schur value of its block's coordinates, O(1) and negative, and the
+// coordinates' pivots stay O(1) and positive: static pivots are stable.
+// The blocks are ordered by AMD on the block graph, each block expanded to
+// all of its unknowns so that AMD weighs blocks by their size. Rows riding
+// along in the fronts until their block comes make L about 1.7 times as
+// full as under the scalar order (26k against 14k nonzeros on the paper's
+// arm); the dense supernodal kernels make up for it. Finer groups
+// (a row with one coordinate, a link's quaternion with its two quaternion
+// rows) measured no better.
+std::vector<int> SparseLayout::InterleavedBlockOrder(
+    const ArmModel& model, const std::vector<Eigen::Triplet<double>>& pattern) const {
+  const int size = n_ + m_;
+  std::vector<int> block_of(size, -1);
+  std::vector<std::vector<int>> members;
+  // Members: coordinates, then rows. The coordinate coupled to all others
+  // of its block goes first (a cable node's s, through the element mass; a
+  // link's quaternion, through its position rows), so that eliminating it
+  // fills the block in and the whole block is one supernode.
+  auto add_block = [&](std::initializer_list<int> coordinates) {
+    for (int k : coordinates) block_of[k] = static_cast<int>(members.size());
+    members.emplace_back(coordinates);
+  };
+  for (int c = 0; c < model.num_cables(); ++c) {
+    for (int k = 0; k < static_cast<int>(model.cables()[c].nodes.size()); ++k) {
+      const int o = model.node_offset(c, k);
+      add_block({o + 3, o, o + 1, o + 2});
+    }
+  }
+  for (int i = 1; i <= model.num_links(); ++i) {
+    const int o = model.link_offset(i);
+    add_block({o + 3, o + 4, o + 5, o + 6, o, o + 1, o + 2});
+  }
+  const int num_blocks = static_cast<int>(members.size());
+  for (int r = 0; r < m_; ++r) {
+    block_of[n_ + r] = block_of[row_owner_[r]];
+    members[block_of[n_ + r]].push_back(n_ + r);
+  }
+  for (int k = 0; k < size; ++k) CCSRM_CHECK(block_of[k] >= 0);
+
+  std::vector<std::vector<int>> neighbours(num_blocks);
+  for (const auto& entry : pattern) {
+    neighbours[block_of[entry.row()]].push_back(block_of[entry.col()]);
+  }
+  std::vector<Eigen::Triplet<double>> expanded;
+  for (int b = 0; b < num_blocks; ++b) {
+    std::vector<int>& adjacent = neighbours[b];
+    std::sort(adjacent.begin(), adjacent.end());
+    adjacent.erase(std::unique(adjacent.begin(), adjacent.end()), adjacent.end());
+    for (int other : adjacent)
+      for (int i : members[b])
+        for (int j : members[other]) expanded.emplace_back(i, j, 1.0);
+  }
+  Eigen::SparseMatrix<double> graph(size, size);
+  graph.setFromTriplets(expanded.begin(), expanded.end());
+  // Eigen's ordering yields the inverse permutation: indices()[k] is the
+  // unknown eliminated k-th.
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> inverse;
+  Eigen::AMDOrdering<int>()(graph, inverse);
+
+  // Blocks in the order their first unknown appears, each laid out whole.
+  std::vector<int> order(size, -1);
+  std::vector<char> placed(num_blocks, 0);
+  int position = 0;
+  for (int k = 0; k < size; ++k) {
+    const int b = block_of[inverse.indices()[k]];
+    if (placed[b]) continue;
+    placed[b] = 1;
+    for (int unknown : members[b]) order[unknown] = position++;
+  }
+  CCSRM_CHECK(position == size);
+  return order;
+}
+
 int SparseLayout::Index(int model_row, int model_col) const {
   const int row = order_[model_row], col = order_[model_col];
   const int* inner = pattern_.innerIndexPtr();
@@ -181,14 +259,11 @@ int SparseLayout::Index(int model_row, int model_col) const {
 }
 
 AugmentedSystem::AugmentedSystem(const SparseLayout& layout)
-    : layout_(layout), matrix_(layout.pattern()) {
+    : layout_(layout), matrix_(layout.pattern()), ldlt_(layout.factorisation()) {
   const int size = layout.num_coordinates() + layout.num_constraints();
-  // The symbolic analysis of the fixed pattern, once per run.
-  ldlt_.analyzePattern(matrix_);
   rhs_.setZero(size);
   solution_.setZero(size);
-  ordered_rhs_.setZero(size);
-  ordered_solution_.setZero(size);
+  ordered_.setZero(size);
 }
 
 void AugmentedSystem::Clear() {
@@ -197,13 +272,12 @@ void AugmentedSystem::Clear() {
 }
 
 bool AugmentedSystem::Solve() {
-  ldlt_.factorize(matrix_);
-  if (ldlt_.info() != Eigen::Success) return false;
+  if (!ldlt_.Factorize(matrix_.valuePtr())) return false;
   const std::vector<int>& order = layout_.order();
   const int size = static_cast<int>(order.size());
-  for (int k = 0; k < size; ++k) ordered_rhs_[order[k]] = rhs_[k];
-  ordered_solution_ = ldlt_.solve(ordered_rhs_);
-  for (int k = 0; k < size; ++k) solution_[k] = ordered_solution_[order[k]];
+  for (int k = 0; k < size; ++k) ordered_[order[k]] = rhs_[k];
+  ldlt_.Solve(ordered_);
+  for (int k = 0; k < size; ++k) solution_[k] = ordered_[order[k]];
   return true;
 }
 

@@ -4,12 +4,15 @@
 //   [ Phi_q               D       ] [ lambda ] = [ -b            ],
 // kept apart from the physics: SparseLayout is the topology (which
 // coordinates each constraint row, element, link and connecting pair
-// touches), the sparsity pattern and its fill-reducing ordering, built once
-// per ArmModel and shared read-only by every run; AugmentedSystem is one
-// run's matrix values, right-hand side and factorisation over it.
-#include <Eigen/SparseCholesky>
+// touches), the sparsity pattern, its elimination order and the symbolic
+// supernodal factorisation, built once per ArmModel and shared read-only by
+// every run; AugmentedSystem is one run's matrix values, right-hand side
+// and numeric factorisation over it.
 #include <Eigen/SparseCore>
+#include <memory>
 #include <vector>
+
+#include "supernodal_ldlt.h"
 
 namespace ccsrm::sim {
 class ArmModel;
@@ -64,18 +67,23 @@ class SparseLayout {
   // The (s, s) entry of hole node h (its material coordinate).
   int hole_material_diagonal(int h) const { return hole_index_[h]; }
 
-  // The pattern with zero values, stored in the fill-reducing (AMD) order,
-  // and the position of model unknown k in that order.
+  // The pattern with zero values, stored in the elimination order (see
+  // InterleavedBlockOrder), and the position of model unknown k in it.
   const Eigen::SparseMatrix<double>& pattern() const { return pattern_; }
   const std::vector<int>& order() const { return order_; }
+  // The symbolic factorisation of the pattern in that order.
+  const SupernodalStructure& factorisation() const { return *factorisation_; }
 
  private:
   int Index(int model_row, int model_col) const;
+  std::vector<int> InterleavedBlockOrder(const ArmModel& model,
+                                         const std::vector<Eigen::Triplet<double>>& pattern) const;
 
   int n_ = 0;
   int m_ = 0;
   std::vector<HoleNodeRef> holes_;
   std::vector<ConstraintRowLayout> rows_;
+  std::vector<int> row_owner_;  // per row, a coordinate of the block it is eliminated with
   std::vector<std::vector<int>> pair_links_;
   Eigen::SparseMatrix<double> pattern_;
   std::vector<int> order_;
@@ -86,10 +94,11 @@ class SparseLayout {
   std::vector<int> row_pair_index_, row_pair_offset_;
   std::vector<int> row_diag_index_;
   std::vector<int> hole_index_;
+  std::unique_ptr<const SupernodalStructure> factorisation_;
 };
 
 // One run's augmented system over a shared layout. The matrix is stored
-// (both triangles) in the layout's fill-reducing order, so that each
+// (both triangles) in the layout's elimination order, so that each
 // factorisation reads it in place instead of permuting a copy; the
 // right-hand side and the solution are in the model's order.
 class AugmentedSystem {
@@ -109,10 +118,9 @@ class AugmentedSystem {
  private:
   const SparseLayout& layout_;
   Eigen::SparseMatrix<double> matrix_;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper, Eigen::NaturalOrdering<int>>
-      ldlt_;
+  SupernodalLdlt ldlt_;
   Eigen::VectorXd rhs_, solution_;
-  Eigen::VectorXd ordered_rhs_, ordered_solution_;
+  Eigen::VectorXd ordered_;  // right-hand side, then solution, in elimination order
 };
 
 }  // namespace ccsrm::sim::internal
