@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
-
 #include "ccsrm/common/error.h"
 #include "ccsrm/sim/kinematics.h"
 #include "kernels/ale_element.h"
@@ -285,12 +283,12 @@ void ArmDynamics::AddHoleFriction(const double* q, const double* qd, const doubl
       // Without memory the Stribeck fall adds dF/dz dz/dv, which rises; a
       // negative added mass would be unphysical, so only a falling total is
       // smoothed.
+      // The fall lies beyond the band, where r(v) = sgn(v): dF/dz =
+      // -(F + T_b) (mu' - mu) theta sgn(v) and dz/dv = target' sgn(v).
       double slope = f.slope;
-      if (!remembers && target_slope != 0.0) {
-        const double dforce_dz = (f.force + std::max(0.0, t_before)) *
-                                 -(law.mu_static - law.mu_kinetic) * report.wrap_angle *
-                                 (v > 0.0 ? 1.0 : -1.0);
-        slope += dforce_dz * target_slope * (v > 0.0 ? 1.0 : -1.0);
+      if (!remembers) {
+        slope -= (f.force + std::max(0.0, t_before)) * (law.mu_static - law.mu_kinetic) *
+                 report.wrap_angle * target_slope;
       }
       const double added_mass = -0.5 * solver_.smoothing_step_s * std::min(0.0, slope);
       if (added_mass > 0.0) {
@@ -366,7 +364,7 @@ void ArmDynamics::AddConnectingMoments(const double* q, const double* memory) {
         // The conduit's frictional memory follows eq. 45's static-to-kinetic
         // target over tau_c_f; with tau_c_f = 0 it is the target (eq. 45).
         const ModifiedCoulombParams& law = pair.large.friction;
-        const double speed = 0.5 * pair.large.pulley_radius_m * std::abs(rt_i + rt_j);
+        const double speed = std::abs(ConduitSlipVelocity(pair.large, rt_i, rt_j));
         double target_slope = 0.0;
         const double target = ConduitMemoryTarget(law, speed, &target_slope);
         const bool remembers = parameters_.tau_c_f > 0.0;

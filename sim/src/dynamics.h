@@ -52,7 +52,6 @@ class ArmDynamics {
   // The frictional memory states follow the coordinates, velocities and
   // dissipated energy.
   int memory_offset() const { return 2 * n_ + 1; }
-  int num_memory_states() const { return num_memory_; }
   const SolverConfig& solver() const { return solver_; }
 
   // Per state entry, the factor of solver.absolute_tolerance in the step

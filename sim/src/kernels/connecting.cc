@@ -66,12 +66,15 @@ double CapstanFactor(double x) {
   return -x / std::expm1(-x);
 }
 
+double ConduitSlipVelocity(const LargeSParams& params, double theta_i_dot, double theta_j_dot) {
+  // Sign chosen so that the friction moments dissipate (see the header).
+  return -0.5 * params.pulley_radius_m * (theta_i_dot + theta_j_dot);
+}
+
 LargeSResult LargeSMoments(const LargeSParams& params, double theta_i, double theta_j,
                            double theta_i_dot, double theta_j_dot, double memory) {
   LargeSResult out;
-  // Sliding speeds of the couple in the conduit; sign chosen so that the
-  // friction moments dissipate (see the header).
-  out.slip_velocity_1 = -0.5 * params.pulley_radius_m * (theta_i_dot + theta_j_dot);
+  out.slip_velocity_1 = ConduitSlipVelocity(params, theta_i_dot, theta_j_dot);
   const double v2 = -out.slip_velocity_1;
   double slope = 0.0;
   const double a1 =

@@ -45,9 +45,9 @@ struct ModifiedCoulombParams {
 //   |v| > v_d:        -mu_c sgn v
 //   v_s <= |v| <= v_d: -[mu'_c + (mu_c - mu'_c) x^2 (3 - 2x)] sgn v,
 //                      x = (|v| - v_s) / (v_d - v_s)     (corrected, continuous)
-// with v_d = v_s + v_c_s.
 //   |v| < v_s:        mu'_c - 2 mu'_c u^2 (3 - 2u), u = (v + v_s) / (2 v_s)
-//                      (the paper's lower branch: +mu'_c at -v_s, 0 at 0, -mu'_c at v_s).
+//                      (the paper's lower branch: +mu'_c at -v_s, 0 at 0, -mu'_c at v_s),
+// with v_d = v_s + v_c_s.
 // Continuous and C1 at |v| = v_s and |v| = v_d (v_c_s > 0). Preconditions: v_s > 0,
 // v_c_s >= 0.
 // It is ModifiedCoulombWithMemory at the memory's steady value.
@@ -97,6 +97,9 @@ struct LargeSResult {
   // damping across the stick band.
   double conduit_damping = 0.0;
 };
+
+// v_tau1 [m/s], the sliding speed of the couple in the conduit (below).
+double ConduitSlipVelocity(const LargeSParams& params, double theta_i_dot, double theta_j_dot);
 
 // Evaluates eqs. 45-53 with the sliding speeds
 //   v_tau1 = -r_lc (theta_i_dot + theta_j_dot) / 2,  v_tau2 = -v_tau1,

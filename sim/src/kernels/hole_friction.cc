@@ -32,18 +32,6 @@ double HoleSlipFriction(double tension_before, double mu, double wrap_angle, dou
   return t_b * std::expm1(-mu * wrap_angle * sigma);
 }
 
-double HoleFrictionCoefficient(const HoleFrictionLaw& law, double speed, double* slope) {
-  const double beyond = std::abs(speed) - law.stick_velocity_mps;
-  const double excess = law.mu_static - law.mu_kinetic;
-  if (slope != nullptr) *slope = 0.0;
-  if (beyond <= 0.0 || excess == 0.0) return beyond <= 0.0 ? law.mu_static : law.mu_kinetic;
-  if (!(law.stribeck_velocity_mps > 0.0)) return law.mu_kinetic;
-  const double x = beyond / law.stribeck_velocity_mps;
-  const double decay = std::exp(-x * x);
-  if (slope != nullptr) *slope = -2.0 * x * excess * decay / law.stribeck_velocity_mps;
-  return law.mu_kinetic + excess * decay;
-}
-
 double HoleMemoryTarget(const HoleFrictionLaw& law, double speed, double* slope) {
   if (slope != nullptr) *slope = 0.0;
   const double beyond = std::abs(speed) - law.stick_velocity_mps;
@@ -53,6 +41,17 @@ double HoleMemoryTarget(const HoleFrictionLaw& law, double speed, double* slope)
   const double decay = std::exp(-x * x);
   if (slope != nullptr) *slope = -2.0 * x * decay / law.stribeck_velocity_mps;
   return decay;
+}
+
+double HoleFrictionCoefficient(const HoleFrictionLaw& law, double speed, double* slope) {
+  const double excess = law.mu_static - law.mu_kinetic;
+  double target_slope = 0.0;
+  const double target = HoleMemoryTarget(law, speed, &target_slope);
+  if (slope != nullptr) *slope = excess * target_slope;
+  // The ends exactly: mu' in the stick band, mu once the fall is over.
+  if (target == 1.0) return law.mu_static;
+  if (target == 0.0 || excess == 0.0) return law.mu_kinetic;
+  return law.mu_kinetic + excess * target;
 }
 
 HoleFrictionForce SmoothedHoleFriction(const HoleFrictionLaw& law, double tension_before,

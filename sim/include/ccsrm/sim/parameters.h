@@ -27,8 +27,8 @@ struct ArmParameters {
   double T_p = 0.0;     // pre-tension of the connecting cables [N]
   double T_d0 = 0.0;    // pre-tension of the driving cables [N]
   double v_s = 0.0;     // Stribeck velocity of the holes: mu' falls to mu over it [m/s]
-  double v_c_s =
-      0.0;  // Stribeck velocity of the large-S conduits: mu'_c falls to mu_c over it [m/s]
+  // Stribeck velocity of the large-S conduits: mu'_c falls to mu_c over it [m/s]
+  double v_c_s = 0.0;
   // Frictional memory: how long the holes' (tau_f) and the conduits'
   // (tau_c_f) friction takes to follow a change of slip speed between its
   // static and kinetic values [s]; 0 follows at once.
