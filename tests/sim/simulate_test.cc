@@ -261,5 +261,19 @@ TEST(Simulate, InvalidParametersAreRefusedWithTheTableMessage) {
   }
 }
 
+TEST(Simulate, SummaryReportsFailedReleasesOnlyWhereThereAreSome) {
+  // The events treatment's failed-release rule raises thresholds; the
+  // summary says how often and by how much, and says nothing when it never
+  // fired (the smoothed treatment has no such rule).
+  SimulationSummary s;
+  EXPECT_EQ(s.FullReport().find("failed releases"), std::string::npos);
+  s.failed_releases = 65;
+  s.largest_threshold_raise_n = 0.214;
+  EXPECT_NE(
+      s.FullReport().find("failed releases:           65 (threshold raised by up to 0.214 N)"),
+      std::string::npos)
+      << s.FullReport();
+}
+
 }  // namespace
 }  // namespace ccsrm::sim
