@@ -15,4 +15,5 @@ void AddGenerateCommand(CLI::App& root);
 void AddCamerasCommands(CLI::App& root);
 void AddReportCommand(CLI::App& root);
 void AddDerivativesCommand(CLI::App& root);
+void AddIdentifyCommand(CLI::App& root);
 }  // namespace ccsrm::app

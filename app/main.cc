@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   ccsrm::app::AddCamerasCommands(root);
   ccsrm::app::AddReportCommand(root);
   ccsrm::app::AddDerivativesCommand(root);
+  ccsrm::app::AddIdentifyCommand(root);
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

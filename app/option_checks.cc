@@ -1,9 +1,41 @@
 #include "option_checks.h"
 
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
 #include <functional>
 #include <sstream>
 
+#include "ccsrm/common/error.h"
+
 namespace ccsrm::app {
+
+std::vector<std::string> SplitList(const std::string& text, const std::string& option) {
+  std::vector<std::string> items;
+  std::size_t begin = 0;
+  while (true) {
+    const std::size_t end = text.find(',', begin);
+    std::string item = text.substr(begin, end == std::string::npos ? end : end - begin);
+    const std::size_t first = item.find_first_not_of(" \t");
+    const std::size_t last = item.find_last_not_of(" \t");
+    item = first == std::string::npos ? "" : item.substr(first, last - first + 1);
+    if (item.empty()) ThrowInputError(option, "", "empty item in '" + text + "'");
+    items.push_back(item);
+    if (end == std::string::npos) return items;
+    begin = end + 1;
+  }
+}
+
+double ParseNumber(const std::string& text, const std::string& option) {
+  errno = 0;
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || errno != 0 || !std::isfinite(value)) {
+    ThrowInputError(option, "", "'" + text + "' is not a number");
+  }
+  return value;
+}
+
 namespace {
 
 // A bound as a user would write it: "60", "0.001".

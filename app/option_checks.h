@@ -6,8 +6,16 @@
 #include <CLI/CLI.hpp>
 
 #include <string>
+#include <vector>
 
 namespace ccsrm::app {
+
+// "a, b,c" -> {"a", "b", "c"}; throws InputError naming `option` for an
+// empty item.
+std::vector<std::string> SplitList(const std::string& text, const std::string& option);
+
+// A finite number, whole text; throws InputError naming `option` otherwise.
+double ParseNumber(const std::string& text, const std::string& option);
 
 // A number in [min, max] (NaN refused); `unit` follows the bounds in the
 // message ("deg", or "" for none).

@@ -1,0 +1,173 @@
+// ccsrm identify --data exp1.h5 [exp2.h5 ...] [--free mu,mu_s,...] [--params p.yaml]
+//                [--set name=value ...] [--threads N] --out fit/
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/common/error.h"
+#include "ccsrm/identify/experiment.h"
+#include "ccsrm/identify/identification.h"
+#include "ccsrm/sim/parameters.h"
+#include "commands.h"
+#include "option_checks.h"
+
+namespace ccsrm::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Exit status of a fit that did not converge (its outputs are written) and
+// of one that failed.
+constexpr int kNotConverged = 4;
+constexpr int kFitFailed = 3;
+
+struct IdentifyArgs {
+  std::vector<std::string> data;
+  std::string free;
+  std::string params;
+  std::vector<std::string> set;
+  int threads = identify::DefaultThreads();
+  int max_iterations = identify::IdentificationOptions().max_iterations;
+  double relative_step = identify::IdentificationOptions().relative_step;
+  double noise_deg = 0.0;  // 0: estimated
+  std::string out;
+  bool quiet = false;
+};
+
+int RunIdentify(const IdentifyArgs& a) {
+  // Everything is checked before the first simulation: options, output path,
+  // every experiment file.
+  identify::IdentificationOptions options;
+  options.threads = a.threads;
+  options.max_iterations = a.max_iterations;
+  options.relative_step = a.relative_step;
+  if (!a.free.empty()) options.free_parameters = SplitList(a.free, "--free");
+  for (const std::string& name : options.free_parameters) sim::FindParameter(name, "--free");
+  if (!a.params.empty()) {
+    identify::ApplyParameterFile(ReadTextFile(a.params), a.params, &options);
+  }
+  for (const std::string& text : a.set) {
+    const auto [name, value] = sim::ParseParameterAssignment(text, "--set");
+    const std::string problem =
+        sim::ParameterValueProblem(sim::FindParameter(name, "--set"), value);
+    if (!problem.empty()) ThrowInputError("--set", "", problem);
+    options.values[name] = value;
+  }
+  std::string error;
+  if (!options.IsValid(&error)) ThrowInputError("identify", "", error);
+  for (const std::string& path : a.data) {
+    std::error_code ec;
+    if (fs::equivalent(path, a.out, ec)) {
+      ThrowInputError(a.out, "--out", "is an input file; inputs are never modified");
+    }
+  }
+  if (fs::exists(a.out) && !fs::is_directory(a.out)) {
+    ThrowInputError(a.out, "--out", "exists and is not a folder");
+  }
+  { const AtomicOutputDirectory probe(a.out); }  // a bad output path fails now
+
+  identify::ExperimentLoadOptions load;
+  if (a.noise_deg > 0.0) load.noise_deg = a.noise_deg;
+  std::vector<identify::Experiment> experiments;
+  for (const std::string& path : a.data) {
+    experiments.push_back(identify::LoadExperiment(path, load));
+    const identify::Experiment& e = experiments.back();
+    double noise = 0.0;
+    for (double s : e.noise_deg) noise += s / static_cast<double>(e.noise_deg.size());
+    std::printf(
+        "experiment %s (%s): %zu frames, %.4g s, %zu measured angles, noise %.4f deg (%s)%s\n",
+        e.name.c_str(), path.c_str(), e.frame_time_s.size(), e.duration_s(), e.measured_samples,
+        noise, e.noise_source.c_str(),
+        e.angles_from_pipeline ? "; joint angles from the mocap pipeline (default settings)" : "");
+  }
+  std::string free_list;
+  for (const std::string& n : options.free_parameters)
+    free_list += (free_list.empty() ? "" : ", ") + n;
+  std::printf("fitting %s on %d thread%s\n", free_list.c_str(), options.threads,
+              options.threads == 1 ? "" : "s");
+  std::fflush(stdout);
+
+  if (!a.quiet) {
+    options.on_iteration = [](const identify::IterationProgress& p) {
+      std::string values;
+      for (const auto& [name, value] : p.values) {
+        char text[64];
+        std::snprintf(text, sizeof(text), " %s=%.6g", name.c_str(), value);
+        values += text;
+      }
+      std::fprintf(stderr, "\r%-100s\r", "");
+      std::printf("iteration %2d: cost %.6g, RMS %.4f deg%s, %lld simulations, %.0f s;%s\n",
+                  p.iteration, p.cost, p.rms_deg, p.step_accepted ? "" : " (step rejected)",
+                  static_cast<long long>(p.simulations), p.wall_time_s, values.c_str());
+      std::fflush(stdout);
+    };
+    options.on_run = [](std::size_t finished, std::size_t total, const identify::RunResult& r) {
+      std::fprintf(stderr, "\r  simulation %zu / %zu (%.1f s wall)", finished, total,
+                   r.summary.wall_time_s);
+      if (finished == total) std::fprintf(stderr, "\r%-60s\r", "");
+    };
+  }
+  const identify::IdentificationSummary summary = identify::Identify(experiments, options);
+  std::printf("%s", summary.FullReport().c_str());
+  const std::vector<std::string> written = identify::WriteFitDirectory(summary, experiments, a.out);
+  std::printf("  output: %s (%zu files)\n", a.out.c_str(), written.size());
+  switch (summary.termination) {
+    case identify::IdentificationTermination::kConverged:
+      return 0;
+    case identify::IdentificationTermination::kNoConvergence:
+      std::fprintf(stderr, "ccsrm: the fit did not converge in %d iterations (outputs written)\n",
+                   summary.iterations);
+      return kNotConverged;
+    case identify::IdentificationTermination::kFailed:
+      std::fprintf(stderr, "ccsrm: the fit failed: %s (outputs written)\n",
+                   summary.message.c_str());
+      return kFitFailed;
+  }
+  return kFitFailed;
+}
+
+}  // namespace
+
+void AddIdentifyCommand(CLI::App& root) {
+  CLI::App* cmd = root.add_subcommand(
+      "identify",
+      "Fit friction, damping and pre-tension to recorded experiments (Ceres): estimates, "
+      "standard errors, correlations, identifiability; writes fit.json and the fitted runs "
+      "(exit 4 if the fit did not converge, 3 if it failed)");
+  auto a = std::make_shared<IdentifyArgs>();
+  cmd->add_option("--data", a->data, "Experiment files (ccsrm-dataset/1), one or more")
+      ->required()
+      ->expected(1, -1);
+  cmd->add_option("--free", a->free,
+                  "Parameters to fit, comma-separated (default: mu,mu_s,mu_c,mu_c_s,beta,c_sc,"
+                  "c_lc,T_p,T_d0)");
+  cmd->add_option("--params", a->params,
+                  "YAML file: name: value, or name: {value, free, bounds: [lo, hi]}");
+  cmd->add_option("--set", a->set,
+                  "Value of a parameter, name=value (start of a free one; repeatable, applied "
+                  "after --params)");
+  cmd->add_option("--threads", a->threads, "Simulations at a time (default: every core)")
+      ->check(ValidIn(&identify::IdentificationOptions::threads));
+  cmd->add_option("--max-iterations", a->max_iterations, "Levenberg-Marquardt iterations")
+      ->capture_default_str()
+      ->check(ValidIn(&identify::IdentificationOptions::max_iterations));
+  cmd->add_option("--relative-step", a->relative_step, "Finite-difference step, relative")
+      ->capture_default_str()
+      ->check(ValidIn(&identify::IdentificationOptions::relative_step));
+  cmd->add_option("--noise-deg", a->noise_deg,
+                  "Measurement noise of the joint angles [deg] (default: estimated per joint "
+                  "from the measured twist)")
+      ->check(Above(0.0, "deg"));
+  cmd->add_option("--out", a->out, "Output folder")->required();
+  cmd->add_flag("--quiet", a->quiet, "No progress lines");
+  cmd->callback([a] {
+    const int code = RunIdentify(*a);
+    if (code != 0) throw CLI::RuntimeError(code);
+  });
+}
+
+}  // namespace ccsrm::app

@@ -1,0 +1,77 @@
+#pragma once
+// A recorded experiment as identification uses it (SPEC 4, 6): simulated
+// from its own inputs, on its own time base, and compared with its measured
+// joint angles at its own mocap frames.
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ccsrm/datasets/experiment_file.h"
+#include "ccsrm/sim/config.h"
+#include "ccsrm/sim/model.h"
+#include "ccsrm/sim/protocol.h"
+
+namespace ccsrm::identify {
+
+struct ExperimentLoadOptions {
+  // Measurement noise of every joint angle, standard deviation after
+  // processing [deg]: the weight of the residuals. Unset (the default): it is
+  // estimated per joint from the scatter of the joint's measured twist. A
+  // universal joint cannot twist, so the twist the mocap pipeline reports
+  // (/measured/joint_twist) is measurement noise, fitted and filtered like
+  // θx and θy; its RMS about the median is that noise. Without a twist
+  // record the 0.03 deg floor of 0.2 mm marker noise is used, and the
+  // experiment's noise_source says so.
+  std::optional<double> noise_deg;
+  // No joint's noise is taken below this [deg]: a twist that a filter has
+  // flattened must not give one joint a weight thousands of times the
+  // others'. Default: a tenth of the 0.03 deg floor.
+  double min_noise_deg = 0.003;
+
+  bool IsValid(std::string* error) const;
+};
+
+// What a simulation of the experiment needs, and what it is compared with.
+struct Experiment {
+  std::string name;  // the file's `name` attribute, else its stem
+  std::string path;  // where it was read from (messages)
+  // The nominal configuration (the file's config_yaml): the arm, the values
+  // of every parameter identification does not change, and the solver.
+  sim::Config config;
+  std::shared_ptr<const sim::ArmModel> model;
+  // /input/length_change on the simulation's time base: simulation time 0 is
+  // the first input sample, where the arm is taken to be straight and at rest.
+  std::shared_ptr<const sim::CableInputs> inputs;
+  double start_time_s = 0.0;  // experiment time of simulation time 0
+  // The mocap frames at or after start_time_s: their experiment times, and
+  // the same on the simulation's time base.
+  std::vector<double> frame_time_s;
+  std::vector<double> sample_time_s;
+  int joints = 0;
+  // Measured angles [rad], row per frame, column 2 j + a (joint j 0-based,
+  // axis a: 0 θx, 1 θy); NaN where not measured.
+  Eigen::MatrixXd measured_rad;
+  std::vector<double> noise_deg;  // per joint
+  std::string noise_source;       // "given", "joint twist scatter" or "default floor ..."
+  // True when the file had no /measured/joint_angles and the mocap pipeline
+  // computed them at load, with default settings.
+  bool angles_from_pipeline = false;
+  std::size_t measured_samples = 0;  // finite entries of measured_rad
+
+  double duration_s() const { return sample_time_s.empty() ? 0.0 : sample_time_s.back(); }
+};
+
+// Builds the experiment from a file already read. Throws InputError
+// "<path>: <field>: <problem>" for an experiment that cannot be identified:
+// no inputs, inputs for another number of cables than the arm has, no
+// config_yaml, no mocap frame at or after the first input sample, measured
+// angles of another number of joints, or no finite measured angle.
+Experiment MakeExperiment(const datasets::ExperimentFile& file, const std::string& path,
+                          const ExperimentLoadOptions& options);
+
+// Reads `path` (ccsrm-dataset/1) and builds the experiment from it.
+Experiment LoadExperiment(const std::string& path, const ExperimentLoadOptions& options);
+
+}  // namespace ccsrm::identify

@@ -1,0 +1,245 @@
+#pragma once
+// Identification (SPEC 6): the friction, damping and pre-tension that make
+// the simulated joint angles match the measured ones over one or several
+// experiments, by Ceres' Levenberg-Marquardt, with standard errors,
+// correlations and an identifiability check.
+//
+// The problem. Parameters by name (sim::Parameters(): mu, mu_s, ...), each
+// free or fixed. Residuals: (simulated - measured) / noise, per measured
+// frame, joint and axis, in degrees over degrees. The free parameters are
+// optimised in a scaled space, u = p / s, with s the magnitude of the start
+// value (else of the nominal value, else 1 % of the bounds' width), so every
+// unknown is of order 1. Bounds go to Ceres as bounds on u, so every trial
+// point of the trust region lies inside them.
+//
+// Derivatives. By finite differences over deterministic simulations, at the
+// relative step that issue 10 checked (1e-2: derivatives at 1e-2 and 3e-3
+// agree within 5 % at the default solver settings; docs/model-notes.md).
+// Central where both trial points fit inside the bounds, else second-order
+// one-sided away from the bound (the plans of sensitivity.h), so every
+// finite-difference point lies inside the bounds too: Ceres' own numeric
+// differentiation does not know the bounds, so this evaluator does it. The
+// runs of one Jacobian (2 per free parameter and experiment) go to the
+// backend as one batch.
+//
+// Uncertainty. ceres::Covariance (dense SVD, exact null directions dropped)
+// of the weighted residuals' Jacobian, times the residual variance
+// 2 cost / (N - p), times N / N_eff: mocap residuals are autocorrelated (a
+// 1 Hz filter on 100 Hz frames), so N samples carry the information of about
+// N_eff independent ones. N_eff sums, over every residual series
+// (experiment, joint, axis), its length over its integrated autocorrelation
+// time (Geyer's initial positive sequence). 95 % intervals use Student's t
+// with N_eff - p degrees of freedom.
+//
+// Identifiability. Singular values of the Jacobian in the scaled space. A
+// direction v_k with singular value σ_k moves the scaled parameters by a
+// standard error of σ_res / σ_k (σ_res² the variance factor above). A
+// parameter is identifiable when its standard error in this space, the
+// root of Σ_k v_ik² (σ_res / σ_k)², is below max_relative_standard_error of
+// its scale; otherwise it gets no standard error and no interval, and the
+// directions that make it so are named as combinations.
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ccsrm/identify/experiment.h"
+#include "ccsrm/identify/sensitivity.h"
+#include "ccsrm/identify/simulation_backend.h"
+#include "ccsrm/sim/parameters.h"
+#include "ccsrm/sim/simulator.h"
+
+namespace ccsrm::identify {
+
+// The nine parameters of SPEC 6, in its order.
+std::vector<std::string> Spec6ParameterNames();
+
+// Reported after every iteration of the minimiser (iteration 0 is the start).
+struct IterationProgress {
+  int iteration = 0;
+  double cost = 0.0;  // 1/2 Σ r², r in units of the noise
+  double rms_deg = 0.0;
+  double relative_decrease = 0.0;  // of the cost, this iteration (0 at the start)
+  double trust_region_radius = 0.0;
+  bool step_accepted = true;
+  std::int64_t simulations = 0;  // so far
+  double wall_time_s = 0.0;
+  std::vector<std::pair<std::string, double>> values;  // the free parameters
+};
+
+struct IdentificationOptions {
+  // The parameters to fit, by name. Default: SPEC 6's nine (mu, mu_s, mu_c,
+  // mu_c_s, beta, c_sc, c_lc, T_p, T_d0). Each Jacobian then costs 18 runs
+  // per experiment; fewer free parameters cost proportionally less.
+  std::vector<std::string> free_parameters = Spec6ParameterNames();
+  // Values set over every experiment's nominal configuration before the fit
+  // (`--params`, `--set`): the start value of a free parameter, the value of
+  // a fixed one. Default: none (the nominal values).
+  std::map<std::string, double> values;
+  // Narrower bounds for free parameters, name -> (lower, upper). Each must
+  // lie inside the parameter's own bounds (sim::Parameters()) and contain
+  // the start value. Default: the parameter's own bounds.
+  std::map<std::string, std::pair<double, double>> bounds;
+  // Relative finite-difference step: a parameter p moves by r s. Default
+  // 1e-2 (see above).
+  double relative_step = 1e-2;
+  // Simulations at a time on this machine (ThreadBackend). Default: every core.
+  int threads = DefaultThreads();
+  // Another backend (null: threads on this machine).
+  std::shared_ptr<SimulationBackend> backend;
+  // Levenberg-Marquardt stopping rules (ceres::Solver::Options of the same
+  // names). Default 30 iterations; a relative cost decrease below 1e-6, a
+  // relative step below 1e-6 or a gradient below 1e-10 stops the fit as
+  // converged.
+  int max_iterations = 30;
+  double function_tolerance = 1e-6;
+  double parameter_tolerance = 1e-6;
+  double gradient_tolerance = 1e-10;
+  // The fit also stops, as converged, once an accepted step moved every free
+  // parameter by less than this fraction of its standard error: further
+  // steps would change the estimate by amounts the data cannot tell apart
+  // (and each costs a Jacobian). Default 0.1. 0 turns the rule off.
+  double converged_step_fraction = 0.1;
+  // A parameter whose standard error exceeds this fraction of its scale is
+  // reported as not identifiable. Default 0.25: its 95 % interval would
+  // then span about ±50 % of the value, which says only its order of
+  // magnitude.
+  double max_relative_standard_error = 0.25;
+  // Called after every iteration and after every simulation; may be empty.
+  std::function<void(const IterationProgress&)> on_iteration;
+  RunFinishedCallback on_run;
+
+  // False with the reason naming the field: an unknown or repeated
+  // parameter name, no free parameter, bounds for a parameter that is not
+  // free, bounds outside the parameter's own or not increasing, a value out
+  // of bounds, relative_step outside (0, 0.1], threads < 1,
+  // max_iterations < 0, tolerances <= 0, max_relative_standard_error <= 0,
+  // converged_step_fraction < 0.
+  bool IsValid(std::string* error) const;
+};
+
+enum class IdentificationTermination {
+  kConverged,      // a stopping tolerance was met
+  kNoConvergence,  // max_iterations reached first
+  kFailed,         // the minimiser could not go on (e.g. the start point diverges)
+};
+const char* TerminationName(IdentificationTermination termination);
+
+struct ParameterEstimate {
+  std::string name;
+  std::string units;
+  bool free = false;
+  double start = 0.0;               // free: start value; fixed: the value used
+  double value = 0.0;               // the estimate (fixed: the value used)
+  double lower = 0.0, upper = 0.0;  // bounds of the fit
+  double scale = 0.0;               // s of the scaled space
+  bool identifiable = true;         // false: no std_error or interval (NaN), see unidentifiable
+  double std_error = std::numeric_limits<double>::quiet_NaN();
+  double ci95_lower = std::numeric_limits<double>::quiet_NaN();
+  double ci95_upper = std::numeric_limits<double>::quiet_NaN();
+  bool at_bound = false;  // the estimate sits on a bound: its interval is not symmetric
+};
+
+// A direction of the scaled parameters that the data do not pin down.
+struct UnidentifiableDirection {
+  double singular_value = 0.0;
+  double relative_std_error = 0.0;  // σ_res / σ_k, in units of the scales (inf for σ_k = 0)
+  // The parameters that make up the direction, largest share first, with
+  // their component in the (unit) singular vector.
+  std::vector<std::pair<std::string, double>> components;
+  std::string Describe() const;  // e.g. "0.71 T_p - 0.70 mu_c"
+};
+
+// Errors of one joint angle series: one experiment, or all of them.
+struct ChannelErrors {
+  // [joint][axis], axis 0 θx, 1 θy, over the measured frames.
+  std::vector<std::array<double, 2>> rms_deg;
+  std::vector<std::array<double, 2>> fit_percent;
+  std::vector<std::array<std::size_t, 2>> samples;
+  double rms_deg_overall = 0.0;
+  // 100 (1 - |sim - meas| / |meas - mean of each series|), over every series.
+  double fit_percent_overall = 0.0;
+};
+
+struct ExperimentFit {
+  std::string name;
+  std::string path;
+  bool angles_from_pipeline = false;
+  std::vector<double> noise_deg;
+  std::string noise_source;
+  ChannelErrors start;  // at the start values
+  ChannelErrors fitted;
+  // The final run: summary, and the trajectory at the experiment's sample times.
+  sim::SimulationResult run;
+  sim::ArmParameters parameters;  // the parameters of that run
+  Eigen::MatrixXd simulated_rad;  // as Experiment::measured_rad
+};
+
+struct IdentificationSummary {
+  IdentificationTermination termination = IdentificationTermination::kFailed;
+  bool converged() const { return termination == IdentificationTermination::kConverged; }
+  std::string message;  // Ceres' reason, or why the fit stopped
+  int iterations = 0;   // minimiser iterations (successful and not)
+  std::int64_t simulations = 0;
+  int threads = 0;
+  double wall_time_s = 0.0;
+  double relative_step = 0.0;
+  std::vector<double> cost_history;  // per iteration, from the start
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  std::size_t residuals = 0;                  // N
+  double effective_samples = 0.0;             // N_eff
+  double residual_variance = 0.0;             // 2 cost / (N - p): 1 at the noise floor
+  std::vector<ParameterEstimate> parameters;  // free ones first, in the options' order
+  std::vector<std::string> free_names;
+  Eigen::MatrixXd correlation;          // free × free; NaN rows of unidentifiable parameters
+  std::vector<double> singular_values;  // scaled Jacobian, descending
+  std::vector<UnidentifiableDirection> unidentifiable;
+  ChannelErrors start_errors;  // every experiment together
+  ChannelErrors errors;
+  std::vector<ExperimentFit> experiments;
+  bool covariance_available = false;
+  std::string covariance_message;  // why not, when not
+
+  const ParameterEstimate* Find(const std::string& name) const;
+  // One line; and the whole result as a table.
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+// Fits the free parameters to every experiment at once. Throws InputError
+// for invalid options or experiments before any simulation runs (also when a
+// value makes an experiment's parameters invalid). A fit that fails or does
+// not converge is returned with its termination, not thrown.
+IdentificationSummary Identify(const std::vector<Experiment>& experiments,
+                               const IdentificationOptions& options);
+
+// Reads a parameter file (`ccsrm identify --params`) into options. Each
+// entry is `name: value` (a start value, or the value of a fixed parameter)
+// or `name: {value: v, free: true|false, bounds: [lower, upper]}`; a truth
+// file's `parameters:` section is read as values. Checked whole before
+// anything changes. Throws InputError "<file>: line N, key 'x': ..." for an
+// unknown name or field, a value that is not a number or out of bounds.
+void ApplyParameterFile(const std::string& yaml_text, const std::string& file,
+                        IdentificationOptions* options);
+
+// fit.json: every number of the summary, SPEC 6 names.
+nlohmann::json ToJson(const IdentificationSummary& summary);
+
+// Writes a fit directory (created if missing, files replaced atomically):
+// fit.json; per experiment <name>.fit.h5 (ccsrm-run/1 of the final run at
+// the measured frames) and <name>.angles.csv (time, then measured, fitted
+// and residual θx, θy of every joint, in degrees). Returns the paths written.
+std::vector<std::string> WriteFitDirectory(const IdentificationSummary& summary,
+                                           const std::vector<Experiment>& experiments,
+                                           const std::string& directory);
+
+}  // namespace ccsrm::identify

@@ -1,0 +1,56 @@
+#pragma once
+// Where identification's simulations run. A fit asks for batches of runs
+// (the base point of every experiment, then the trial points of the finite
+// differences) and waits for the whole batch; a backend decides where they
+// run. ThreadBackend runs them on this machine's cores. A request holds only
+// an experiment index and parameter values, so another backend can send
+// batches to other machines that loaded the same experiments.
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ccsrm/identify/experiment.h"
+#include "ccsrm/sim/parameters.h"
+#include "ccsrm/sim/simulator.h"
+
+namespace ccsrm::identify {
+
+struct RunRequest {
+  std::size_t experiment = 0;  // index into the experiments the backend was given
+  sim::ArmParameters parameters;
+  bool keep_trajectory = false;  // also return every sampled frame
+};
+
+struct RunResult {
+  sim::SimulationSummary summary;
+  // The simulated angles at the experiment's sample times [rad], laid out as
+  // Experiment::measured_rad; rows beyond a run that ended early are NaN.
+  Eigen::MatrixXd angles_rad;
+  sim::Trajectory trajectory;  // only with keep_trajectory
+};
+
+// Called after each finished run, one call at a time.
+using RunFinishedCallback =
+    std::function<void(std::size_t finished, std::size_t total, const RunResult& result)>;
+
+class SimulationBackend {
+ public:
+  virtual ~SimulationBackend() = default;
+  // Runs every request; result k belongs to request k. Deterministic: the
+  // same requests give the same results whatever the backend's parallelism.
+  // A run that diverges is reported in its summary, not thrown.
+  virtual std::vector<RunResult> RunBatch(const std::vector<RunRequest>& requests,
+                                          const RunFinishedCallback& on_finished) = 0;
+  // Runs at a time (for reports).
+  virtual int parallelism() const = 0;
+};
+
+// Runs on `threads` threads of this process, each run with its own
+// simulation data over the experiments' shared, read-only models.
+// `experiments` must outlive the backend.
+std::unique_ptr<SimulationBackend> MakeThreadBackend(const std::vector<Experiment>* experiments,
+                                                     int threads);
+
+}  // namespace ccsrm::identify

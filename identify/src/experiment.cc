@@ -1,0 +1,177 @@
+#include "ccsrm/identify/experiment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "ccsrm/common/error.h"
+#include "ccsrm/identify/sensitivity.h"
+
+namespace ccsrm::identify {
+namespace {
+
+constexpr double kDeg = 180.0 / M_PI;
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const std::size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+  return v[mid];
+}
+
+// Per joint: RMS about the median of the measured twist [deg]; NaN when a
+// joint has fewer than 10 finite frames.
+std::vector<double> TwistScatterDeg(const datasets::Array& twist, std::size_t first_frame,
+                                    int joints) {
+  std::vector<double> out(static_cast<std::size_t>(joints),
+                          std::numeric_limits<double>::quiet_NaN());
+  for (int j = 0; j < joints; ++j) {
+    std::vector<double> values;
+    for (std::size_t f = first_frame; f < twist.rows(); ++f) {
+      const double v = twist.at(f, static_cast<std::size_t>(j));
+      if (std::isfinite(v)) values.push_back(v);
+    }
+    if (values.size() < 10) continue;
+    const double median = Median(values);
+    double sum = 0.0;
+    for (double v : values) sum += (v - median) * (v - median);
+    out[static_cast<std::size_t>(j)] = std::sqrt(sum / static_cast<double>(values.size())) * kDeg;
+  }
+  return out;
+}
+
+}  // namespace
+
+bool ExperimentLoadOptions::IsValid(std::string* error) const {
+  if (noise_deg && !(*noise_deg > 0.0 && std::isfinite(*noise_deg))) {
+    *error = "noise_deg must be > 0";
+    return false;
+  }
+  if (!(min_noise_deg > 0.0 && std::isfinite(min_noise_deg))) {
+    *error = "min_noise_deg must be > 0";
+    return false;
+  }
+  return true;
+}
+
+Experiment MakeExperiment(const datasets::ExperimentFile& file, const std::string& path,
+                          const ExperimentLoadOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) ThrowInputError(path, "noise", error);
+
+  Experiment e;
+  e.path = path;
+  e.name = !file.name.empty() ? file.name : std::filesystem::path(path).stem().string();
+  if (file.config_yaml.empty()) {
+    ThrowInputError(path, "attribute 'config_yaml'",
+                    "is empty: identification needs the arm's nominal configuration");
+  }
+  e.config = sim::ParseConfig(file.config_yaml, path + ": attribute 'config_yaml'");
+  auto model = std::make_shared<sim::ArmModel>(e.config.arm);
+  e.joints = model->num_joints();
+
+  // Inputs: the arm is simulated from its own recorded inputs.
+  const std::size_t n = file.input_time.rows();
+  const std::size_t cables =
+      file.input_length_change.rank() == 2 ? file.input_length_change.shape[1] : std::size_t{0};
+  if (cables == 0) {
+    ThrowInputError(path, "/input/length_change",
+                    "has no cable columns: the experiment records no inputs, and "
+                    "identification simulates each experiment from its own inputs");
+  }
+  if (static_cast<int>(cables) != model->num_cables()) {
+    ThrowInputError(path, "/input/length_change",
+                    "has " + std::to_string(cables) +
+                        " cable columns, the arm of its "
+                        "config_yaml has " +
+                        std::to_string(model->num_cables()) + " driving cables");
+  }
+  if (n < 2) {
+    ThrowInputError(path, "/input/time",
+                    "has " + std::to_string(n) + " sample; the inputs need at least 2");
+  }
+  e.start_time_s = file.input_time.at(0);
+  Eigen::VectorXd time(static_cast<Eigen::Index>(n));
+  Eigen::MatrixXd length(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(cables));
+  for (std::size_t i = 0; i < n; ++i) {
+    time[static_cast<Eigen::Index>(i)] = file.input_time.at(i) - e.start_time_s;
+    for (std::size_t c = 0; c < cables; ++c) {
+      length(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c)) =
+          file.input_length_change.at(i, c);
+    }
+  }
+  e.inputs = std::make_shared<sim::CableInputs>(std::move(time), std::move(length));
+  e.model = std::move(model);
+
+  // Frames: those the simulation can reach, from the first input sample on.
+  if (!file.measured_joint_angles) {
+    ThrowInputError(path, "/measured/joint_angles",
+                    "is missing: process the markers first (ccsrm mocap process --in " + path +
+                        " --out processed.h5)");
+  }
+  const datasets::Array& measured = *file.measured_joint_angles;
+  if (measured.rank() != 3 || measured.shape[1] != static_cast<std::size_t>(e.joints) ||
+      measured.shape[2] != 2) {
+    ThrowInputError(
+        path, "/measured/joint_angles",
+        "must be F x " + std::to_string(e.joints) + " x 2 (the joints of its config_yaml)");
+  }
+  std::size_t first = 0;
+  while (first < file.mocap_time.rows() && file.mocap_time.at(first) < e.start_time_s) ++first;
+  const std::size_t frames = file.mocap_time.rows() - first;
+  if (frames == 0) {
+    ThrowInputError(path, "/mocap/time",
+                    "has no frame at or after the first input sample (t = " +
+                        std::to_string(e.start_time_s) + " s)");
+  }
+  e.measured_rad.resize(static_cast<Eigen::Index>(frames), 2 * e.joints);
+  for (std::size_t f = 0; f < frames; ++f) {
+    const double t = file.mocap_time.at(first + f);
+    e.frame_time_s.push_back(t);
+    e.sample_time_s.push_back(t - e.start_time_s);
+    for (int j = 0; j < e.joints; ++j) {
+      for (int a = 0; a < 2; ++a) {
+        const double v = measured.values[((first + f) * static_cast<std::size_t>(e.joints) +
+                                          static_cast<std::size_t>(j)) *
+                                             2 +
+                                         static_cast<std::size_t>(a)];
+        e.measured_rad(static_cast<Eigen::Index>(f), 2 * j + a) = v;
+        if (std::isfinite(v)) ++e.measured_samples;
+      }
+    }
+  }
+  if (e.measured_samples == 0) {
+    ThrowInputError(path, "/measured/joint_angles",
+                    "has no finite angle after t = " + std::to_string(e.start_time_s) + " s");
+  }
+
+  // Noise: given, else from the twist scatter, else the floor.
+  e.noise_deg.assign(static_cast<std::size_t>(e.joints), kMocapNoiseFloorDeg);
+  if (options.noise_deg) {
+    e.noise_deg.assign(static_cast<std::size_t>(e.joints), *options.noise_deg);
+    e.noise_source = "given";
+  } else if (file.measured_joint_twist && file.measured_joint_twist->rank() == 2 &&
+             file.measured_joint_twist->shape[1] == static_cast<std::size_t>(e.joints)) {
+    const std::vector<double> scatter =
+        TwistScatterDeg(*file.measured_joint_twist, first, e.joints);
+    bool any = false;
+    for (int j = 0; j < e.joints; ++j) {
+      const double s = scatter[static_cast<std::size_t>(j)];
+      if (std::isfinite(s)) {
+        e.noise_deg[static_cast<std::size_t>(j)] = std::max(s, options.min_noise_deg);
+        any = true;
+      }
+    }
+    e.noise_source = any ? "joint twist scatter" : "default floor 0.03 deg (too few twist frames)";
+  } else {
+    e.noise_source = "default floor 0.03 deg (no /measured/joint_twist)";
+  }
+  return e;
+}
+
+Experiment LoadExperiment(const std::string& path, const ExperimentLoadOptions& options) {
+  return MakeExperiment(datasets::ReadExperimentFile(path), path, options);
+}
+
+}  // namespace ccsrm::identify

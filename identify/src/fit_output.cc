@@ -1,0 +1,293 @@
+// The identification summary as text, JSON and a fit directory.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/common/error.h"
+#include "ccsrm/datasets/run_file.h"
+#include "ccsrm/identify/identification.h"
+#include "ccsrm/sim_io/run_file.h"
+
+namespace ccsrm::identify {
+namespace {
+
+constexpr double kDeg = 180.0 / M_PI;
+
+std::string Format(const char* format, double value) {
+  if (!std::isfinite(value)) return "-";
+  char text[64];
+  std::snprintf(text, sizeof(text), format, value);
+  return text;
+}
+
+// JSON has no NaN: unknown numbers are null.
+nlohmann::json Number(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
+}
+
+nlohmann::json ChannelJson(const ChannelErrors& e) {
+  nlohmann::json joints = nlohmann::json::array();
+  for (std::size_t j = 0; j < e.rms_deg.size(); ++j) {
+    joints.push_back({{"joint", j + 1},
+                      {"rms_deg", {Number(e.rms_deg[j][0]), Number(e.rms_deg[j][1])}},
+                      {"fit_percent", {Number(e.fit_percent[j][0]), Number(e.fit_percent[j][1])}},
+                      {"samples", {e.samples[j][0], e.samples[j][1]}}});
+  }
+  return {{"rms_deg", Number(e.rms_deg_overall)},
+          {"fit_percent", Number(e.fit_percent_overall)},
+          {"per_joint", joints},
+          {"axes", {"theta_x", "theta_y"}}};
+}
+
+// Unique, file-safe stems for the experiments' output files.
+std::vector<std::string> OutputStems(const IdentificationSummary& summary) {
+  std::vector<std::string> stems;
+  std::set<std::string> used;
+  for (const ExperimentFit& fit : summary.experiments) {
+    std::string stem;
+    for (char c : fit.name) {
+      stem += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.')
+                  ? c
+                  : '_';
+    }
+    if (stem.empty()) stem = "experiment";
+    std::string unique = stem;
+    for (int k = 2; used.count(unique) != 0; ++k) unique = stem + "_" + std::to_string(k);
+    used.insert(unique);
+    stems.push_back(unique);
+  }
+  return stems;
+}
+
+}  // namespace
+
+std::string UnidentifiableDirection::Describe() const {
+  std::string out;
+  for (const auto& [name, c] : components) {
+    char text[64];
+    std::snprintf(text, sizeof(text), "%s%.2f %s",
+                  out.empty() ? (c < 0 ? "-" : "") : (c < 0 ? " - " : " + "), std::abs(c),
+                  name.c_str());
+    out += text;
+  }
+  return out.empty() ? "(no dominant parameter)" : out;
+}
+
+std::string IdentificationSummary::BriefReport() const {
+  char text[512];
+  std::snprintf(text, sizeof(text),
+                "identification %s after %d iterations (%lld simulations, %d threads, %.1f s): "
+                "RMS %s -> %s deg, fit %s %%",
+                TerminationName(termination), iterations, static_cast<long long>(simulations),
+                threads, wall_time_s, Format("%.4f", start_errors.rms_deg_overall).c_str(),
+                Format("%.4f", errors.rms_deg_overall).c_str(),
+                Format("%.1f", errors.fit_percent_overall).c_str());
+  return text;
+}
+
+std::string IdentificationSummary::FullReport() const {
+  std::ostringstream out;
+  out << BriefReport() << "\n";
+  out << "  termination: " << TerminationName(termination) << " (" << message << ")\n";
+  out << "  residuals: " << residuals << " (effective " << Format("%.0f", effective_samples)
+      << "), residual variance " << Format("%.3g", residual_variance)
+      << " (1 = at the measurement noise), cost " << Format("%.6g", initial_cost) << " -> "
+      << Format("%.6g", final_cost) << "\n";
+  out << "  finite differences: relative step " << relative_step
+      << ", central or one-sided second order inside the bounds\n\n";
+  out << "  parameter      start          estimate       std error      95 % interval"
+         "                  units\n";
+  for (const ParameterEstimate& p : parameters) {
+    if (!p.free) continue;
+    char line[512];
+    const std::string interval = p.identifiable ? "[" + Format("%.6g", p.ci95_lower) + ", " +
+                                                      Format("%.6g", p.ci95_upper) + "]"
+                                                : "not identifiable";
+    std::snprintf(line, sizeof(line), "  %-14s %-14s %-14s %-14s %-30s %s%s\n", p.name.c_str(),
+                  Format("%.6g", p.start).c_str(), Format("%.6g", p.value).c_str(),
+                  p.identifiable ? Format("%.3g", p.std_error).c_str() : "-", interval.c_str(),
+                  p.units.c_str(), p.at_bound ? "  (at a bound)" : "");
+    out << line;
+  }
+  if (!covariance_available) out << "  no covariance: " << covariance_message << "\n";
+  out << "\n  singular values of the scaled Jacobian:";
+  for (double s : singular_values) out << " " << Format("%.3g", s);
+  out << "\n";
+  if (unidentifiable.empty()) {
+    out << "  every free parameter is identifiable from these data\n";
+  } else {
+    for (const UnidentifiableDirection& d : unidentifiable) {
+      out << "  not pinned down by the data: " << d.Describe() << " (singular value "
+          << Format("%.3g", d.singular_value) << ", relative std error "
+          << Format("%.3g", d.relative_std_error) << ")\n";
+    }
+  }
+  out << "\n  joint   RMS θx [deg]   RMS θy [deg]   fit θx [%]   fit θy [%]\n";
+  for (std::size_t j = 0; j < errors.rms_deg.size(); ++j) {
+    char line[256];
+    std::snprintf(line, sizeof(line), "  %5zu   %-14s %-14s %-12s %s\n", j + 1,
+                  Format("%.4f", errors.rms_deg[j][0]).c_str(),
+                  Format("%.4f", errors.rms_deg[j][1]).c_str(),
+                  Format("%.1f", errors.fit_percent[j][0]).c_str(),
+                  Format("%.1f", errors.fit_percent[j][1]).c_str());
+    out << line;
+  }
+  out << "\n";
+  for (const ExperimentFit& e : experiments) {
+    char line[512];
+    double noise = 0.0;
+    for (double s : e.noise_deg) noise += s / static_cast<double>(e.noise_deg.size());
+    std::snprintf(line, sizeof(line), "  %s: RMS %s -> %s deg, fit %s %%, noise %.4f deg (%s)%s\n",
+                  e.name.c_str(), Format("%.4f", e.start.rms_deg_overall).c_str(),
+                  Format("%.4f", e.fitted.rms_deg_overall).c_str(),
+                  Format("%.1f", e.fitted.fit_percent_overall).c_str(), noise,
+                  e.noise_source.c_str(),
+                  e.angles_from_pipeline ? ", angles from the mocap pipeline" : "");
+    out << line;
+  }
+  return out.str();
+}
+
+nlohmann::json ToJson(const IdentificationSummary& s) {
+  nlohmann::json parameters = nlohmann::json::object();
+  for (const ParameterEstimate& p : s.parameters) {
+    nlohmann::json entry = {
+        {"value", p.value}, {"units", p.units}, {"free", p.free}, {"start", p.start}};
+    if (p.free) {
+      entry["std_error"] = p.identifiable ? Number(p.std_error) : nullptr;
+      entry["ci95"] = p.identifiable ? nlohmann::json{Number(p.ci95_lower), Number(p.ci95_upper)}
+                                     : nlohmann::json(nullptr);
+      entry["identifiable"] = p.identifiable;
+      entry["bounds"] = {p.lower, p.upper};
+      entry["scale"] = p.scale;
+      entry["at_bound"] = p.at_bound;
+    }
+    parameters[p.name] = entry;
+  }
+  nlohmann::json correlation = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < s.correlation.rows(); ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    for (Eigen::Index j = 0; j < s.correlation.cols(); ++j)
+      row.push_back(Number(s.correlation(i, j)));
+    correlation.push_back(row);
+  }
+  nlohmann::json unidentifiable = nlohmann::json::array();
+  for (const UnidentifiableDirection& d : s.unidentifiable) {
+    nlohmann::json parts = nlohmann::json::object();
+    for (const auto& [name, c] : d.components) parts[name] = c;
+    unidentifiable.push_back({{"combination", d.Describe()},
+                              {"components", parts},
+                              {"singular_value", d.singular_value},
+                              {"relative_std_error", Number(d.relative_std_error)}});
+  }
+  nlohmann::json experiments = nlohmann::json::array();
+  for (const ExperimentFit& e : s.experiments) {
+    experiments.push_back({{"name", e.name},
+                           {"path", e.path},
+                           {"angles_from_pipeline", e.angles_from_pipeline},
+                           {"noise_deg", e.noise_deg},
+                           {"noise_source", e.noise_source},
+                           {"start", ChannelJson(e.start)},
+                           {"fitted", ChannelJson(e.fitted)},
+                           {"run",
+                            {{"status", e.run.summary.completed() ? "completed" : "failed"},
+                             {"message", e.run.summary.message},
+                             {"wall_time_s", e.run.summary.wall_time_s},
+                             {"real_time_factor", e.run.summary.real_time_factor}}}});
+  }
+  return {{"schema", "ccsrm-fit/1"},
+          {"converged", s.converged()},
+          {"termination", TerminationName(s.termination)},
+          {"message", s.message},
+          {"iterations", s.iterations},
+          {"simulations", s.simulations},
+          {"threads", s.threads},
+          {"wall_time_s", s.wall_time_s},
+          {"relative_step", s.relative_step},
+          {"free", s.free_names},
+          {"parameters", parameters},
+          {"rms_deg", Number(s.errors.rms_deg_overall)},
+          {"fit_percent", Number(s.errors.fit_percent_overall)},
+          {"rms_deg_start", Number(s.start_errors.rms_deg_overall)},
+          {"errors", ChannelJson(s.errors)},
+          {"start_errors", ChannelJson(s.start_errors)},
+          {"cost_history", s.cost_history},
+          {"initial_cost", Number(s.initial_cost)},
+          {"final_cost", Number(s.final_cost)},
+          {"residuals", s.residuals},
+          {"effective_samples", Number(s.effective_samples)},
+          {"residual_variance", Number(s.residual_variance)},
+          {"covariance_available", s.covariance_available},
+          {"covariance_message", s.covariance_message},
+          {"correlation", correlation},
+          {"singular_values", s.singular_values},
+          {"unidentifiable", unidentifiable},
+          {"experiments", experiments}};
+}
+
+std::vector<std::string> WriteFitDirectory(const IdentificationSummary& summary,
+                                           const std::vector<Experiment>& experiments,
+                                           const std::string& directory) {
+  CCSRM_CHECK(summary.experiments.size() == experiments.size());
+  namespace fs = std::filesystem;
+  AtomicOutputDirectory out(directory);
+  const fs::path tmp(out.temp_path());
+  std::vector<std::string> written;
+  const std::vector<std::string> stems = OutputStems(summary);
+  nlohmann::json json = ToJson(summary);
+  for (std::size_t e = 0; e < experiments.size(); ++e) {
+    const ExperimentFit& fit = summary.experiments[e];
+    const Experiment& x = experiments[e];
+    json["experiments"][e]["run_file"] = stems[e] + ".fit.h5";
+    json["experiments"][e]["angles_file"] = stems[e] + ".angles.csv";
+    if (fit.run.trajectory.size() > 0) {
+      sim::Config config = x.config;
+      config.parameters = fit.parameters;
+      datasets::RunFile run = sim_io::ToRunFile(*x.model, fit.run, {"custom", sim::ToYaml(config)});
+      datasets::WriteRunFile((tmp / (stems[e] + ".fit.h5")).string(), run);
+      written.push_back((fs::path(directory) / (stems[e] + ".fit.h5")).string());
+    } else {
+      json["experiments"][e]["run_file"] = nullptr;
+    }
+    std::ostringstream csv;
+    csv << "# " << fit.name << ": measured and fitted joint angles [deg] at the measured frames; "
+        << "residual = fitted - measured; empty where not measured\n";
+    csv << "time_s";
+    for (int j = 1; j <= x.joints; ++j) {
+      for (const char* axis : {"x", "y"}) {
+        csv << ",measured_theta" << axis << j << "_deg,fitted_theta" << axis << j
+            << "_deg,residual_theta" << axis << j << "_deg";
+      }
+    }
+    csv << "\n";
+    char value[64];
+    for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
+      std::snprintf(value, sizeof(value), "%.6f", x.frame_time_s[static_cast<std::size_t>(f)]);
+      csv << value;
+      for (Eigen::Index c = 0; c < x.measured_rad.cols(); ++c) {
+        const double m = x.measured_rad(f, c) * kDeg;
+        const double s = fit.simulated_rad.rows() > f ? fit.simulated_rad(f, c) * kDeg : NAN;
+        for (double v : {m, s, s - m}) {
+          if (std::isfinite(v)) {
+            std::snprintf(value, sizeof(value), ",%.6f", v);
+            csv << value;
+          } else {
+            csv << ",";
+          }
+        }
+      }
+      csv << "\n";
+    }
+    WriteTextFileAtomically((tmp / (stems[e] + ".angles.csv")).string(), csv.str());
+    written.push_back((fs::path(directory) / (stems[e] + ".angles.csv")).string());
+  }
+  WriteTextFileAtomically((tmp / "fit.json").string(), json.dump(2) + "\n");
+  written.insert(written.begin(), (fs::path(directory) / "fit.json").string());
+  out.Commit();
+  return written;
+}
+
+}  // namespace ccsrm::identify

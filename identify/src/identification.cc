@@ -1,0 +1,846 @@
+#include "ccsrm/identify/identification.h"
+
+#include <ceres/ceres.h>
+#include <ceres/covariance.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <set>
+
+#include "ccsrm/common/error.h"
+#include "finite_difference.h"
+#include "statistics.h"
+
+namespace ccsrm::identify {
+namespace {
+
+constexpr double kDeg = 180.0 / M_PI;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// One free parameter in the scaled space u = p / scale.
+struct FreeParameter {
+  std::string name;
+  double lower = 0.0, upper = 0.0;  // [parameter units]
+  double start = 0.0;
+  double scale = 1.0;
+};
+
+// Where each residual comes from: experiment, frame, column (2 joint + axis).
+struct ResidualIndex {
+  std::uint32_t experiment;
+  std::uint32_t frame;
+  std::uint16_t column;
+};
+
+// The simulated angles of every experiment at one point of u.
+struct Evaluation {
+  std::vector<double> u;
+  std::vector<Eigen::MatrixXd> angles_rad;  // per experiment
+  std::vector<sim::SimulationSummary> summaries;
+  Eigen::VectorXd residuals;  // weighted
+  bool ok = false;
+  std::string failure;
+};
+
+class FitProblem {
+ public:
+  FitProblem(const std::vector<Experiment>& experiments, const IdentificationOptions& options,
+             std::vector<sim::ArmParameters> base, std::vector<FreeParameter> free,
+             SimulationBackend* backend)
+      : experiments_(experiments),
+        options_(options),
+        base_(std::move(base)),
+        free_(std::move(free)),
+        backend_(backend) {
+    for (std::size_t e = 0; e < experiments_.size(); ++e) {
+      const Experiment& x = experiments_[e];
+      for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
+        for (Eigen::Index c = 0; c < x.measured_rad.cols(); ++c) {
+          if (std::isfinite(x.measured_rad(f, c))) {
+            index_.push_back({static_cast<std::uint32_t>(e), static_cast<std::uint32_t>(f),
+                              static_cast<std::uint16_t>(c)});
+          }
+        }
+      }
+    }
+  }
+
+  std::size_t num_residuals() const { return index_.size(); }
+  std::size_t num_free() const { return free_.size(); }
+  const std::vector<ResidualIndex>& index() const { return index_; }
+  const std::vector<FreeParameter>& free() const { return free_; }
+  std::int64_t simulations() const { return simulations_; }
+
+  // The parameters of experiment e at the free values p.
+  sim::ArmParameters ParametersAt(std::size_t e, const std::vector<double>& p) const {
+    sim::ArmParameters out = base_[e];
+    for (std::size_t i = 0; i < free_.size(); ++i) {
+      sim::SetParameter(free_[i].name, p[i], "identification", &out);
+    }
+    return out;
+  }
+
+  std::vector<double> ValuesAt(const double* u) const {
+    std::vector<double> p(free_.size());
+    for (std::size_t i = 0; i < free_.size(); ++i) {
+      // Ceres keeps u inside the bounds; clamping only removes the last-bit
+      // rounding of p = u s.
+      p[i] = std::clamp(u[i] * free_[i].scale, free_[i].lower, free_[i].upper);
+    }
+    return p;
+  }
+
+  // The base evaluation at u (cached: Ceres asks for the same point twice,
+  // once for the cost and once for the Jacobian).
+  Evaluation Evaluate(const double* u, bool keep_trajectories = false) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      for (const Evaluation& e : cache_) {
+        if (!keep_trajectories && std::equal(e.u.begin(), e.u.end(), u)) return e;
+      }
+    }
+    Evaluation ev;
+    ev.u.assign(u, u + free_.size());
+    const std::vector<double> p = ValuesAt(u);
+    std::vector<RunRequest> requests;
+    for (std::size_t e = 0; e < experiments_.size(); ++e) {
+      requests.push_back({e, ParametersAt(e, p), keep_trajectories});
+    }
+    std::vector<RunResult> results = Run(requests);
+    ev.ok = true;
+    for (std::size_t e = 0; e < results.size(); ++e) {
+      if (!results[e].summary.completed() && ev.ok) {
+        ev.ok = false;
+        ev.failure = experiments_[e].name + ": " + results[e].summary.message;
+      }
+      ev.angles_rad.push_back(std::move(results[e].angles_rad));
+      ev.summaries.push_back(results[e].summary);
+      if (keep_trajectories) trajectories_.push_back(std::move(results[e].trajectory));
+    }
+    if (ev.ok) ev.residuals = Residuals(ev.angles_rad);
+    const std::lock_guard<std::mutex> lock(mutex_);
+    cache_.push_back(std::move(ev));
+    if (cache_.size() > 8) cache_.erase(cache_.begin());
+    return cache_.back();
+  }
+
+  // Jacobian of the weighted residuals with respect to u, by the difference
+  // plans of every free parameter; false (with *failure) when a run failed.
+  bool Jacobian(const double* u, Eigen::MatrixXd* jacobian, std::string* failure) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (jacobian_u_.size() == free_.size() &&
+          std::equal(jacobian_u_.begin(), jacobian_u_.end(), u)) {
+        *jacobian = jacobian_;
+        return true;
+      }
+    }
+    const Evaluation base = Evaluate(u);
+    if (!base.ok) {
+      *failure = base.failure;
+      return false;
+    }
+    const Eigen::VectorXd base_residuals = base.residuals;
+    const std::vector<double> p = ValuesAt(u);
+    std::vector<internal::DifferencePlan> plans;
+    std::vector<RunRequest> requests;
+    for (std::size_t i = 0; i < free_.size(); ++i) {
+      const double h = options_.relative_step * free_[i].scale;
+      const std::optional<internal::DifferencePlan> plan =
+          internal::PlanDifference(p[i], h, free_[i].lower, free_[i].upper);
+      CCSRM_CHECK(plan.has_value());  // Identify checked the bounds' width
+      plans.push_back(*plan);
+      for (int t = 0; t < 2; ++t) {
+        std::vector<double> trial = p;
+        trial[i] = plan->trial_values[static_cast<std::size_t>(t)];
+        for (std::size_t e = 0; e < experiments_.size(); ++e) {
+          requests.push_back({e, ParametersAt(e, trial), false});
+        }
+      }
+    }
+    const std::vector<RunResult> results = Run(requests);
+    jacobian->resize(static_cast<Eigen::Index>(index_.size()),
+                     static_cast<Eigen::Index>(free_.size()));
+    const std::size_t ne = experiments_.size();
+    for (std::size_t i = 0; i < free_.size(); ++i) {
+      std::vector<Eigen::MatrixXd> trial_angles[2];
+      for (int t = 0; t < 2; ++t) {
+        for (std::size_t e = 0; e < ne; ++e) {
+          const RunResult& r = results[(i * 2 + static_cast<std::size_t>(t)) * ne + e];
+          if (!r.summary.completed()) {
+            *failure = "finite difference of " + free_[i].name + ": " + experiments_[e].name +
+                       ": " + r.summary.message;
+            return false;
+          }
+          trial_angles[t].push_back(r.angles_rad);
+        }
+      }
+      const Eigen::VectorXd r0 = Residuals(trial_angles[0]);
+      const Eigen::VectorXd r1 = Residuals(trial_angles[1]);
+      const internal::DifferencePlan& plan = plans[i];
+      const double h = options_.relative_step * free_[i].scale;
+      // dr/du = s dr/dp; h dr/dp = (w_b r(p) + w_0 r(t_0) + w_1 r(t_1)) / 2.
+      jacobian->col(static_cast<Eigen::Index>(i)) =
+          (plan.base_weight * base_residuals + plan.trial_weights[0] * r0 +
+           plan.trial_weights[1] * r1) *
+          (free_[i].scale / (2.0 * h));
+    }
+    const std::lock_guard<std::mutex> lock(mutex_);
+    jacobian_u_.assign(u, u + free_.size());
+    jacobian_ = *jacobian;
+    return true;
+  }
+
+  // (simulated - measured) / noise at every residual index.
+  Eigen::VectorXd Residuals(const std::vector<Eigen::MatrixXd>& angles_rad) const {
+    Eigen::VectorXd r(static_cast<Eigen::Index>(index_.size()));
+    for (std::size_t k = 0; k < index_.size(); ++k) {
+      const ResidualIndex& at = index_[k];
+      const Experiment& x = experiments_[at.experiment];
+      const double sim = angles_rad[at.experiment](at.frame, at.column);
+      const double meas = x.measured_rad(at.frame, at.column);
+      r[static_cast<Eigen::Index>(k)] =
+          (sim - meas) * kDeg / x.noise_deg[static_cast<std::size_t>(at.column / 2)];
+    }
+    return r;
+  }
+
+  // RMS of the unweighted residuals [deg].
+  double RmsDeg(const std::vector<Eigen::MatrixXd>& angles_rad) const {
+    double sum = 0.0;
+    for (const ResidualIndex& at : index_) {
+      const double d = (angles_rad[at.experiment](at.frame, at.column) -
+                        experiments_[at.experiment].measured_rad(at.frame, at.column)) *
+                       kDeg;
+      sum += d * d;
+    }
+    return std::sqrt(sum / static_cast<double>(std::max<std::size_t>(index_.size(), 1)));
+  }
+
+  std::optional<double> CachedRmsDeg(const double* u) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (const Evaluation& e : cache_) {
+      if (e.ok && std::equal(e.u.begin(), e.u.end(), u)) return RmsDeg(e.angles_rad);
+    }
+    return std::nullopt;
+  }
+
+  std::optional<Eigen::MatrixXd> CachedJacobian(const double* u) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (jacobian_u_.size() == free_.size() &&
+        std::equal(jacobian_u_.begin(), jacobian_u_.end(), u)) {
+      return jacobian_;
+    }
+    return std::nullopt;
+  }
+
+  std::vector<sim::Trajectory> TakeTrajectories() { return std::move(trajectories_); }
+
+ private:
+  std::vector<RunResult> Run(const std::vector<RunRequest>& requests) {
+    std::vector<RunResult> results = backend_->RunBatch(requests, options_.on_run);
+    simulations_ += static_cast<std::int64_t>(requests.size());
+    return results;
+  }
+
+  const std::vector<Experiment>& experiments_;
+  const IdentificationOptions& options_;
+  std::vector<sim::ArmParameters> base_;
+  std::vector<FreeParameter> free_;
+  SimulationBackend* backend_;
+  std::vector<ResidualIndex> index_;
+  std::mutex mutex_;
+  std::vector<Evaluation> cache_;
+  std::vector<double> jacobian_u_;
+  Eigen::MatrixXd jacobian_;
+  std::vector<sim::Trajectory> trajectories_;
+  std::int64_t simulations_ = 0;
+};
+
+// The whole problem as one residual block of one parameter block: every
+// evaluation is a batch of simulations that the backend spreads out.
+class SimulatedAnglesCost final : public ceres::CostFunction {
+ public:
+  explicit SimulatedAnglesCost(FitProblem* problem) : problem_(problem) {
+    set_num_residuals(static_cast<int>(problem->num_residuals()));
+    mutable_parameter_block_sizes()->push_back(static_cast<std::int32_t>(problem->num_free()));
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    try {
+      const Evaluation ev = problem_->Evaluate(parameters[0]);
+      if (!ev.ok) {
+        last_failure_ = ev.failure;
+        return false;
+      }
+      Eigen::Map<Eigen::VectorXd>(residuals, ev.residuals.size()) = ev.residuals;
+      if (jacobians != nullptr && jacobians[0] != nullptr) {
+        Eigen::MatrixXd j;
+        if (!problem_->Jacobian(parameters[0], &j, &last_failure_)) return false;
+        // Ceres' Jacobians are row-major.
+        Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+            jacobians[0], j.rows(), j.cols()) = j;
+      }
+      return true;
+    } catch (const std::exception& error) {
+      last_failure_ = error.what();
+      return false;
+    }
+  }
+
+  const std::string& last_failure() const { return last_failure_; }
+
+ private:
+  FitProblem* problem_;
+  mutable std::string last_failure_;
+};
+
+class IterationReporter final : public ceres::IterationCallback {
+ public:
+  IterationReporter(FitProblem* problem, const double* u, const IdentificationOptions& options,
+                    std::chrono::steady_clock::time_point start, std::vector<double>* costs)
+      : problem_(problem), u_(u), options_(options), start_(start), costs_(costs) {}
+
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    if (s.step_is_successful || s.iteration == 0) costs_->push_back(s.cost);
+    Report(s);
+    if (s.iteration == 0) previous_.assign(u_, u_ + problem_->num_free());
+    if (s.iteration == 0 || !s.step_is_successful) return ceres::SOLVER_CONTINUE;
+    const bool small = StepWithinStandardErrors(s.cost);
+    previous_.assign(u_, u_ + problem_->num_free());
+    if (small) {
+      converged_by_step_ = true;
+      return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+    }
+    return ceres::SOLVER_CONTINUE;
+  }
+
+  bool converged_by_step() const { return converged_by_step_; }
+
+ private:
+  // The statistical stopping rule: the last step moved every free parameter
+  // by less than options.converged_step_fraction of its standard error
+  // (from the Jacobian at the new point, residual variance 2 cost / (N - p),
+  // without the autocorrelation factor, which only makes errors larger).
+  // Further steps would move the estimate by amounts the data cannot tell
+  // apart, so the fit stops instead of creeping along a flat valley.
+  bool StepWithinStandardErrors(double cost) const {
+    const std::optional<Eigen::MatrixXd> jacobian = problem_->CachedJacobian(u_);
+    const std::size_t p = problem_->num_free();
+    const double n = static_cast<double>(problem_->num_residuals());
+    if (!jacobian || n <= static_cast<double>(p)) return false;
+    const Eigen::MatrixXd h = jacobian->transpose() * *jacobian;
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(h);
+    if (ldlt.info() != Eigen::Success) return false;
+    const Eigen::MatrixXd inverse = ldlt.solve(Eigen::MatrixXd::Identity(h.rows(), h.cols()));
+    const double variance = 2.0 * cost / (n - static_cast<double>(p));
+    for (std::size_t i = 0; i < p; ++i) {
+      const double se =
+          std::sqrt(variance * inverse(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)));
+      const double step = std::abs(u_[i] - previous_[i]);
+      // A direction the data do not determine (se not finite) does not hold the fit back.
+      if (std::isfinite(se) && step > options_.converged_step_fraction * se) return false;
+    }
+    return true;
+  }
+
+  void Report(const ceres::IterationSummary& s) {
+    if (options_.on_iteration) {
+      IterationProgress p;
+      p.iteration = s.iteration;
+      p.cost = s.cost;
+      p.rms_deg = problem_->CachedRmsDeg(u_).value_or(kNaN);
+      p.relative_decrease = s.iteration == 0 ? 0.0 : s.relative_decrease;
+      p.trust_region_radius = s.trust_region_radius;
+      p.step_accepted = s.step_is_successful;
+      p.simulations = problem_->simulations();
+      p.wall_time_s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+      const std::vector<double> values = problem_->ValuesAt(u_);
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        p.values.emplace_back(problem_->free()[i].name, values[i]);
+      }
+      options_.on_iteration(p);
+    }
+  }
+
+  FitProblem* problem_;
+  const double* u_;
+  const IdentificationOptions& options_;
+  std::chrono::steady_clock::time_point start_;
+  std::vector<double>* costs_;
+  std::vector<double> previous_;
+  bool converged_by_step_ = false;
+};
+
+ChannelErrors ErrorsOf(const std::vector<const Experiment*>& experiments,
+                       const std::vector<const Eigen::MatrixXd*>& simulated) {
+  const int joints = experiments.front()->joints;
+  ChannelErrors out;
+  out.rms_deg.assign(static_cast<std::size_t>(joints), {kNaN, kNaN});
+  out.fit_percent.assign(static_cast<std::size_t>(joints), {kNaN, kNaN});
+  out.samples.assign(static_cast<std::size_t>(joints), {0, 0});
+  double total_sq = 0.0, total_spread = 0.0;
+  std::size_t total_n = 0;
+  for (int j = 0; j < joints; ++j) {
+    for (int a = 0; a < 2; ++a) {
+      double sq = 0.0, spread = 0.0;
+      std::size_t n = 0;
+      for (std::size_t e = 0; e < experiments.size(); ++e) {
+        const Eigen::MatrixXd& meas = experiments[e]->measured_rad;
+        if (experiments[e]->joints != joints) continue;
+        // Each experiment's own mean: fit percent compares with a constant
+        // per series, not a mean across experiments.
+        double mean = 0.0;
+        std::size_t count = 0;
+        for (Eigen::Index f = 0; f < meas.rows(); ++f) {
+          if (std::isfinite(meas(f, 2 * j + a))) {
+            mean += meas(f, 2 * j + a);
+            ++count;
+          }
+        }
+        if (count == 0) continue;
+        mean /= static_cast<double>(count);
+        for (Eigen::Index f = 0; f < meas.rows(); ++f) {
+          const double m = meas(f, 2 * j + a);
+          if (!std::isfinite(m)) continue;
+          const double d = ((*simulated[e])(f, 2 * j + a) - m) * kDeg;
+          sq += d * d;
+          spread += (m - mean) * (m - mean) * kDeg * kDeg;
+          ++n;
+        }
+      }
+      const std::size_t jj = static_cast<std::size_t>(j), aa = static_cast<std::size_t>(a);
+      out.samples[jj][aa] = n;
+      if (n > 0) {
+        out.rms_deg[jj][aa] = std::sqrt(sq / static_cast<double>(n));
+        out.fit_percent[jj][aa] = spread > 0.0 ? 100.0 * (1.0 - std::sqrt(sq / spread)) : kNaN;
+      }
+      total_sq += sq;
+      total_spread += spread;
+      total_n += n;
+    }
+  }
+  out.rms_deg_overall = total_n > 0 ? std::sqrt(total_sq / static_cast<double>(total_n)) : kNaN;
+  out.fit_percent_overall =
+      total_spread > 0.0 ? 100.0 * (1.0 - std::sqrt(total_sq / total_spread)) : kNaN;
+  return out;
+}
+
+IdentificationTermination FromCeres(ceres::TerminationType type) {
+  switch (type) {
+    case ceres::CONVERGENCE:
+    case ceres::USER_SUCCESS:
+      return IdentificationTermination::kConverged;
+    case ceres::NO_CONVERGENCE:
+      return IdentificationTermination::kNoConvergence;
+    default:
+      return IdentificationTermination::kFailed;
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> Spec6ParameterNames() {
+  return {"mu", "mu_s", "mu_c", "mu_c_s", "beta", "c_sc", "c_lc", "T_p", "T_d0"};
+}
+
+const char* TerminationName(IdentificationTermination termination) {
+  switch (termination) {
+    case IdentificationTermination::kConverged:
+      return "converged";
+    case IdentificationTermination::kNoConvergence:
+      return "no convergence";
+    case IdentificationTermination::kFailed:
+      return "failed";
+  }
+  return "?";
+}
+
+bool IdentificationOptions::IsValid(std::string* error) const {
+  const auto fail = [error](const std::string& message) {
+    *error = message;
+    return false;
+  };
+  if (free_parameters.empty()) return fail("free parameters: none given");
+  std::set<std::string> seen;
+  for (const std::string& name : free_parameters) {
+    try {
+      sim::FindParameter(name, "free parameters");
+    } catch (const InputError& e) {
+      return fail(e.what());
+    }
+    if (!seen.insert(name).second) return fail("free parameters: '" + name + "' is repeated");
+  }
+  for (const auto& [name, value] : values) {
+    try {
+      const sim::ParameterInfo& info = sim::FindParameter(name, "values");
+      const std::string problem = sim::ParameterValueProblem(info, value);
+      if (!problem.empty()) return fail("values: " + problem);
+    } catch (const InputError& e) {
+      return fail(e.what());
+    }
+  }
+  for (const auto& [name, range] : bounds) {
+    if (seen.count(name) == 0) {
+      return fail("bounds: '" + name + "' is not a free parameter");
+    }
+    const sim::ParameterInfo& info = sim::FindParameter(name, "bounds");
+    if (!(range.first < range.second) || !std::isfinite(range.first) ||
+        !std::isfinite(range.second)) {
+      return fail("bounds of '" + name + "': the lower bound must be below the upper one");
+    }
+    if (range.first < info.lower || range.second > info.upper) {
+      char text[256];
+      std::snprintf(text, sizeof(text), "bounds of '%s': [%g, %g] leave its own bounds [%g, %g]",
+                    name.c_str(), range.first, range.second, info.lower, info.upper);
+      return fail(text);
+    }
+  }
+  if (!(relative_step > 0.0 && relative_step <= 0.1)) {
+    return fail("relative_step must be in (0, 0.1]");
+  }
+  if (threads < 1) return fail("threads must be >= 1");
+  if (max_iterations < 0) return fail("max_iterations must be >= 0");
+  if (!(function_tolerance > 0.0) || !(parameter_tolerance > 0.0) || !(gradient_tolerance > 0.0)) {
+    return fail("tolerances must be > 0");
+  }
+  if (!(max_relative_standard_error > 0.0)) return fail("max_relative_standard_error must be > 0");
+  if (!(converged_step_fraction >= 0.0)) return fail("converged_step_fraction must be >= 0");
+  return true;
+}
+
+const ParameterEstimate* IdentificationSummary::Find(const std::string& name) const {
+  for (const ParameterEstimate& p : parameters) {
+    if (p.name == name) return &p;
+  }
+  return nullptr;
+}
+
+IdentificationSummary Identify(const std::vector<Experiment>& experiments,
+                               const IdentificationOptions& options) {
+  const auto clock_start = std::chrono::steady_clock::now();
+  std::string error;
+  if (!options.IsValid(&error)) ThrowInputError("identification", "options", error);
+  if (experiments.empty()) ThrowInputError("identification", "experiments", "none given");
+  for (const Experiment& e : experiments) {
+    if (e.joints != experiments.front().joints) {
+      ThrowInputError(e.path, "joints",
+                      "the experiments' arms differ (" + std::to_string(e.joints) + " against " +
+                          std::to_string(experiments.front().joints) + " joints)");
+    }
+  }
+
+  // Every experiment's parameters: its nominal values with options.values.
+  std::vector<sim::ArmParameters> base;
+  for (const Experiment& e : experiments) {
+    sim::ArmParameters p = e.config.parameters;
+    for (const auto& [name, value] : options.values) SetParameter(name, value, "--set", &p);
+    base.push_back(p);
+  }
+  // The free parameters: start from the first experiment's value.
+  std::vector<FreeParameter> free;
+  for (const std::string& name : options.free_parameters) {
+    const sim::ParameterInfo& info = sim::FindParameter(name, "--free");
+    FreeParameter f;
+    f.name = name;
+    f.lower = info.lower;
+    f.upper = info.upper;
+    if (const auto it = options.bounds.find(name); it != options.bounds.end()) {
+      f.lower = it->second.first;
+      f.upper = it->second.second;
+    }
+    f.start = sim::GetParameter(base.front(), name);
+    if (f.start < f.lower || f.start > f.upper) {
+      char text[256];
+      std::snprintf(text, sizeof(text), "start value %g is outside the bounds [%g, %g] %s", f.start,
+                    f.lower, f.upper, info.units.c_str());
+      ThrowInputError("parameter '" + name + "'", "", text);
+    }
+    const double nominal = sim::GetParameter(experiments.front().config.parameters, name);
+    f.scale = f.start != 0.0   ? std::abs(f.start)
+              : nominal != 0.0 ? std::abs(nominal)
+                               : 0.01 * (f.upper - f.lower);
+    // Every difference plan must fit inside the bounds (see PlanDifference).
+    if (f.upper - f.lower < 2.0 * options.relative_step * f.scale) {
+      ThrowInputError("parameter '" + name + "'", "bounds",
+                      "too narrow for a finite-difference step of " +
+                          std::to_string(options.relative_step * f.scale));
+    }
+    free.push_back(f);
+  }
+  for (const sim::ArmParameters& p : base) {
+    if (!p.IsValid(&error)) ThrowInputError("identification", "parameters", error);
+  }
+
+  std::unique_ptr<SimulationBackend> own_backend;
+  SimulationBackend* backend = options.backend.get();
+  if (backend == nullptr) {
+    own_backend = MakeThreadBackend(&experiments, options.threads);
+    backend = own_backend.get();
+  }
+  FitProblem problem(experiments, options, base, free, backend);
+
+  IdentificationSummary summary;
+  summary.threads = backend->parallelism();
+  summary.relative_step = options.relative_step;
+  summary.residuals = problem.num_residuals();
+  for (const FreeParameter& f : free) summary.free_names.push_back(f.name);
+
+  std::vector<double> u(free.size());
+  for (std::size_t i = 0; i < free.size(); ++i) u[i] = free[i].start / free[i].scale;
+
+  // The start point first: a start that does not run is an answer in itself.
+  const Evaluation start_eval = problem.Evaluate(u.data());
+
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem ceres_problem(problem_options);
+  SimulatedAnglesCost cost(&problem);
+  ceres_problem.AddResidualBlock(&cost, nullptr, u.data());
+  for (std::size_t i = 0; i < free.size(); ++i) {
+    ceres_problem.SetParameterLowerBound(u.data(), static_cast<int>(i),
+                                         free[i].lower / free[i].scale);
+    ceres_problem.SetParameterUpperBound(u.data(), static_cast<int>(i),
+                                         free[i].upper / free[i].scale);
+  }
+
+  if (!start_eval.ok) {
+    summary.termination = IdentificationTermination::kFailed;
+    summary.message = "the run at the start values did not complete: " + start_eval.failure;
+  } else {
+    ceres::Solver::Options solver;
+    solver.minimizer_type = ceres::TRUST_REGION;
+    solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+    solver.linear_solver_type = ceres::DENSE_QR;
+    solver.max_num_iterations = options.max_iterations;
+    solver.function_tolerance = options.function_tolerance;
+    solver.parameter_tolerance = options.parameter_tolerance;
+    solver.gradient_tolerance = options.gradient_tolerance;
+    solver.num_threads = 1;  // the parallelism is in the backend
+    solver.logging_type = ceres::SILENT;
+    solver.update_state_every_iteration = true;
+    IterationReporter progress(&problem, u.data(), options, clock_start, &summary.cost_history);
+    solver.callbacks.push_back(&progress);
+    ceres::Solver::Summary ceres_summary;
+    ceres::Solve(solver, &ceres_problem, &ceres_summary);
+    summary.termination = FromCeres(ceres_summary.termination_type);
+    summary.message = progress.converged_by_step()
+                          ? "the last step moved every parameter by less than " +
+                                std::to_string(options.converged_step_fraction) +
+                                " of its standard error"
+                          : ceres_summary.message;
+    if (summary.termination == IdentificationTermination::kFailed && !cost.last_failure().empty()) {
+      summary.message += " (" + cost.last_failure() + ")";
+    }
+    summary.iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
+    summary.initial_cost = ceres_summary.initial_cost;
+    summary.final_cost = ceres_summary.final_cost;
+    // Ceres leaves u at the best point it accepted.
+  }
+
+  // The final point: runs with their trajectories, residual statistics.
+  const std::vector<double> p_final = problem.ValuesAt(u.data());
+  const Evaluation final_eval = problem.Evaluate(u.data(), /*keep_trajectories=*/true);
+  std::vector<sim::Trajectory> trajectories = problem.TakeTrajectories();
+  if (!start_eval.ok) {
+    summary.initial_cost = summary.final_cost = kNaN;
+  } else if (final_eval.ok) {
+    summary.final_cost = 0.5 * final_eval.residuals.squaredNorm();
+    summary.initial_cost = 0.5 * start_eval.residuals.squaredNorm();
+  }
+
+  const std::size_t p_count = free.size();
+  Eigen::MatrixXd covariance_u;  // free × free, scaled space, times σ_res²
+  std::vector<bool> identifiable(p_count, true);
+  if (final_eval.ok) {
+    // Effective samples from the residual series of every experiment, joint and axis.
+    std::vector<std::vector<double>> series;
+    std::size_t k = 0;
+    const std::vector<ResidualIndex>& index = problem.index();
+    for (std::size_t e = 0; e < experiments.size(); ++e) {
+      const int columns = 2 * experiments[e].joints;
+      std::vector<std::vector<double>> per_column(static_cast<std::size_t>(columns));
+      for (; k < index.size() && index[k].experiment == e; ++k) {
+        per_column[index[k].column].push_back(final_eval.residuals[static_cast<Eigen::Index>(k)]);
+      }
+      for (auto& c : per_column) series.push_back(std::move(c));
+    }
+    summary.effective_samples = internal::EffectiveSampleSize(series);
+    const double n = static_cast<double>(summary.residuals);
+    summary.residual_variance = n > static_cast<double>(p_count)
+                                    ? 2.0 * summary.final_cost / (n - static_cast<double>(p_count))
+                                    : kNaN;
+    const double inflation = summary.effective_samples > 0.0 ? n / summary.effective_samples : 1.0;
+    const double variance_factor = summary.residual_variance * inflation;
+
+    // Singular values of the scaled Jacobian, and what the data cannot pin down.
+    Eigen::MatrixXd jacobian;
+    std::string failure;
+    if (problem.Jacobian(u.data(), &jacobian, &failure)) {
+      const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian, Eigen::ComputeThinV);
+      const Eigen::VectorXd sv = svd.singularValues();
+      const Eigen::MatrixXd v = svd.matrixV();
+      summary.singular_values.assign(sv.data(), sv.data() + sv.size());
+      const double sigma_res = std::sqrt(variance_factor);
+      const double tiny = sv.size() > 0 ? sv[0] * 1e-8 : 0.0;
+      int null_rank = 0;
+      Eigen::VectorXd direction_error(sv.size());
+      for (Eigen::Index d = 0; d < sv.size(); ++d) {
+        direction_error[d] =
+            sv[d] > tiny ? sigma_res / sv[d] : std::numeric_limits<double>::infinity();
+        if (!(sv[d] > tiny)) ++null_rank;
+      }
+      for (std::size_t i = 0; i < p_count; ++i) {
+        double var = 0.0;
+        for (Eigen::Index d = 0; d < sv.size(); ++d) {
+          const double c = v(static_cast<Eigen::Index>(i), d);
+          if (c != 0.0) var += c * c * direction_error[d] * direction_error[d];
+        }
+        // Relative to the scale of the estimate: u is in units of the start's.
+        const double relative =
+            std::sqrt(var) * free[i].scale / std::max(std::abs(p_final[i]), 1e-12 * free[i].scale);
+        identifiable[i] =
+            std::isfinite(relative) && relative <= options.max_relative_standard_error;
+      }
+      for (Eigen::Index d = 0; d < sv.size(); ++d) {
+        if (direction_error[d] <= options.max_relative_standard_error) continue;
+        UnidentifiableDirection dir;
+        dir.singular_value = sv[d];
+        dir.relative_std_error = direction_error[d];
+        std::vector<std::pair<std::string, double>> parts;
+        for (std::size_t i = 0; i < p_count; ++i) {
+          const double c = v(static_cast<Eigen::Index>(i), d);
+          if (std::abs(c) >= 0.2) parts.emplace_back(free[i].name, c);
+        }
+        std::sort(parts.begin(), parts.end(), [](const auto& a, const auto& b) {
+          return std::abs(a.second) > std::abs(b.second);
+        });
+        dir.components = std::move(parts);
+        summary.unidentifiable.push_back(std::move(dir));
+      }
+
+      // Covariance by Ceres, exact null directions dropped.
+      ceres::Covariance::Options cov_options;
+      cov_options.algorithm_type = ceres::DENSE_SVD;
+      cov_options.null_space_rank = null_rank;
+      cov_options.min_reciprocal_condition_number = 1e-16;
+      cov_options.apply_loss_function = false;
+      cov_options.num_threads = 1;
+      ceres::Covariance ceres_covariance(cov_options);
+      std::vector<std::pair<const double*, const double*>> blocks = {{u.data(), u.data()}};
+      if (ceres_covariance.Compute(blocks, &ceres_problem)) {
+        covariance_u.resize(static_cast<Eigen::Index>(p_count), static_cast<Eigen::Index>(p_count));
+        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> c(
+            static_cast<Eigen::Index>(p_count), static_cast<Eigen::Index>(p_count));
+        ceres_covariance.GetCovarianceBlock(u.data(), u.data(), c.data());
+        covariance_u = c * variance_factor;
+        summary.covariance_available = true;
+      } else {
+        summary.covariance_message = "ceres::Covariance failed at the final point";
+      }
+    } else {
+      summary.covariance_message = "the Jacobian at the final point failed: " + failure;
+    }
+  } else {
+    summary.covariance_message = "the run at the final point did not complete";
+  }
+
+  // Parameter table: free ones first, then every other named parameter.
+  const double t975 =
+      internal::StudentT975(summary.effective_samples - static_cast<double>(p_count));
+  for (std::size_t i = 0; i < p_count; ++i) {
+    const sim::ParameterInfo& info = sim::FindParameter(free[i].name, "--free");
+    ParameterEstimate est;
+    est.name = free[i].name;
+    est.units = info.units;
+    est.free = true;
+    est.start = free[i].start;
+    est.value = p_final[i];
+    est.lower = free[i].lower;
+    est.upper = free[i].upper;
+    est.scale = free[i].scale;
+    const double span = free[i].upper - free[i].lower;
+    est.at_bound = std::abs(est.value - est.lower) <= 1e-9 * span ||
+                   std::abs(est.value - est.upper) <= 1e-9 * span;
+    est.identifiable = summary.covariance_available && identifiable[i];
+    if (est.identifiable) {
+      est.std_error =
+          std::sqrt(std::max(
+              covariance_u(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)), 0.0)) *
+          free[i].scale;
+      est.ci95_lower = std::max(est.value - t975 * est.std_error, est.lower);
+      est.ci95_upper = std::min(est.value + t975 * est.std_error, est.upper);
+    }
+    summary.parameters.push_back(est);
+  }
+  for (const std::string& name : AllParameterNames()) {
+    if (std::find(summary.free_names.begin(), summary.free_names.end(), name) !=
+        summary.free_names.end()) {
+      continue;
+    }
+    const sim::ParameterInfo& info = sim::FindParameter(name, "parameters");
+    ParameterEstimate est;
+    est.name = name;
+    est.units = info.units;
+    est.free = false;
+    est.start = est.value = sim::GetParameter(base.front(), name);
+    est.lower = info.lower;
+    est.upper = info.upper;
+    est.identifiable = false;
+    summary.parameters.push_back(est);
+  }
+  summary.correlation = Eigen::MatrixXd::Constant(static_cast<Eigen::Index>(p_count),
+                                                  static_cast<Eigen::Index>(p_count), kNaN);
+  if (summary.covariance_available) {
+    for (std::size_t i = 0; i < p_count; ++i) {
+      for (std::size_t j = 0; j < p_count; ++j) {
+        if (!identifiable[i] || !identifiable[j]) continue;
+        const Eigen::Index a = static_cast<Eigen::Index>(i), b = static_cast<Eigen::Index>(j);
+        const double d = std::sqrt(covariance_u(a, a) * covariance_u(b, b));
+        summary.correlation(a, b) = d > 0.0 ? covariance_u(a, b) / d : kNaN;
+      }
+    }
+  }
+
+  // Errors per experiment and overall, at the start and at the end.
+  std::vector<const Experiment*> all;
+  std::vector<const Eigen::MatrixXd*> start_angles, final_angles;
+  for (std::size_t e = 0; e < experiments.size(); ++e) {
+    ExperimentFit fit;
+    fit.name = experiments[e].name;
+    fit.path = experiments[e].path;
+    fit.angles_from_pipeline = experiments[e].angles_from_pipeline;
+    fit.noise_deg = experiments[e].noise_deg;
+    fit.noise_source = experiments[e].noise_source;
+    if (start_eval.ok || !start_eval.angles_rad.empty()) {
+      fit.start = ErrorsOf({&experiments[e]}, {&start_eval.angles_rad[e]});
+    }
+    fit.fitted = ErrorsOf({&experiments[e]}, {&final_eval.angles_rad[e]});
+    fit.run.summary = final_eval.summaries[e];
+    if (e < trajectories.size()) fit.run.trajectory = std::move(trajectories[e]);
+    fit.parameters = problem.ParametersAt(e, p_final);
+    fit.simulated_rad = final_eval.angles_rad[e];
+    summary.experiments.push_back(std::move(fit));
+    all.push_back(&experiments[e]);
+    start_angles.push_back(&start_eval.angles_rad[e]);
+    final_angles.push_back(&final_eval.angles_rad[e]);
+  }
+  summary.start_errors = ErrorsOf(all, start_angles);
+  summary.errors = ErrorsOf(all, final_angles);
+  summary.simulations = problem.simulations();
+  summary.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+  if (!final_eval.ok && summary.termination != IdentificationTermination::kFailed) {
+    summary.termination = IdentificationTermination::kFailed;
+    summary.message = "the run at the final point did not complete: " + final_eval.failure;
+  }
+  return summary;
+}
+
+}  // namespace ccsrm::identify

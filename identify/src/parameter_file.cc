@@ -1,0 +1,106 @@
+// `ccsrm identify --params FILE`: values, free flags and bounds by name.
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+
+#include "ccsrm/common/error.h"
+#include "ccsrm/identify/identification.h"
+
+namespace ccsrm::identify {
+namespace {
+
+double Number(const YAML::Node& node, const std::string& file, const std::string& where) {
+  try {
+    if (!node.IsScalar()) throw YAML::Exception(node.Mark(), "not a scalar");
+    return node.as<double>();
+  } catch (const YAML::Exception&) {
+    ThrowInputError(file, where, "expected a number");
+  }
+}
+
+}  // namespace
+
+void ApplyParameterFile(const std::string& yaml_text, const std::string& file,
+                        IdentificationOptions* options) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    ThrowInputError(file, "line " + std::to_string(e.mark.line + 1), "not valid YAML: " + e.msg);
+  }
+  std::string prefix;
+  if (root.IsMap() && root["parameters"]) {  // a truth file of ccsrm generate
+    root = root["parameters"];
+    prefix = "parameters.";
+  }
+  if (!root.IsMap()) {
+    ThrowInputError(file, "",
+                    "expected a mapping of parameter names to values or to {value, free, "
+                    "bounds} (e.g. 'mu: 0.18')");
+  }
+  // Built aside and applied only when the whole file is good.
+  IdentificationOptions updated = *options;
+  for (const auto& entry : root) {
+    const std::string name = entry.first.as<std::string>();
+    const std::string where =
+        "line " + std::to_string(entry.first.Mark().line + 1) + ", key '" + prefix + name + "'";
+    const sim::ParameterInfo* info = nullptr;
+    try {
+      info = &sim::FindParameter(name, file);
+    } catch (const InputError&) {
+      std::string known;
+      for (const std::string& n : AllParameterNames()) known += (known.empty() ? "" : ", ") + n;
+      ThrowInputError(file, where, "unknown parameter (known: " + known + ")");
+    }
+    const auto set_value = [&](double value, const std::string& at) {
+      const std::string problem = sim::ParameterValueProblem(*info, value);
+      if (!problem.empty()) ThrowInputError(file, at, problem);
+      updated.values[name] = value;
+    };
+    if (entry.second.IsScalar()) {
+      set_value(Number(entry.second, file, where), where);
+      continue;
+    }
+    if (!entry.second.IsMap()) {
+      ThrowInputError(file, where, "expected a number or a mapping {value, free, bounds}");
+    }
+    for (const auto& field : entry.second) {
+      const std::string key = field.first.as<std::string>();
+      const std::string at = "line " + std::to_string(field.first.Mark().line + 1) + ", key '" +
+                             prefix + name + "." + key + "'";
+      if (key == "value" || key == "start") {
+        set_value(Number(field.second, file, at), at);
+      } else if (key == "free") {
+        bool free = false;
+        try {
+          free = field.second.as<bool>();
+        } catch (const YAML::Exception&) {
+          ThrowInputError(file, at, "expected true or false");
+        }
+        auto& list = updated.free_parameters;
+        const auto it = std::find(list.begin(), list.end(), name);
+        if (free && it == list.end()) list.push_back(name);
+        if (!free && it != list.end()) list.erase(it);
+      } else if (key == "bounds") {
+        if (!field.second.IsSequence() || field.second.size() != 2) {
+          ThrowInputError(file, at, "expected [lower, upper]");
+        }
+        const double lower = Number(field.second[0], file, at);
+        const double upper = Number(field.second[1], file, at);
+        if (!(lower < upper) || lower < info->lower || upper > info->upper) {
+          char text[256];
+          std::snprintf(text, sizeof(text),
+                        "[%g, %g] must be increasing and inside the parameter's bounds [%g, %g] %s",
+                        lower, upper, info->lower, info->upper, info->units.c_str());
+          ThrowInputError(file, at, text);
+        }
+        updated.bounds[name] = {lower, upper};
+      } else {
+        ThrowInputError(file, at, "unknown field (known: value, free, bounds)");
+      }
+    }
+  }
+  *options = std::move(updated);
+}
+
+}  // namespace ccsrm::identify
