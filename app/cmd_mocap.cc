@@ -1,24 +1,25 @@
 // ccsrm mocap inspect FILE [--json]
 // ccsrm mocap process --in FILE (--rigid-bodies rb.yaml | --config cfg.yaml) ... --out exp.h5
 // ccsrm mocap rigid-bodies --config cfg.yaml [--static-trial FILE] --out rb.yaml
+// ccsrm mocap export --in FILE [--units mm|m] --out markers.c3d
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
-#include "ccsrm/cameras/camera_model.h"
 #include "ccsrm/cameras/reconstruction.h"
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/datasets/experiment_file.h"
-#include "ccsrm/datasets/inspect.h"
-#include "ccsrm/datasets/run_file.h"
+#include "ccsrm/mocap/c3d.h"
 #include "ccsrm/mocap/marker_io.h"
 #include "ccsrm/mocap/marker_layout.h"
 #include "ccsrm/mocap/processing.h"
+#include "ccsrm/mocap/recording.h"
 #include "ccsrm/mocap/rigid_bodies.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
@@ -30,12 +31,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-bool IsHdf5Name(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".h5" || ext == ".hdf5";
-}
-
 // Never write onto an input (SPEC 11): the same path or the same file.
 void RefuseToOverwrite(const std::string& input, const std::string& output) {
   std::error_code ec;
@@ -44,59 +39,14 @@ void RefuseToOverwrite(const std::string& input, const std::string& output) {
   }
 }
 
-struct Layout {
-  mocap::MarkerLayout layout;
-  std::string config_yaml;  // the configuration text, when --config was given
-  // Joint positions of the arm, from --config or else the experiment's
-  // nominal configuration; none when neither is there.
-  std::optional<mocap::JointChain> chain;
-  // For labelling camera reconstructions; 0 without an arm configuration.
-  double max_link_spacing_m = 0.0;
-};
-
-// The rigid bodies: --rigid-bodies, else the default layout of --config, else
-// (for an experiment input) the experiment's own; --static-trial refines them.
-Layout ResolveLayout(const std::string& rigid_bodies, const std::string& config,
-                     const std::string& static_trial, const datasets::ExperimentFile* experiment,
-                     const std::string& input) {
-  Layout out;
-  std::unique_ptr<sim::ArmModel> model;
-  if (!config.empty()) {
-    out.config_yaml = ReadTextFile(config);
-    model = std::make_unique<sim::ArmModel>(sim::ParseConfig(out.config_yaml, config).arm);
-  } else if (experiment != nullptr && !experiment->config_yaml.empty()) {
-    model = std::make_unique<sim::ArmModel>(
-        sim::ParseConfig(experiment->config_yaml, input + ": attribute 'config_yaml'").arm);
+void PrintRefinement(const std::string& static_trial, const mocap::StaticTrialRefinement& refined) {
+  double largest = 0.0;
+  for (double d : refined.displacement_m) {
+    if (std::isfinite(d)) largest = std::max(largest, d);
   }
-  if (model) {
-    out.chain = mocap::JointChain::FromModel(*model);
-    out.max_link_spacing_m = cameras::MaxLinkSpacing(*model);
-  }
-  if (!rigid_bodies.empty()) {
-    out.layout = mocap::ReadRigidBodiesFile(rigid_bodies);
-  } else if (model) {
-    out.layout = mocap::DefaultMarkerLayout(*model);
-  } else if (experiment != nullptr && !experiment->rigid_bodies.empty()) {
-    out.layout = mocap::LayoutFromExperiment(experiment->rigid_bodies, input);
-  } else {
-    ThrowInputError(input, "rigid bodies",
-                    "give --rigid-bodies FILE or --config FILE (the default marker layout)");
-  }
-  if (!static_trial.empty()) {
-    if (!model)
-      ThrowInputError(static_trial, "--static-trial", "needs --config (the arm's kinematics)");
-    const mocap::StaticTrialRefinement refined = mocap::RefineFromStaticTrial(
-        out.layout, *model, mocap::ReadMarkerFile(static_trial), static_trial);
-    double largest = 0.0;
-    for (double d : refined.displacement_m) {
-      if (std::isfinite(d)) largest = std::max(largest, d);
-    }
-    std::printf("static trial %s: marker positions refined (largest change %.3f mm)\n",
-                static_trial.c_str(), largest * 1e3);
-    for (const std::string& w : refined.warnings) std::printf("  warning: %s\n", w.c_str());
-    out.layout = refined.layout;
-  }
-  return out;
+  std::printf("static trial %s: marker positions refined (largest change %.3f mm)\n",
+              static_trial.c_str(), largest * 1e3);
+  for (const std::string& w : refined.warnings) std::printf("  warning: %s\n", w.c_str());
 }
 
 struct ProcessArgs {
@@ -113,22 +63,8 @@ struct ProcessArgs {
   bool quiet = false;
 };
 
-// /input/time and /input/length_change of a run or experiment file.
-void CopyInputs(const std::string& path, datasets::ExperimentFile* experiment) {
-  const datasets::FileSummary summary = datasets::InspectFile(path);
-  if (summary.kind == datasets::FileKind::kExperiment) {
-    const datasets::ExperimentFile source = datasets::ReadExperimentFile(path);
-    experiment->input_time = source.input_time;
-    experiment->input_length_change = source.input_length_change;
-  } else {
-    const datasets::RunFile run = datasets::ReadRunFile(path);
-    experiment->input_time = run.time;
-    experiment->input_length_change = run.input_length_change;
-  }
-}
-
-void RunProcess(ProcessArgs a) {
-  a.options.rigid_fill = !a.no_rigid_fill;
+// Parse (done by CLI11) -> mocap::ProcessRecording -> write -> print.
+void RunProcess(const ProcessArgs& a) {
   if (a.in.empty() && a.cameras.empty()) {
     ThrowInputError("mocap process", "--in", "give --in FILE or --cameras FILE --video ...");
   }
@@ -136,43 +72,18 @@ void RunProcess(ProcessArgs a) {
     ThrowInputError(a.cameras, "--config",
                     "videos need --config or --rigid-bodies (the markers to label)");
   }
-  if (!a.in.empty()) RefuseToOverwrite(a.in, a.out);
-  if (!a.cameras.empty()) RefuseToOverwrite(a.cameras, a.out);
+  for (const std::string& input :
+       {a.in, a.cameras, a.rigid_bodies, a.config, a.static_trial, a.inputs}) {
+    if (!input.empty()) RefuseToOverwrite(input, a.out);
+  }
   for (const std::string& video : a.videos) RefuseToOverwrite(video, a.out);
   { const AtomicOutputFile probe(a.out); }  // fail on a bad output path before working
 
-  // What is read, and the experiment the result goes into.
-  datasets::ExperimentFile experiment;
-  mocap::MarkerTable table;
-  std::vector<double> time;
-  bool from_experiment = false;
-  std::string run_config_yaml;
-  if (IsHdf5Name(a.in) && datasets::InspectFile(a.in).kind == datasets::FileKind::kExperiment) {
-    experiment = datasets::ReadExperimentFile(a.in);
-    table = mocap::MarkerTableFromExperiment(experiment);
-    time = experiment.mocap_time.values;
-    from_experiment = true;
-  } else if (IsHdf5Name(a.in)) {  // a run with virtual markers
-    const datasets::RunFile run = datasets::ReadRunFile(a.in);
-    table = mocap::ReadHdf5Markers(a.in);
-    time = run.time.values;
-    experiment.input_time = run.time;
-    experiment.input_length_change = run.input_length_change;
-    experiment.source = datasets::ExperimentSource::kGenerated;
-    run_config_yaml = run.config_yaml;
-  } else if (a.cameras.empty()) {
-    table = mocap::ReadMarkerFile(a.in);
-  }
-
-  const std::string& source = a.cameras.empty() ? a.in : a.cameras;
-  const Layout layout = ResolveLayout(a.rigid_bodies, a.config, a.static_trial,
-                                      from_experiment ? &experiment : nullptr, source);
+  mocap::RecordingRequest request;
+  request.in = a.in;
   if (!a.cameras.empty()) {
     // Camera front end (mocap/cameras): the same marker table a file gives.
-    const cameras::CameraRig rig = cameras::LoadCameraRig(a.cameras);
     cameras::ReconstructionOptions options;
-    if (layout.max_link_spacing_m > 0.0)
-      options.labelling.max_link_spacing_m = layout.max_link_spacing_m;
     if (!a.quiet) {
       options.progress = [](std::size_t done, std::size_t total) {
         if (done % 25 == 0 || done == total) {
@@ -181,36 +92,22 @@ void RunProcess(ProcessArgs a) {
         }
       };
     }
-    const cameras::ReconstructionResult reconstruction =
-        cameras::ReconstructMarkers(rig, a.videos, layout.layout, options);
-    std::printf("%s", reconstruction.quality.BriefReport().c_str());
-    table = reconstruction.markers;
+    request.reconstruct = cameras::VideoMarkerSource(a.cameras, a.videos, options);
+    request.reconstruction_source = a.cameras;
   }
-  const mocap::ProcessingResult result = mocap::ProcessMarkers(
-      table, time, layout.layout, a.options, a.in, layout.chain ? &*layout.chain : nullptr);
+  request.rigid_bodies = a.rigid_bodies;
+  request.config = a.config;
+  request.static_trial = a.static_trial;
+  request.inputs = a.inputs;
+  request.name = fs::path(a.out).stem().string();
+  request.processing = a.options;
+  request.processing.rigid_fill = !a.no_rigid_fill;
+  const mocap::ProcessedRecording processed = mocap::ProcessRecording(request);
 
-  if (!from_experiment) {
-    experiment.name = fs::path(a.out).stem().string();
-    experiment.description = "markers of " + fs::path(source).filename().string() + " (" +
-                             table.format + "), processed by ccsrm mocap process";
-    experiment.config_yaml = !layout.config_yaml.empty() ? layout.config_yaml : run_config_yaml;
-    experiment.mocap_time = datasets::Array({result.time.size()});
-    experiment.mocap_time.values = result.time;
-    experiment.mocap_markers = result.raw_markers;
-    experiment.marker_names = result.marker_names;
-    if (experiment.input_time.rows() == 0) {
-      // No actuator record: one sample at the start with no cable columns.
-      experiment.input_time = datasets::Array({1}, result.time.front());
-      experiment.input_length_change = datasets::Array({1, 0});
-    }
-  }
-  if (!a.inputs.empty()) CopyInputs(a.inputs, &experiment);
-  experiment.rigid_bodies = mocap::ToExperimentRigidBodies(layout.layout);
-  experiment.mocap_quality.clear();
-  experiment.mocap_quality_units.clear();
-  experiment.created.clear();
-  mocap::StoreInExperiment(result, &experiment);
-  datasets::WriteExperimentFile(a.out, experiment);
+  if (processed.static_trial) PrintRefinement(a.static_trial, *processed.static_trial);
+  std::printf("%s", processed.reconstruction_report.c_str());
+  datasets::WriteExperimentFile(a.out, processed.experiment);
+  const mocap::ProcessingResult& result = processed.result;
   if (a.quiet) {
     std::printf("%s\n", result.summary.BriefReport().c_str());
   } else {
@@ -218,6 +115,40 @@ void RunProcess(ProcessArgs a) {
   }
   std::printf("  output: %s (%zu frames, %zu joints)\n", a.out.c_str(), result.time.size(),
               result.summary.joints.size());
+}
+
+// The rigid bodies of `ccsrm mocap rigid-bodies`: the default layout of the
+// configuration, refined from a static trial when one is given.
+mocap::MarkerLayout DefaultLayout(const std::string& config, const std::string& static_trial) {
+  const sim::ArmModel model(sim::LoadConfig(config).arm);
+  mocap::MarkerLayout layout = mocap::DefaultMarkerLayout(model);
+  if (static_trial.empty()) return layout;
+  const mocap::StaticTrialRefinement refined = mocap::RefineFromStaticTrial(
+      layout, model, mocap::ReadMarkerFile(static_trial), static_trial);
+  PrintRefinement(static_trial, refined);
+  return refined.layout;
+}
+
+struct ExportArgs {
+  std::string in;
+  std::string out;
+  std::string units = mocap::C3dWriteOptions().units;
+};
+
+// ccsrm mocap export: any marker file as C3D.
+void RunExport(const ExportArgs& a) {
+  std::string extension = fs::path(a.out).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension != ".c3d") ThrowInputError(a.out, "--out", "unsupported format (expected .c3d)");
+  RefuseToOverwrite(a.in, a.out);
+  mocap::C3dWriteOptions options;
+  options.units = a.units;
+  std::string error;
+  if (!options.IsValid(&error)) ThrowInputError("mocap export", "--units", error);
+  const mocap::MarkerTable table = mocap::ReadMarkerFile(a.in);
+  mocap::WriteC3d(a.out, table, options);
+  std::printf("%s: %zu frames, %zu markers at %g Hz (C3D, Intel, float storage, %s)\n",
+              a.out.c_str(), table.frames(), table.markers(), table.rate_hz, options.units.c_str());
 }
 
 }  // namespace
@@ -294,6 +225,18 @@ void AddMocapCommands(CLI::App& root) {
   process->add_flag("--quiet", a->quiet, "One summary line instead of the quality tables");
   process->callback([a] { RunProcess(*a); });
 
+  CLI::App* exporter = mocap->add_subcommand(
+      "export",
+      "Write any marker file (C3D, TRC, Nexus/Motive CSV, our HDF5 experiment or run) as a C3D "
+      "file: Intel, float storage; times restart at 0 (C3D keeps a rate, not a start time)");
+  auto e = std::make_shared<ExportArgs>();
+  exporter->add_option("--in", e->in, "Marker file (any format mocap inspect reads)")->required();
+  exporter->add_option("--units", e->units, "Unit of the stored coordinates: mm or m")
+      ->default_val(e->units)
+      ->check(CLI::IsMember({"mm", "m"}));
+  exporter->add_option("--out", e->out, "Output C3D file (.c3d)")->required();
+  exporter->callback([e] { RunExport(*e); });
+
   CLI::App* rigid = mocap->add_subcommand(
       "rigid-bodies",
       "Write the rigid-bodies file of an arm's default marker layout (optionally refined from "
@@ -309,10 +252,10 @@ void AddMocapCommands(CLI::App& root) {
                     "Marker file of a static trial with the arm straight");
   rigid->add_option("--out", r->out, "Output rigid-bodies file (.yaml)")->required();
   rigid->callback([r] {
-    const Layout layout = ResolveLayout("", r->config, r->static_trial, nullptr, r->config);
-    mocap::WriteRigidBodiesFile(r->out, layout.layout);
-    std::printf("%s: %zu bodies, %zu markers\n", r->out.c_str(), layout.layout.bodies.size(),
-                layout.layout.marker_count());
+    const mocap::MarkerLayout layout = DefaultLayout(r->config, r->static_trial);
+    mocap::WriteRigidBodiesFile(r->out, layout);
+    std::printf("%s: %zu bodies, %zu markers\n", r->out.c_str(), layout.bodies.size(),
+                layout.marker_count());
   });
 }
 

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <variant>
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/datasets/inspect.h"
@@ -81,14 +82,17 @@ MarkerTable MarkerTableFromExperiment(const datasets::ExperimentFile& experiment
                         experiment.mocap_time.values, "ccsrm-dataset");
 }
 
-MarkerTable ReadHdf5Markers(const std::string& path) {
-  const datasets::FileSummary summary = datasets::InspectFile(path);
-  if (summary.kind == datasets::FileKind::kExperiment) {
-    return MarkerTableFromExperiment(datasets::ReadExperimentFile(path));
-  }
-  const datasets::RunFile run = datasets::ReadRunFile(path);
-  if (!run.markers) ThrowInputError(path, "/markers", "missing: this run has no virtual markers");
+MarkerTable MarkerTableFromRun(const datasets::RunFile& run, const std::string& file) {
+  if (!run.markers) ThrowInputError(file, "/markers", "missing: this run has no virtual markers");
   return TableFromArray(*run.markers, run.marker_names, run.time.values, "ccsrm-run");
+}
+
+MarkerTable ReadHdf5Markers(const std::string& path) {
+  const datasets::AnyFile file = datasets::ReadAnyFile(path);  // read once
+  if (const auto* experiment = std::get_if<datasets::ExperimentFile>(&file)) {
+    return MarkerTableFromExperiment(*experiment);
+  }
+  return MarkerTableFromRun(std::get<datasets::RunFile>(file), path);
 }
 
 MarkerTable ReadMarkerFile(const std::string& path) {

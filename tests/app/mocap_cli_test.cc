@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -14,7 +16,9 @@
 #include "ccsrm/datasets/run_file.h"
 #include "ccsrm/mocap/c3d.h"
 #include "ccsrm/mocap/marker_io.h"
+#include "ccsrm/mocap/recording.h"
 #include "run_ccsrm.h"
+#include "same_experiment.h"
 
 namespace {
 namespace fs = std::filesystem;
@@ -255,6 +259,130 @@ TEST(MocapProcess, BadRigidBodiesFileIsOneLineNamingLineAndKey) {
   EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
   EXPECT_THAT(o.err, HasSubstr(rb + ": line 5, key 'bodies[0].colour': unknown key"));
   EXPECT_FALSE(fs::exists(dir / "x.h5"));
+}
+
+TEST(MocapProcess, LibraryCallOnAnExperimentEqualsWhatTheCommandWrites) {
+  const fs::path dir = FreshDir("library_call");
+  const std::string exp = (Generated() / "exp.h5").string();
+  const std::string out = (dir / "processed.h5").string();
+  const Outcome o = RunCcsrm("mocap process --quiet --in " + exp + " --cutoff-hz 3 --out " + out);
+  ASSERT_EQ(o.status, 0) << o.err;
+  ccsrm::mocap::RecordingRequest request;
+  request.in = exp;
+  request.name = "processed";
+  request.processing.cutoff_hz = 3.0;
+  const ccsrm::mocap::ProcessedRecording processed = ccsrm::mocap::ProcessRecording(request);
+  ccsrm::testing::ExpectSameExperiment(processed.experiment,
+                                       ccsrm::datasets::ReadExperimentFile(out));
+  // The command prints the library's summary.
+  EXPECT_THAT(o.out, HasSubstr(processed.result.summary.BriefReport()));
+}
+
+TEST(MocapProcess, LibraryCallOnAC3dFileWithInputsEqualsWhatTheCommandWrites) {
+  const fs::path dir = FreshDir("library_call_c3d");
+  const std::string exp = (Generated() / "exp.h5").string();
+  const std::string c3d = (dir / "rec.c3d").string();
+  ccsrm::mocap::WriteC3d(c3d, ccsrm::mocap::ReadMarkerFile(exp));
+  const std::string out = (dir / "new.h5").string();
+  const Outcome o = RunCcsrm("mocap process --quiet --in " + c3d + " --config " + Paper() +
+                             " --inputs " + exp + " --no-rigid-fill --out " + out);
+  ASSERT_EQ(o.status, 0) << o.err;
+  ccsrm::mocap::RecordingRequest request;
+  request.in = c3d;
+  request.config = Paper();
+  request.inputs = exp;
+  request.name = "new";  // the command names a new experiment after --out
+  request.processing.rigid_fill = false;
+  ccsrm::testing::ExpectSameExperiment(ccsrm::mocap::ProcessRecording(request).experiment,
+                                       ccsrm::datasets::ReadExperimentFile(out));
+}
+
+TEST(MocapProcess, ExperimentProcessedInMemoryGivesTheCommandsMeasurement) {
+  // What identification does with an experiment lacking measured angles.
+  const fs::path dir = FreshDir("in_memory");
+  const std::string exp = (Generated() / "exp.h5").string();
+  const ccsrm::datasets::ExperimentFile read = ccsrm::datasets::ReadExperimentFile(exp);
+  ASSERT_FALSE(read.measured_joint_angles.has_value());
+  const std::string out = (dir / "processed.h5").string();
+  const Outcome o = RunCcsrm("mocap process --quiet --in " + exp + " --out " + out);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const ccsrm::mocap::ProcessedRecording processed =
+      ccsrm::mocap::AddMeasuredJointAngles(read, exp);
+  ccsrm::testing::ExpectSameExperiment(processed.experiment,
+                                       ccsrm::datasets::ReadExperimentFile(out));
+}
+
+// The real-file path of issue 11: an experiment's markers written as C3D,
+// then processed with the paper's configuration and the experiment's inputs,
+// give the experiment the HDF5 route gives.
+TEST(MocapExport, C3dOfAnExperimentProcessesToTheSameMeasurementAsTheExperiment) {
+  const fs::path dir = FreshDir("export");
+  const std::string exp = (Generated() / "exp.h5").string();
+  const std::string c3d = (dir / "exp.c3d").string();
+  Outcome o = RunCcsrm("mocap export --in " + exp + " --out " + c3d);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_THAT(o.out, HasSubstr("31 frames, 52 markers at 100 Hz (C3D, Intel, float storage, mm)"));
+  const std::string via_c3d = (dir / "exp_c3d.h5").string();
+  o = RunCcsrm("mocap process --quiet --in " + c3d + " --config " + Paper() + " --inputs " + exp +
+               " --out " + via_c3d);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const std::string via_h5 = (dir / "exp_h5.h5").string();
+  o = RunCcsrm("mocap process --quiet --in " + exp + " --out " + via_h5);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const auto a = ccsrm::datasets::ReadExperimentFile(via_c3d);
+  const auto b = ccsrm::datasets::ReadExperimentFile(via_h5);
+
+  // What identification reads is the same: inputs exactly, the frame times to
+  // rounding (the C3D keeps the rate, 100 Hz, not the times: frame i is at
+  // i / rate, which the generated times k * 10 ms start from 0 as well), the
+  // nominal configuration, the layout.
+  ccsrm::testing::ExpectSameArray(a.input_time, b.input_time, "/input/time");
+  ccsrm::testing::ExpectSameArray(a.input_length_change, b.input_length_change,
+                                  "/input/length_change");
+  ccsrm::testing::ExpectSameArray(a.mocap_time, b.mocap_time, "/mocap/time", 1e-12);
+  EXPECT_EQ(a.config_yaml, b.config_yaml);
+  EXPECT_EQ(a.marker_names, b.marker_names);
+  ASSERT_EQ(a.rigid_bodies.size(), b.rigid_bodies.size());
+  for (std::size_t i = 0; i < a.rigid_bodies.size(); ++i) {
+    ccsrm::testing::ExpectSameArray(a.rigid_bodies[i].local_position,
+                                    b.rigid_bodies[i].local_position, a.rigid_bodies[i].name);
+  }
+  // The measurement. C3D stores float32 millimetres: below 2048 mm (the arm
+  // reaches about 1.2 m) a coordinate is rounded by at most half of 2^-13 mm,
+  // 6.1e-8 m. That moves a link's fitted rotation by at most about that over
+  // the plate's narrowest spread (8 mm): 7.6e-6 rad, and the filter averages
+  // it further. The bound is that worst case; the noise the measurement
+  // carries (0.2 mm markers) is 100 times larger.
+  constexpr double kC3dRoundingRad = 6.1e-8 / 8e-3;
+  ASSERT_TRUE(a.measured_joint_angles && b.measured_joint_angles);
+  ccsrm::testing::ExpectSameArray(*a.measured_joint_angles, *b.measured_joint_angles,
+                                  "/measured/joint_angles", kC3dRoundingRad);
+  ccsrm::testing::ExpectSameArray(*a.measured_joint_twist, *b.measured_joint_twist,
+                                  "/measured/joint_twist", kC3dRoundingRad);
+  double largest = 0.0;
+  for (std::size_t i = 0; i < a.measured_joint_angles->size(); ++i) {
+    const double d = a.measured_joint_angles->values[i] - b.measured_joint_angles->values[i];
+    if (std::isfinite(d)) largest = std::max(largest, std::abs(d));
+  }
+  std::printf("C3D route vs HDF5 route: largest joint-angle difference %.3g rad\n", largest);
+}
+
+TEST(MocapExport, RefusesOtherFormatsAndItsOwnInput) {
+  const fs::path dir = FreshDir("export_bad");
+  const std::string exp = (Generated() / "exp.h5").string();
+  Outcome o = RunCcsrm("mocap export --in " + exp + " --out " + (dir / "x.trc").string());
+  EXPECT_EQ(o.status, 2);
+  EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
+  EXPECT_THAT(o.err, HasSubstr("x.trc: --out: unsupported format (expected .c3d)"));
+  const std::string c3d = (dir / "a.c3d").string();
+  ASSERT_EQ(RunCcsrm("mocap export --in " + exp + " --out " + c3d).status, 0);
+  o = RunCcsrm("mocap export --in " + c3d + " --out " + c3d);
+  EXPECT_EQ(o.status, 2);
+  EXPECT_THAT(o.err, HasSubstr("is the input file"));
+  o = RunCcsrm("mocap export --in " + exp + " --units cm --out " + c3d);
+  EXPECT_EQ(o.status, 2);
+  EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
+  EXPECT_FALSE(fs::exists(dir / "x.trc"));
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <future>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include "ccsrm/cameras/reconstruction.h"
 #include "ccsrm/cameras/video_io.h"
@@ -316,6 +317,21 @@ std::string ReconstructionQuality::BriefReport() const {
   out << line;
   for (const std::string& warning : warnings) out << "warning: " << warning << "\n";
   return out.str();
+}
+
+mocap::MarkerReconstruction VideoMarkerSource(std::string cameras_file,
+                                              std::vector<std::string> videos,
+                                              ReconstructionOptions options) {
+  return [cameras_file = std::move(cameras_file), videos = std::move(videos),
+          options = std::move(options)](const mocap::MarkerLayout& layout,
+                                        const sim::ArmModel* model) {
+    const CameraRig rig = LoadCameraRig(cameras_file);
+    ReconstructionOptions used = options;
+    if (model != nullptr) used.labelling.max_link_spacing_m = MaxLinkSpacing(*model);
+    ReconstructionResult reconstruction = ReconstructMarkers(rig, videos, layout, used);
+    return mocap::ReconstructedMarkers{std::move(reconstruction.markers),
+                                       reconstruction.quality.BriefReport()};
+  };
 }
 
 }  // namespace ccsrm::cameras

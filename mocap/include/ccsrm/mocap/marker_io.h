@@ -6,6 +6,7 @@
 #include <string>
 
 #include "ccsrm/datasets/experiment_file.h"
+#include "ccsrm/datasets/run_file.h"
 #include "ccsrm/mocap/marker_table.h"
 
 namespace ccsrm::mocap {
@@ -27,6 +28,10 @@ MarkerTable ReadHdf5Markers(const std::string& path);
 
 // An experiment's markers as a table (the rate as in ReadHdf5Markers).
 MarkerTable MarkerTableFromExperiment(const datasets::ExperimentFile& experiment);
+
+// A run's virtual markers as a table (the rate as in ReadHdf5Markers). `file`
+// names the run in errors. Throws InputError when the run has no /markers.
+MarkerTable MarkerTableFromRun(const datasets::RunFile& run, const std::string& file);
 
 // A JSON summary with the keys: format, frames, markers, rate_hz,
 // first_frame_number, duration_s, labels, units_in_file, up_axis,

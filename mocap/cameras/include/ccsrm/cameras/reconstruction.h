@@ -18,6 +18,7 @@
 #include "ccsrm/cameras/camera_model.h"
 #include "ccsrm/mocap/marker_layout.h"
 #include "ccsrm/mocap/marker_table.h"
+#include "ccsrm/mocap/recording.h"
 #include "ccsrm/sim/model.h"
 
 namespace ccsrm::cameras {
@@ -248,6 +249,16 @@ ReconstructionResult ReconstructMarkers(const CameraRig& rig,
                                         const std::vector<std::string>& videos,
                                         const mocap::MarkerLayout& layout,
                                         const ReconstructionOptions& options = {});
+
+// The camera front end as the marker source of mocap::ProcessRecording
+// (`ccsrm mocap process --cameras`): when called, loads the rig from
+// `cameras_file` (LoadCameraRig), sets options.labelling.max_link_spacing_m
+// from the arm when the model is known (MaxLinkSpacing), reconstructs the
+// layout's markers from `videos` (ReconstructMarkers) and reports the
+// quality's BriefReport. Throws what those throw.
+mocap::MarkerReconstruction VideoMarkerSource(std::string cameras_file,
+                                              std::vector<std::string> videos,
+                                              ReconstructionOptions options = {});
 
 // The same from blob detections already made: detections[frame][camera].
 ReconstructionResult ReconstructMarkersFromDetections(
