@@ -76,13 +76,17 @@ int RunIdentify(const IdentifyArgs& a) {
   for (const std::string& path : a.data) {
     experiments.push_back(identify::LoadExperiment(path, load));
     const identify::Experiment& e = experiments.back();
+    if (e.angles_from_pipeline)
+      std::printf("mocap %s: %s\n", path.c_str(), e.pipeline_report.c_str());
     double noise = 0.0;
     for (double s : e.noise_deg) noise += s / static_cast<double>(e.noise_deg.size());
     std::printf(
         "experiment %s (%s): %zu frames, %.4g s, %zu measured angles, noise %.4f deg (%s)%s\n",
         e.name.c_str(), path.c_str(), e.frame_time_s.size(), e.duration_s(), e.measured_samples,
         noise, e.noise_source.c_str(),
-        e.angles_from_pipeline ? "; joint angles from the mocap pipeline (default settings)" : "");
+        e.angles_from_pipeline ? "; no measured joint angles in the file: computed by the mocap "
+                                 "pipeline with default settings"
+                               : "");
   }
   std::string free_list;
   for (const std::string& n : options.free_parameters)

@@ -7,11 +7,14 @@
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/identify/sensitivity.h"
+#include "ccsrm/mocap/recording.h"
+#include "ccsrm/mocap/signal.h"
 
 namespace ccsrm::identify {
 namespace {
 
 constexpr double kDeg = 180.0 / M_PI;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double Median(std::vector<double> v) {
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -55,8 +58,14 @@ bool ExperimentLoadOptions::IsValid(std::string* error) const {
   return true;
 }
 
-Experiment MakeExperiment(const datasets::ExperimentFile& file, const std::string& path,
+Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::string& path,
                           const ExperimentLoadOptions& options) {
+  // Without measured angles, the mocap pipeline first, with default settings.
+  std::optional<mocap::ProcessedRecording> processed;
+  if (!recorded.measured_joint_angles) {
+    processed = mocap::AddMeasuredJointAngles(recorded, path);
+  }
+  const datasets::ExperimentFile& file = processed ? processed->experiment : recorded;
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError(path, "noise", error);
 
@@ -105,10 +114,10 @@ Experiment MakeExperiment(const datasets::ExperimentFile& file, const std::strin
   e.model = std::move(model);
 
   // Frames: those the simulation can reach, from the first input sample on.
-  if (!file.measured_joint_angles) {
-    ThrowInputError(path, "/measured/joint_angles",
-                    "is missing: process the markers first (ccsrm mocap process --in " + path +
-                        " --out processed.h5)");
+  CCSRM_CHECK(file.measured_joint_angles.has_value());
+  if (processed) {
+    e.angles_from_pipeline = true;
+    e.pipeline_report = processed->result.summary.BriefReport();
   }
   const datasets::Array& measured = *file.measured_joint_angles;
   if (measured.rank() != 3 || measured.shape[1] != static_cast<std::size_t>(e.joints) ||
@@ -146,6 +155,30 @@ Experiment MakeExperiment(const datasets::ExperimentFile& file, const std::strin
                     "has no finite angle after t = " + std::to_string(e.start_time_s) + " s");
   }
 
+  // The low-pass the pipeline applied, when the file records it.
+  const auto quality = [&file](const char* name) {
+    const auto it = file.mocap_quality.find(name);
+    return it != file.mocap_quality.end() && it->second.size() == 1
+               ? it->second.values[0]
+               : std::numeric_limits<double>::quiet_NaN();
+  };
+  const double cutoff = quality("filter_cutoff_hz");
+  if (std::isfinite(cutoff) && cutoff > 0.0 && frames >= 2) {
+    Experiment::LowPass low_pass;
+    low_pass.cutoff_hz = cutoff;
+    low_pass.order = static_cast<int>(quality("filter_order"));
+    low_pass.min_run_frames = static_cast<int>(quality("filter_min_run_frames"));
+    low_pass.rate_hz =
+        static_cast<double>(frames - 1) / (e.frame_time_s.back() - e.frame_time_s.front());
+    if (low_pass.order < 1 || low_pass.order > 8 || low_pass.min_run_frames < 2 ||
+        !(cutoff < 0.5 * low_pass.rate_hz)) {
+      ThrowInputError(path, "/mocap/quality/filter_*",
+                      "the recorded low-pass is not a valid filter (order 1..8, cutoff below "
+                      "half the frame rate, minimum run >= 2)");
+    }
+    e.low_pass = low_pass;
+  }
+
   // Noise: given, else from the twist scatter, else the floor.
   e.noise_deg.assign(static_cast<std::size_t>(e.joints), kMocapNoiseFloorDeg);
   if (options.noise_deg) {
@@ -168,6 +201,24 @@ Experiment MakeExperiment(const datasets::ExperimentFile& file, const std::strin
     e.noise_source = "default floor 0.03 deg (no /measured/joint_twist)";
   }
   return e;
+}
+
+void Experiment::AsMeasured(Eigen::MatrixXd* angles_rad) const {
+  CCSRM_CHECK(angles_rad->rows() == measured_rad.rows() &&
+              angles_rad->cols() == measured_rad.cols());
+  for (Eigen::Index c = 0; c < measured_rad.cols(); ++c) {
+    for (Eigen::Index f = 0; f < measured_rad.rows(); ++f) {
+      if (!std::isfinite(measured_rad(f, c))) (*angles_rad)(f, c) = kNaN;
+    }
+  }
+  if (!low_pass) return;
+  const std::vector<mocap::BiquadSection> sections =
+      mocap::DesignButterworthLowPass(low_pass->order, low_pass->cutoff_hz, low_pass->rate_hz);
+  for (Eigen::Index c = 0; c < angles_rad->cols(); ++c) {
+    mocap::ZeroLagLowPass(sections, low_pass->cutoff_hz, low_pass->rate_hz,
+                          angles_rad->col(c).data(), static_cast<std::size_t>(angles_rad->rows()),
+                          1, static_cast<std::size_t>(low_pass->min_run_frames));
+  }
 }
 
 Experiment LoadExperiment(const std::string& path, const ExperimentLoadOptions& options) {

@@ -625,6 +625,11 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     solver.num_threads = 1;  // the parallelism is in the backend
     solver.logging_type = ceres::SILENT;
     solver.update_state_every_iteration = true;
+    // Steps are projected onto the bounds, without Ceres' projected line
+    // search: its every trial point asks for a gradient, i.e. a whole
+    // finite-difference Jacobian, and one bound-hugging fit spent 50
+    // simulations there for no gain.
+    solver.max_num_line_search_step_size_iterations = 0;
     IterationReporter progress(&problem, u.data(), options, clock_start, &summary.cost_history);
     solver.callbacks.push_back(&progress);
     ceres::Solver::Summary ceres_summary;

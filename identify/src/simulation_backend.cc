@@ -33,6 +33,7 @@ RunResult RunOne(const Experiment& e, const RunRequest& request) {
           frame.joint_angles[static_cast<std::size_t>(j)].y();
     }
   }
+  e.AsMeasured(&out.angles_rad);
   out.summary = std::move(result.summary);
   if (request.keep_trajectory) out.trajectory = std::move(result.trajectory);
   return out;

@@ -305,6 +305,9 @@ ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<doub
   result.time = TimeBase(table, time, source, &rate_hz);
   summary.frames = F;
   summary.rate_hz = rate_hz;
+  summary.filter_cutoff_hz = options.cutoff_hz;
+  summary.filter_order = options.filter_order;
+  summary.min_filter_run_frames = options.min_filter_run_frames;
   if (options.cutoff_hz > 0.0 && !(options.cutoff_hz < 0.5 * rate_hz)) {
     ThrowInputError(source, "cutoff",
                     "low-pass cutoff " + std::to_string(options.cutoff_hz) +
@@ -800,6 +803,11 @@ void StoreInExperiment(const ProcessingResult& result, datasets::ExperimentFile*
   put("joint_frames_lost", Vector(joint_lost), "frames");
   put("joint_max_abs_twist", Vector(joint_twist), "rad");
   put("ground_fit_rms", Vector({s.world_from_ground ? s.ground_fit_rms_m : kNaN}), "m");
+  // The low-pass of the measured motion (identification filters simulated
+  // angles the same way before comparing them).
+  put("filter_cutoff_hz", Vector({s.filter_cutoff_hz}), "Hz");
+  put("filter_order", Vector({double(s.filter_order)}), "1");
+  put("filter_min_run_frames", Vector({double(s.min_filter_run_frames)}), "frames");
 }
 
 }  // namespace ccsrm::mocap

@@ -58,12 +58,35 @@ struct Experiment {
   // True when the file had no /measured/joint_angles and the mocap pipeline
   // computed them at load, with default settings.
   bool angles_from_pipeline = false;
+  std::string pipeline_report;       // the pipeline's one-line quality summary, when it ran
   std::size_t measured_samples = 0;  // finite entries of measured_rad
+
+  // The zero-lag low-pass the mocap pipeline applied to the measured angles,
+  // from the file's quality figures (filter_cutoff_hz, ...); unset when the
+  // file does not record one or the cutoff is 0.
+  struct LowPass {
+    double cutoff_hz = 0.0;
+    int order = 0;
+    int min_run_frames = 0;
+    double rate_hz = 0.0;  // of the frames
+  };
+  std::optional<LowPass> low_pass;
+
+  // Makes simulated angles [rad], laid out as measured_rad, comparable with
+  // the measured ones: NaN where nothing was measured, then the pipeline's
+  // low-pass on every run of frames between gaps, as the pipeline did to the
+  // true angles. Without the filter, a 1 Hz low-pass would shave the fast
+  // parts of the measured motion that the raw simulation keeps, and a fit
+  // would trade damping for that difference.
+  void AsMeasured(Eigen::MatrixXd* angles_rad) const;
 
   double duration_s() const { return sample_time_s.empty() ? 0.0 : sample_time_s.back(); }
 };
 
-// Builds the experiment from a file already read. Throws InputError
+// Builds the experiment from a file already read. A file without
+// /measured/joint_angles first goes through the mocap pipeline with default
+// settings (mocap::AddMeasuredJointAngles); angles_from_pipeline says so.
+// Throws InputError
 // "<path>: <field>: <problem>" for an experiment that cannot be identified:
 // no inputs, inputs for another number of cables than the arm has, no
 // config_yaml, no mocap frame at or after the first input sample, measured

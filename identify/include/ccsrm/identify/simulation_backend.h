@@ -26,7 +26,9 @@ struct RunRequest {
 struct RunResult {
   sim::SimulationSummary summary;
   // The simulated angles at the experiment's sample times [rad], laid out as
-  // Experiment::measured_rad; rows beyond a run that ended early are NaN.
+  // Experiment::measured_rad and made comparable with them
+  // (Experiment::AsMeasured: the measurement's gaps and low-pass); rows
+  // beyond a run that ended early are NaN.
   Eigen::MatrixXd angles_rad;
   sim::Trajectory trajectory;  // only with keep_trajectory
 };

@@ -102,6 +102,12 @@ struct JointQuality {
 struct ProcessingSummary {
   std::size_t frames = 0;
   double rate_hz = 0.0;
+  // The zero-lag low-pass applied to the joint angles, twists and poses
+  // (ProcessingOptions; cutoff 0: none). Stored with the quality figures, so
+  // that identification can pass simulated angles through the same filter.
+  double filter_cutoff_hz = 0.0;
+  int filter_order = 0;
+  int min_filter_run_frames = 0;
   // True when the links were fitted as a chain with shared joint centres.
   bool joint_constrained = false;
   // True when the ground cluster fixed the world frame W; false: the file
