@@ -512,6 +512,7 @@ bool IdentificationOptions::IsValid(std::string* error) const {
   }
   if (!(max_relative_standard_error > 0.0)) return fail("max_relative_standard_error must be > 0");
   if (!(converged_step_fraction >= 0.0)) return fail("converged_step_fraction must be >= 0");
+  if (!(initial_trust_region_radius > 0.0)) return fail("initial_trust_region_radius must be > 0");
   return true;
 }
 
@@ -622,6 +623,7 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     solver.function_tolerance = options.function_tolerance;
     solver.parameter_tolerance = options.parameter_tolerance;
     solver.gradient_tolerance = options.gradient_tolerance;
+    solver.initial_trust_region_radius = options.initial_trust_region_radius;
     solver.num_threads = 1;  // the parallelism is in the backend
     solver.logging_type = ceres::SILENT;
     solver.update_state_every_iteration = true;

@@ -103,6 +103,13 @@ struct IdentificationOptions {
   double function_tolerance = 1e-6;
   double parameter_tolerance = 1e-6;
   double gradient_tolerance = 1e-10;
+  // Ceres' initial trust region radius (Levenberg-Marquardt: the inverse of
+  // the first damping, relative to the Jacobian's diagonal). Default 1: the
+  // first step goes about halfway to the Gauss-Newton point. Ceres' own
+  // default (1e4) takes the whole step at once, which on a stick-slip arm can
+  // jump from a smooth region of the cost into a rough one (where static
+  // friction exceeds kinetic) and stall there.
+  double initial_trust_region_radius = 1.0;
   // The fit also stops, as converged, once an accepted step moved every free
   // parameter by less than this fraction of its standard error: further
   // steps would change the estimate by amounts the data cannot tell apart

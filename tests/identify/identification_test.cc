@@ -1,0 +1,186 @@
+// Identification recovers parameters it generated data from, names what the
+// data cannot determine, checks its input before any simulation runs, and
+// gives the same answer on any number of threads. The experiments are made
+// here: the paper's arm on a compressed protocol (case 4, connecting-cable
+// friction only: a run takes about a second), recorded as white noise of a
+// known size on the true angles.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "ccsrm/common/error.h"
+#include "ccsrm/identify/experiment.h"
+#include "ccsrm/identify/identification.h"
+#include "ccsrm/sim/config.h"
+#include "ccsrm/sim/model.h"
+#include "ccsrm/sim/protocol.h"
+#include "ccsrm/sim/simulator.h"
+#include "synthetic_experiment.h"
+
+namespace ccsrm::identify {
+namespace {
+
+using ::testing::HasSubstr;
+using testing_support::Nominal;
+using testing_support::Record;
+using testing_support::Truth;
+
+const Experiment& Recorded() {
+  static const Experiment e =
+      MakeExperiment(Record(Truth(), 0.03, 7), "synthetic.h5", ExperimentLoadOptions());
+  return e;
+}
+
+// A backend that only counts what it is asked to run.
+class CountingBackend final : public SimulationBackend {
+ public:
+  std::vector<RunResult> RunBatch(const std::vector<RunRequest>& requests,
+                                  const RunFinishedCallback&) override {
+    runs += requests.size();
+    return std::vector<RunResult>(requests.size());
+  }
+  int parallelism() const override { return 1; }
+  std::size_t runs = 0;
+};
+
+TEST(ExperimentLoading, EstimatesTheNoiseFromTheTwistAndKeepsEveryFrame) {
+  const Experiment& e = Recorded();
+  EXPECT_EQ(e.frame_time_s.size(), 301u);
+  EXPECT_EQ(e.measured_samples, 301u * 12 * 2);
+  EXPECT_EQ(e.noise_source, "joint twist scatter");
+  for (double s : e.noise_deg) EXPECT_NEAR(s, 0.03, 0.006);  // 301 samples: ±4 % (1σ)
+  EXPECT_FALSE(e.angles_from_pipeline);
+  EXPECT_FALSE(e.low_pass.has_value());  // the synthetic record has no filter
+}
+
+TEST(ExperimentLoading, RefusesAnExperimentWithoutInputs) {
+  datasets::ExperimentFile file = Record(Nominal().parameters, 0.03, 1);
+  file.input_time = datasets::Array({1}, 0.0);
+  file.input_length_change = datasets::Array({1, 0});
+  try {
+    MakeExperiment(file, "x.h5", {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("x.h5: /input/length_change: has no cable columns"));
+  }
+}
+
+TEST(ExperimentLoading, RefusesInputsForAnotherArm) {
+  datasets::ExperimentFile file = Record(Nominal().parameters, 0.03, 1);
+  file.input_length_change = datasets::Array({file.input_time.rows(), 4});
+  EXPECT_THROW(MakeExperiment(file, "x.h5", {}), InputError);
+  file = Record(Nominal().parameters, 0.03, 1);
+  file.config_yaml.clear();
+  try {
+    MakeExperiment(file, "x.h5", {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("x.h5: attribute 'config_yaml'"));
+  }
+}
+
+TEST(IdentificationOptions, NameTheFieldOfEveryProblem) {
+  std::string error;
+  IdentificationOptions o;
+  EXPECT_TRUE(o.IsValid(&error)) << error;
+  o.free_parameters = {"mu", "nope"};
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_THAT(error, HasSubstr("unknown parameter 'nope'"));
+  o.free_parameters = {"mu", "mu"};
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_THAT(error, HasSubstr("'mu' is repeated"));
+  o.free_parameters = {"mu"};
+  o.bounds["T_p"] = {10.0, 20.0};
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_THAT(error, HasSubstr("'T_p' is not a free parameter"));
+  o.bounds.clear();
+  o.bounds["mu"] = {0.0, 3.0};
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_THAT(error, HasSubstr("leave its own bounds [0, 2]"));
+  o.bounds.clear();
+  o.values["beta"] = 5.0;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_THAT(error, HasSubstr("parameter 'beta' = 5 is outside [0, 0.1] s"));
+}
+
+TEST(ParameterFile, ReadsValuesFreeFlagsAndBounds) {
+  IdentificationOptions o;
+  o.free_parameters = {"mu"};
+  ApplyParameterFile(
+      "mu: 0.2\nT_p: {value: 60, free: true, bounds: [20, 120]}\n"
+      "mu_s: {free: false}\n",
+      "p.yaml", &o);
+  EXPECT_EQ(o.values.at("mu"), 0.2);
+  EXPECT_EQ(o.values.at("T_p"), 60.0);
+  EXPECT_EQ(o.free_parameters, (std::vector<std::string>{"mu", "T_p"}));
+  EXPECT_EQ(o.bounds.at("T_p"), std::make_pair(20.0, 120.0));
+  // A truth file's parameters are values.
+  ApplyParameterFile("schema: ccsrm-truth/1\nparameters:\n  c_sc: 0.07\n", "t.yaml", &o);
+  EXPECT_EQ(o.values.at("c_sc"), 0.07);
+}
+
+TEST(ParameterFile, NamesLineAndKeyOfABadEntryAndChangesNothing) {
+  const struct {
+    std::string text, message;
+  } cases[] = {
+      {"mu: 0.2\nfoo: 1\n", "p.yaml: line 2, key 'foo': unknown parameter"},
+      {"T_p: {bounds: [200, 100]}\n", "p.yaml: line 1, key 'T_p.bounds': [200, 100] must be"},
+      {"T_p: {valu: 3}\n", "p.yaml: line 1, key 'T_p.valu': unknown field"},
+      {"mu: high\n", "p.yaml: line 1, key 'mu': expected a number"},
+      {"beta: 2\n", "p.yaml: line 1, key 'beta': parameter 'beta' = 2 is outside"},
+      {"- mu\n", "p.yaml: expected a mapping"},
+  };
+  for (const auto& c : cases) {
+    IdentificationOptions o;
+    const IdentificationOptions before = o;
+    try {
+      ApplyParameterFile(c.text, "p.yaml", &o);
+      ADD_FAILURE() << "no error for " << c.text;
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), HasSubstr(c.message)) << c.text;
+    }
+    EXPECT_EQ(o.values, before.values);
+    EXPECT_EQ(o.free_parameters, before.free_parameters);
+  }
+}
+
+TEST(Identification, RefusesAStartOutsideItsBoundsBeforeAnyRun) {
+  auto backend = std::make_shared<CountingBackend>();
+  IdentificationOptions o;
+  o.free_parameters = {"T_p"};
+  o.bounds["T_p"] = {60.0, 80.0};  // the start, 50 N, lies below
+  o.backend = backend;
+  try {
+    Identify({Recorded()}, o);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(),
+                HasSubstr("parameter 'T_p': start value 50 is outside the bounds [60, 80]"));
+  }
+  EXPECT_EQ(backend->runs, 0u);
+}
+
+// Each run writes only its own result, and Simulate is deterministic: the
+// start point's analysis gives the same numbers, to the bit, on one thread or two.
+TEST(Identification, GivesTheSameAnswerOnAnyNumberOfThreads) {
+  IdentificationOptions o;
+  o.free_parameters = {"T_p"};
+  o.max_iterations = 0;  // the start, one Jacobian, the statistics
+  o.threads = 1;
+  const IdentificationSummary one = Identify({Recorded()}, o);
+  o.threads = 2;
+  const IdentificationSummary two = Identify({Recorded()}, o);
+  EXPECT_EQ(one.Find("T_p")->value, two.Find("T_p")->value);
+  EXPECT_EQ(one.final_cost, two.final_cost);
+  EXPECT_EQ(one.singular_values, two.singular_values);
+  EXPECT_EQ(one.simulations, two.simulations);
+}
+
+}  // namespace
+}  // namespace ccsrm::identify

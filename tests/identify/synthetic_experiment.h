@@ -1,0 +1,99 @@
+#pragma once
+// Experiments made in the tests: the paper's arm on a compressed protocol
+// (case 4, connecting-cable friction only: a run takes about a second),
+// recorded as white noise of a known size on the true angles.
+#include <gtest/gtest.h>
+#include <Eigen/Core>
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "ccsrm/datasets/experiment_file.h"
+#include "ccsrm/sim/config.h"
+#include "ccsrm/sim/model.h"
+#include "ccsrm/sim/protocol.h"
+#include "ccsrm/sim/simulator.h"
+
+namespace ccsrm::identify::testing_support {
+
+inline constexpr double kDeg = 180.0 / M_PI;
+
+// The nominal configuration of the experiments: the paper's arm, case 4's
+// friction (none on the driving cables), a compressed protocol of which the
+// experiments record the 2 s ramp and the 1 s hold.
+inline sim::Config Nominal() {
+  sim::Config c = sim::LoadConfig(std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml");
+  c.protocol.ramp_s = 2.0;
+  c.protocol.hold_s = 1.0;
+  c.protocol.return_s = 2.0;
+  c.protocol.rest_s = 0.5;
+  c.parameters.mu = c.parameters.mu_s = 0.0;
+  return c;
+}
+
+// An experiment recorded from the arm with `truth`: inputs at 100 Hz, the
+// true angles at 100 Hz plus white noise of noise_deg, and a twist record of
+// the same noise (from which the loader estimates it).
+inline datasets::ExperimentFile Record(const sim::ArmParameters& truth, double noise_deg,
+                                       unsigned seed) {
+  const sim::Config config = Nominal();
+  const sim::ArmModel model(config.arm);
+  const double duration = config.protocol.ramp_s + config.protocol.hold_s;
+  const sim::CableInputs planned =
+      sim::PlanCableInputs(model, sim::PaperTrajectory(model, config.protocol), duration);
+  const std::size_t frames = static_cast<std::size_t>(std::lround(duration * 100.0)) + 1;
+  const int cables = model.num_cables();
+  datasets::ExperimentFile file;
+  file.name = "synthetic";
+  file.source = datasets::ExperimentSource::kGenerated;
+  file.config_yaml = sim::ToYaml(config);
+  file.input_time = datasets::Array({frames});
+  file.input_length_change = datasets::Array({frames, static_cast<std::size_t>(cables)});
+  Eigen::VectorXd time(static_cast<Eigen::Index>(frames));
+  Eigen::MatrixXd length(static_cast<Eigen::Index>(frames), cables);
+  for (std::size_t f = 0; f < frames; ++f) {
+    const double t = static_cast<double>(f) / 100.0;
+    file.input_time.at(f) = t;
+    time[static_cast<Eigen::Index>(f)] = t;
+    for (int c = 0; c < cables; ++c) {
+      double value = 0.0, rate = 0.0, accel = 0.0;
+      planned.Evaluate(c, t, &value, &rate, &accel);
+      file.input_length_change.at(f, static_cast<std::size_t>(c)) = value;
+      length(static_cast<Eigen::Index>(f), c) = value;
+    }
+  }
+  // The truth runs from the recorded inputs, as identification will.
+  const sim::CableInputs inputs(time, length);
+  sim::SimulationOptions options;
+  options.duration_s = duration;
+  options.solver = config.solver;
+  const sim::SimulationResult run = sim::Simulate(model, truth, inputs, options);
+  EXPECT_TRUE(run.summary.completed()) << run.summary.message;
+  EXPECT_EQ(run.trajectory.size(), frames);
+
+  const std::size_t joints = static_cast<std::size_t>(model.num_joints());
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, noise_deg / kDeg);
+  file.mocap_time = file.input_time;
+  file.mocap_markers = datasets::Array({frames, 0, 3});
+  file.measured_joint_angles = datasets::Array({frames, joints, 2});
+  file.measured_joint_twist = datasets::Array({frames, joints});
+  for (std::size_t f = 0; f < frames; ++f) {
+    for (std::size_t j = 0; j < joints; ++j) {
+      for (int a = 0; a < 2; ++a) {
+        file.measured_joint_angles->values[(f * joints + j) * 2 + static_cast<std::size_t>(a)] =
+            run.trajectory.frames[f].joint_angles[j][a] + noise(rng);
+      }
+      file.measured_joint_twist->at(f, j) = noise(rng);
+    }
+  }
+  return file;
+}
+
+inline sim::ArmParameters Truth() {
+  sim::ArmParameters p = Nominal().parameters;
+  p.T_p = 65.0;  // nominal 50
+  return p;
+}
+
+}  // namespace ccsrm::identify::testing_support
