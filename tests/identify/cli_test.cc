@@ -99,4 +99,69 @@ TEST(DerivativesCommand, BadOptionsExitWithOneLineNamingTheOption) {
   }
 }
 
+// A generated experiment (no measured angles: the pipeline runs first), one
+// free parameter, two iterations: fit.json with the keys, the fitted
+// run and the angles table, and an exit status that says whether it converged.
+TEST(IdentifyCommand, FitsAGeneratedExperimentAndWritesTheFitFolder) {
+  const fs::path dir = FreshDir("fit");
+  const std::string exp = (dir / "g.h5").string();
+  const Outcome g = RunCcsrm("generate --config " + Paper() +
+                             " --case 4 --duration 2 --set T_p=60 --quiet --out " + exp);
+  ASSERT_EQ(g.status, 0) << g.all();
+  const std::string out = (dir / "fit").string();
+  const Outcome o = RunCcsrm("identify --data " + exp +
+                             " --free T_p --set mu=0 --set mu_s=0 --max-iterations 2 --threads 2 "
+                             "--quiet --out " +
+                             out);
+  ASSERT_TRUE(o.status == 0 || o.status == 4) << o.all();
+  EXPECT_THAT(o.out, HasSubstr("computed by the mocap pipeline with default settings"));
+  EXPECT_THAT(o.out, HasSubstr("T_p"));
+  const nlohmann::json fit = nlohmann::json::parse(ccsrm::ReadTextFile(out + "/fit.json"));
+  for (const char* key : {"parameters", "rms_deg", "fit_percent", "converged", "iterations",
+                          "simulations", "wall_time_s", "correlation", "singular_values"}) {
+    EXPECT_TRUE(fit.contains(key)) << key;
+  }
+  EXPECT_EQ(fit["converged"].get<bool>(), o.status == 0);
+  const nlohmann::json& tp = fit["parameters"]["T_p"];
+  for (const char* key : {"value", "std_error", "ci95", "identifiable"}) {
+    EXPECT_TRUE(tp.contains(key)) << key;
+  }
+  EXPECT_FALSE(fit["parameters"]["mu"]["free"].get<bool>());
+  EXPECT_EQ(fit["parameters"]["mu"]["value"].get<double>(), 0.0);
+  EXPECT_TRUE(fs::exists(out + "/g.fit.h5"));
+  EXPECT_TRUE(fs::exists(out + "/g.angles.csv"));
+  // The input is never modified.
+  EXPECT_TRUE(fs::exists(exp));
+}
+
+TEST(IdentifyCommand, BadInputExitsWithOneLineBeforeAnySimulation) {
+  const fs::path dir = FreshDir("bad");
+  const std::string truncated = (dir / "truncated.h5").string();
+  ccsrm::WriteTextFileAtomically(truncated, "HDF5 but not really");
+  const std::string params = (dir / "p.yaml").string();
+  ccsrm::WriteTextFileAtomically(params, "T_p: {bounds: [60, 80]}\n");
+  const std::string exp = (dir / "e.h5").string();
+  const Outcome g =
+      RunCcsrm("generate --config " + Paper() + " --case 4 --duration 0.5 --quiet --out " + exp);
+  ASSERT_EQ(g.status, 0) << g.all();
+  const std::string out = " --out " + (dir / "fit").string();
+  const struct {
+    std::string args, message;
+  } cases[] = {
+      {"--data /nonexistent.h5", "/nonexistent.h5"},
+      {"--data " + truncated, truncated},
+      {"--data " + exp + " --free mu,friction", "unknown parameter 'friction'"},
+      {"--data " + exp + " --free T_p --params " + params, "start value 50 is outside the bounds"},
+      {"--data " + exp + " --set beta=3", "parameter 'beta' = 3 is outside"},
+      {"--data " + exp + " --threads 0", "--threads"},
+  };
+  for (const auto& c : cases) {
+    const Outcome o = RunCcsrm("identify " + c.args + out);
+    EXPECT_EQ(o.status, 2) << c.args << "\n" << o.all();
+    EXPECT_EQ(Lines(o.err), 1) << c.args << "\n" << o.err;
+    EXPECT_THAT(o.err, HasSubstr(c.message)) << c.args;
+    EXPECT_FALSE(fs::exists(dir / "fit")) << c.args;
+  }
+}
+
 }  // namespace
