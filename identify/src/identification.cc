@@ -709,9 +709,11 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
           const double c = v(static_cast<Eigen::Index>(i), d);
           if (c != 0.0) var += c * c * direction_error[d] * direction_error[d];
         }
-        // Relative to the scale of the estimate: u is in units of the start's.
+        // Relative to the estimate (u is in units of the start's magnitude),
+        // with a floor of a tenth of that magnitude, so that an estimate the
+        // data pin near zero is not called undetermined for being small.
         const double relative =
-            std::sqrt(var) * free[i].scale / std::max(std::abs(p_final[i]), 1e-12 * free[i].scale);
+            std::sqrt(var) * free[i].scale / std::max(std::abs(p_final[i]), 0.1 * free[i].scale);
         identifiable[i] =
             std::isfinite(relative) && relative <= options.max_relative_standard_error;
       }

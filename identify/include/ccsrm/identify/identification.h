@@ -36,7 +36,7 @@
 // standard error of σ_res / σ_k (σ_res² the variance factor above). A
 // parameter is identifiable when its standard error in this space, the
 // root of Σ_k v_ik² (σ_res / σ_k)², is below max_relative_standard_error of
-// its scale; otherwise it gets no standard error and no interval, and the
+// its estimate (at least a tenth of its scale s); otherwise it gets no standard error and no interval, and the
 // directions that make it so are named as combinations.
 #include <Eigen/Core>
 #include <array>
