@@ -85,8 +85,9 @@ void ListEffects(bool json) {
                 e.description.c_str());
     for (const std::string& name : e.parameters) {
       const sim::ParameterInfo& p = sim::FindParameter(name, "--list-effects");
-      std::printf("  %-36s [%s, %s] %-10s default %-8s realistic %-8s %s\n", p.name.c_str(),
-                  FormatNumber(p.lower).c_str(), FormatNumber(p.upper).c_str(), p.units.c_str(),
+      const std::string bounds =
+          "[" + FormatNumber(p.lower) + ", " + FormatNumber(p.upper) + "] " + p.units;
+      std::printf("  %-36s %-24s default %-7s realistic %-8s %s\n", p.name.c_str(), bounds.c_str(),
                   FormatNumber(p.absent_value).c_str(), FormatNumber(p.realistic).c_str(),
                   p.description.c_str());
     }
