@@ -250,6 +250,17 @@ int RunGenerate(const GenerateArgs& a) {
   mocap::VirtualExperiment generated = mocap::MakeVirtualExperiment(seen, layout, options);
   generated.truth.link_pose = truth_run.link_pose;
   generated.truth.markers = mocap::MarkersFromLinkPoses(layout, truth_run.link_pose);
+  // The experiment records the commanded inputs; what actuator effects
+  // (delay, creep) made of them stays in the truth run.
+  datasets::Array& commanded = generated.experiment.input_length_change;
+  for (std::size_t f = 0; f < commanded.shape[0]; ++f) {
+    for (std::size_t c = 0; c < commanded.shape[1]; ++c) {
+      double value, rate, accel;
+      run.inputs.Evaluate(static_cast<int>(c), generated.experiment.input_time.at(f), &value, &rate,
+                          &accel);
+      commanded.at(f, c) = value;
+    }
+  }
 
   datasets::WriteExperimentFile(a.out, generated.experiment);
   datasets::WriteRunFile(truth_h5_path, generated.truth);

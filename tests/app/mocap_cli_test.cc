@@ -332,3 +332,23 @@ TEST(Generate, BadEffectInputIsOneLine) {
     EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
   }
 }
+
+TEST(Generate, ExperimentRecordsTheCommandWhileTheTruthRunHasTheDelayedInputs) {
+  const fs::path dir = FreshDir("delay");
+  const std::string exp = (dir / "exp.h5").string();
+  const Outcome g = RunCcsrm("generate --config " + Paper() +
+                             " --case 1 --duration 0.3 --quiet --seed 7 --effect "
+                             "actuator_delay:dead_time_s=0.1 --out " +
+                             exp);
+  ASSERT_EQ(g.status, 0) << g.err;
+  const auto delayed = ccsrm::datasets::ReadExperimentFile(exp);
+  const auto nominal = ccsrm::datasets::ReadExperimentFile((Generated() / "exp.h5").string());
+  // The recorded inputs are the command, as without the effect.
+  EXPECT_EQ(delayed.input_length_change.values, nominal.input_length_change.values);
+  // The truth run drove the arm with the command 0.1 s late.
+  const auto truth = ccsrm::datasets::ReadRunFile((dir / "exp.truth.h5").string());
+  ASSERT_EQ(truth.input_length_change.shape, nominal.input_length_change.shape);
+  for (std::size_t c = 0; c < 6; ++c) {
+    EXPECT_NEAR(truth.input_length_change.at(30, c), nominal.input_length_change.at(20, c), 1e-9);
+  }
+}
