@@ -3,6 +3,7 @@
 #include <string>
 
 #include "ccsrm/sim/config.h"
+#include "ccsrm/sim/effects.h"
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/parameters.h"
 #include "commands.h"
@@ -39,6 +40,19 @@ void RunConfigCheck(const std::string& path) {
     parameters += item;
   }
   std::printf("  parameters: %s\n", parameters.c_str());
+  // Effects: which are on, with every parameter's value (defaults included).
+  const std::vector<std::string> effects = c.parameters.EnabledEffects();
+  if (effects.empty()) std::printf("  effects: none on\n");
+  for (const std::string& effect : effects) {
+    std::string values;
+    for (const std::string& name : sim::FindEffect(effect, path).parameters) {
+      char item[96];
+      std::snprintf(item, sizeof(item), "%s%s %.4g", values.empty() ? "" : ", ",
+                    name.substr(effect.size() + 1).c_str(), sim::GetParameter(c.parameters, name));
+      values += item;
+    }
+    std::printf("  effect on: %s (%s)\n", effect.c_str(), values.c_str());
+  }
   static const char* const kHoleFriction[] = {"events", "smoothed", "off"};
   std::printf("  structure: hole friction %s, connecting friction smoothing %s\n",
               kHoleFriction[static_cast<int>(c.solver.hole_friction)],

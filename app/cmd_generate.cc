@@ -3,6 +3,8 @@
 // and the ground truth in two side files no fitting code reads.
 #include <yaml-cpp/yaml.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -18,6 +20,7 @@
 #include "ccsrm/mocap/marker_layout.h"
 #include "ccsrm/mocap/virtual_experiment.h"
 #include "ccsrm/sim/config.h"
+#include "ccsrm/sim/effects.h"
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/parameters.h"
 #include "ccsrm/sim/protocol.h"
@@ -38,7 +41,58 @@ struct GenerateArgs {
   bool no_occlusions = false;
   std::string out;
   bool quiet = false;
+  // Effects switched on in the truth (never in the experiment's nominal
+  // configuration): a YAML file, then --effect items in order.
+  std::string effects_path;
+  std::vector<std::string> effects;
+  bool list_effects = false;
+  bool json = false;
 };
+
+std::string FormatNumber(double v) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.6g", v);
+  return text;
+}
+
+// ccsrm generate --list-effects [--json]: every effect with its parameters,
+// units, bounds, default and realistic magnitude.
+void ListEffects(bool json) {
+  if (json) {
+    nlohmann::json effects = nlohmann::json::array();
+    for (const sim::EffectInfo& e : sim::Effects()) {
+      nlohmann::json parameters = nlohmann::json::array();
+      for (const std::string& name : e.parameters) {
+        const sim::ParameterInfo& p = sim::FindParameter(name, "--list-effects");
+        parameters.push_back({{"name", p.name},
+                              {"units", p.units},
+                              {"lower", p.lower},
+                              {"upper", p.upper},
+                              {"default", p.absent_value},
+                              {"realistic", p.realistic},
+                              {"description", p.description}});
+      }
+      effects.push_back({{"name", e.name},
+                         {"description", e.description},
+                         {"measurement", e.measurement},
+                         {"parameters", parameters}});
+    }
+    std::printf("%s\n", nlohmann::json{{"effects", effects}}.dump(2).c_str());
+    return;
+  }
+  for (const sim::EffectInfo& e : sim::Effects()) {
+    std::printf("%s%s: %s\n", e.name.c_str(), e.measurement ? " (measurement)" : "",
+                e.description.c_str());
+    for (const std::string& name : e.parameters) {
+      const sim::ParameterInfo& p = sim::FindParameter(name, "--list-effects");
+      const std::string bounds =
+          "[" + FormatNumber(p.lower) + ", " + FormatNumber(p.upper) + "] " + p.units;
+      std::printf("  %-36s %-24s default %-7s realistic %-8s %s\n", p.name.c_str(), bounds.c_str(),
+                  FormatNumber(p.absent_value).c_str(), FormatNumber(p.realistic).c_str(),
+                  p.description.c_str());
+    }
+  }
+}
 
 // "<dir>/exp.h5" -> "<dir>/exp": the stem the side files share.
 std::string OutputStem(const std::string& out) {
@@ -74,7 +128,17 @@ std::string TruthYaml(const GenerateArgs& a, const sim::Config& truth, double du
     out << YAML::Key << p.name << YAML::Value << truth.parameters.*p.field;
   }
   out << YAML::EndMap;
-  out << YAML::Key << "effects" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::EndMap;
+  out << YAML::Key << "effects" << YAML::Comment("effects switched on, true values");
+  out << YAML::Value << YAML::BeginMap;
+  for (const std::string& effect : truth.parameters.EnabledEffects()) {
+    out << YAML::Key << effect << YAML::Value << YAML::BeginMap;
+    for (const std::string& name : sim::FindEffect(effect, "truth").parameters) {
+      out << YAML::Key << name.substr(effect.size() + 1) << YAML::Value
+          << sim::GetParameter(truth.parameters, name);
+    }
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
   out << YAML::Key << "noise" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "sigma_mm" << YAML::Value << recording.noise_sigma_m * 1e3;
   out << YAML::EndMap;
@@ -96,6 +160,11 @@ std::string TruthYaml(const GenerateArgs& a, const sim::Config& truth, double du
 }
 
 int RunGenerate(const GenerateArgs& a) {
+  if (a.list_effects) {
+    ListEffects(a.json);
+    return 0;
+  }
+  if (a.out.empty()) ThrowInputError("--out", "", "is required (or --list-effects)");
   const std::string stem = OutputStem(a.out);
   const std::string truth_yaml_path = stem + ".truth.yaml";
   const std::string truth_h5_path = stem + ".truth.h5";
@@ -107,13 +176,30 @@ int RunGenerate(const GenerateArgs& a) {
 
   // The nominal configuration goes into the experiment as given; the truth
   // is that configuration with the case, amplitude and parameters applied.
+  // Effects join the truth only.
   const sim::PaperRun run = sim::PreparePaperRun(a.run);
-  const sim::Config& truth = run.config;
+  sim::Config truth = run.config;
+  if (!a.effects_path.empty()) {
+    sim::ApplyEffectsYaml(ReadTextFile(a.effects_path), a.effects_path, &truth.parameters);
+  }
+  for (const std::string& spec : a.effects)
+    sim::ApplyEffectSpec(spec, "--effect", &truth.parameters);
   const double duration = run.simulation.duration_s;
 
   mocap::VirtualExperimentOptions options;
   options.name = fs::path(stem).filename().string();
   options.nominal_config_yaml = run.config_text;
+  {
+    // A configuration that itself switches effects on is written without
+    // them: the experiment states the nominal model only.
+    sim::Config nominal = sim::ParseConfig(run.config_text, a.run.config_path);
+    if (nominal.parameters.AnyEffectOn()) {
+      for (const std::string& effect : nominal.parameters.EnabledEffects()) {
+        nominal.parameters.DisableEffect(effect);
+      }
+      options.nominal_config_yaml = sim::ToYaml(nominal);
+    }
+  }
   options.recording.noise_sigma_m = a.noise_mm * 1e-3;
   options.recording.seed = a.seed;
   options.recording.occlusions.enabled = !a.no_occlusions;
@@ -151,8 +237,30 @@ int RunGenerate(const GenerateArgs& a) {
                 a.noise_mm, a.no_occlusions ? "off" : "on",
                 static_cast<unsigned long long>(a.seed));
   options.description = description;
-  const mocap::VirtualExperiment generated =
-      mocap::MakeVirtualExperiment(truth_run, mocap::DefaultMarkerLayout(run.model), options);
+  // Motion capture sees the links as the measurement effects (mocap_offset)
+  // make them look; the truth keeps the physical run.
+  const mocap::MarkerLayout layout = mocap::DefaultMarkerLayout(run.model);
+  datasets::RunFile seen = truth_run;
+  for (std::size_t f = 0; f < result.trajectory.size(); ++f) {
+    const auto poses =
+        sim::RecordedLinkPoses(run.model, truth.parameters, result.trajectory.frames[f]);
+    for (std::size_t l = 0; l < poses.size(); ++l)
+      for (int k = 0; k < 7; ++k) seen.link_pose.at(f, l, k) = poses[l][k];
+  }
+  mocap::VirtualExperiment generated = mocap::MakeVirtualExperiment(seen, layout, options);
+  generated.truth.link_pose = truth_run.link_pose;
+  generated.truth.markers = mocap::MarkersFromLinkPoses(layout, truth_run.link_pose);
+  // The experiment records the commanded inputs; what actuator effects
+  // (delay, creep) made of them stays in the truth run.
+  datasets::Array& commanded = generated.experiment.input_length_change;
+  for (std::size_t f = 0; f < commanded.shape[0]; ++f) {
+    for (std::size_t c = 0; c < commanded.shape[1]; ++c) {
+      double value, rate, accel;
+      run.inputs.Evaluate(static_cast<int>(c), generated.experiment.input_time.at(f), &value, &rate,
+                          &accel);
+      commanded.at(f, c) = value;
+    }
+  }
 
   datasets::WriteExperimentFile(a.out, generated.experiment);
   datasets::WriteRunFile(truth_h5_path, generated.truth);
@@ -161,6 +269,9 @@ int RunGenerate(const GenerateArgs& a) {
 
   std::printf("simulated %.4g s (case %s) in %.2f s wall\n", duration, case_name.c_str(),
               wall_time_s);
+  std::string effects;
+  for (const std::string& e : truth.parameters.EnabledEffects()) effects += " " + e;
+  std::printf("effects on (truth only):%s\n", effects.empty() ? " none" : effects.c_str());
   std::printf(
       "recorded %zu frames of %zu markers: noise %.3g mm, %zu marker gaps, %zu whole-link "
       "losses, %.2f %% of samples hidden\n",
@@ -187,7 +298,16 @@ void AddGenerateCommand(CLI::App& root) {
   cmd->add_option("--seed", a->seed, "Seed of the noise and occlusion generator")
       ->capture_default_str();
   cmd->add_flag("--no-occlusions", a->no_occlusions, "Every marker seen in every frame");
-  cmd->add_option("--out", a->out, "Output experiment (.h5)")->required();
+  cmd->add_option("--effects", a->effects_path,
+                  "YAML file switching effects on: effect name -> {parameter: value} (truth "
+                  "only; the experiment keeps the nominal configuration)");
+  cmd->add_option("--effect", a->effects,
+                  "An effect on: NAME (at its realistic magnitude) or NAME:param=value,... "
+                  "(the others at their defaults); repeatable, after --effects");
+  cmd->add_flag("--list-effects", a->list_effects,
+                "List the effects, their parameters, units, bounds and realistic magnitudes");
+  cmd->add_flag("--json", a->json, "With --list-effects: one JSON object");
+  cmd->add_option("--out", a->out, "Output experiment (.h5)");
   cmd->add_flag("--quiet", a->quiet, "No progress lines");
   cmd->callback([a] {
     const int code = RunGenerate(*a);

@@ -38,10 +38,13 @@ void AddPaperRunOptions(CLI::App* command, sim::PaperRunOptions* args) {
 
 void AddParameterOptions(CLI::App* command, sim::PaperRunOptions* args) {
   std::string names;
-  for (const sim::ParameterInfo& p : sim::Parameters()) names += (names.empty() ? "" : ", ") + p.name;
+  for (const sim::ParameterInfo& p : sim::Parameters())
+    names += (names.empty() ? "" : ", ") + p.name;
   command->add_option("--set", args->sets,
                       "Parameter value, name=value (" + names +
-                          "); repeatable, applied after the case and --params");
+                          ", or an effect's <effect>.<parameter>, which switches the effect "
+                          "on: ccsrm generate --list-effects); repeatable, applied after the "
+                          "case and --params");
   command->add_option("--params", args->params_path,
                       "YAML file of parameter values (name: value, or a truth file's "
                       "'parameters:')");

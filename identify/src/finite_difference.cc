@@ -36,7 +36,7 @@ std::optional<DifferencePlan> PlanDifference(double value, double step, double l
 double ParameterScale(const sim::ParameterInfo& info, double value,
                       const std::optional<sim::ArmParameters>& scale_at_zero) {
   if (value != 0.0) return std::abs(value);
-  return scale_at_zero ? std::abs((*scale_at_zero).*info.field) : 0.0;
+  return scale_at_zero ? std::abs(sim::GetParameter(*scale_at_zero, info.name)) : 0.0;
 }
 
 const char* RunStatusWord(sim::SimulationStatus status) {

@@ -277,7 +277,7 @@ DerivativeCheckSummary DerivativeCheck(const sim::ArmModel& model, const sim::Ar
     ParameterDerivative p;
     p.name = info.name;
     p.units = info.units;
-    p.value = base.*info.field;
+    p.value = sim::GetParameter(base, info.name);
     p.scale = internal::ParameterScale(info, p.value, options.scale_at_zero);
     std::vector<StepRuns> step_runs;
     if (p.scale == 0.0) {
@@ -301,7 +301,7 @@ DerivativeCheckSummary DerivativeCheck(const sim::ArmModel& model, const sim::Ar
         step.scheme = plan->scheme;
         for (int k = 0; k < 2; ++k) {
           sim::ArmParameters trial = base;
-          trial.*info.field = plan->trial_values[k];
+          sim::SetParameter(info.name, plan->trial_values[k], "derivative trial", &trial);
           runs.trial[k] = requests.size();
           requests.push_back({trial, name + " = " + Format("%.6g", plan->trial_values[k]) +
                                          " (step " + Format("%g", r) + ")"});

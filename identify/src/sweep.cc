@@ -91,7 +91,7 @@ SweepSummary ParameterSweep(const sim::ArmModel& model, const sim::ArmParameters
   SweepSummary s;
   s.parameter = info.name;
   s.units = info.units;
-  s.value = base.*info.field;
+  s.value = sim::GetParameter(base, info.name);
   s.scale = internal::ParameterScale(info, s.value, options.scale_at_zero);
   s.span = options.span;
   s.threads = options.threads;
@@ -112,7 +112,7 @@ SweepSummary ParameterSweep(const sim::ArmModel& model, const sim::ArmParameters
     }
     s.values.push_back(value);
     sim::ArmParameters p = base;
-    p.*info.field = value;
+    sim::SetParameter(info.name, value, "sweep", &p);
     requests.push_back({p, info.name + " = " + Format("%.6g", value)});
   }
   const std::vector<internal::RunOutcome> outcomes =

@@ -11,6 +11,8 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/sim/effects.h"
+#include "effects/effects_yaml.h"
 
 namespace ccsrm::sim {
 namespace {
@@ -76,6 +78,14 @@ class MapReader {
   }
 
   bool Has(const std::string& key) const { return node_[key].IsDefined(); }
+
+  // An optional section read by someone else (undefined when absent).
+  YAML::Node OptionalNode(const std::string& key) {
+    read_.insert(key);
+    allowed_.push_back(key);
+    if (node_[key].IsDefined()) Record(Join(key), node_[key]);
+    return node_[key];
+  }
   YAML::Node Node(const std::string& key) const { return node_[key]; }
 
   int Integer(const std::string& key) {
@@ -367,6 +377,14 @@ void ValidateWithLines(const Config& c, const LineMap* lines) {
     const std::string problem = ParameterValueProblem(p, c.parameters.*p.field);
     if (!problem.empty()) check.Fail(p.config_key, problem);
   }
+  // Effect parameters, by their key under `effects:`.
+  for (const auto& [name, value] : c.parameters.effect_values) {
+    const ParameterInfo& p = FindParameter(name, c.source_name);
+    const std::string problem = ParameterValueProblem(p, value);
+    if (!problem.empty()) check.Fail(p.config_key, problem);
+  }
+  std::string problem;
+  if (!c.parameters.IsValid(&problem)) check.Fail("effects", problem);
   CheckSolver(c.solver, check);
   CheckProtocol(c.protocol, check);
 }
@@ -523,6 +541,11 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
     pc.rest_s = p.Number("rest_s");
     p.Finish();
   }
+  // Optional: the effects that are on and their values (ccsrm/sim/effects.h).
+  const YAML::Node effects = top.OptionalNode("effects");
+  if (effects.IsDefined()) {
+    internal::ApplyEffectsNode(effects, source_name, "effects.", &c.parameters);
+  }
   top.Finish();
   ValidateWithLines(c, &lines);
   return c;
@@ -638,6 +661,21 @@ std::string ToYaml(const Config& c) {
   out << YAML::Key << "return_s" << YAML::Value << p.return_s;
   out << YAML::Key << "rest_s" << YAML::Value << p.rest_s;
   out << YAML::EndMap;
+  // Only when an effect is on, so that a configuration without effects
+  // writes back as before.
+  if (c.parameters.AnyEffectOn()) {
+    out << YAML::Key << "effects" << YAML::Value << YAML::BeginMap;
+    for (const EffectInfo& e : Effects()) {
+      if (!c.parameters.EffectOn(e.name)) continue;
+      out << YAML::Key << e.name << YAML::Value << YAML::BeginMap;
+      for (const std::string& name : e.parameters) {
+        out << YAML::Key << name.substr(e.name.size() + 1) << YAML::Value
+            << GetParameter(c.parameters, name);
+      }
+      out << YAML::EndMap;
+    }
+    out << YAML::EndMap;
+  }
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

@@ -31,6 +31,39 @@ constexpr double kRegularization = 1e-10;
 
 }  // namespace
 
+// The state an effect may read and the loads it may add during one
+// evaluation (effects/effect.h).
+class ArmDynamics::EffectLoadsView final : public EffectLoads {
+ public:
+  explicit EffectLoadsView(ArmDynamics* dynamics) : d_(dynamics) {}
+  void Bind(double t, const double* qd) {
+    t_ = t;
+    qd_ = qd;
+  }
+  double time() const override { return t_; }
+  int num_links() const override { return d_->model_.num_links(); }
+  int num_joints() const override { return d_->model_.num_joints(); }
+  const Eigen::Vector2d& joint_rate(int joint) const override { return d_->theta_dot_[joint - 1]; }
+  Vector3 link_velocity(int link) const override {
+    return Position(qd_, d_->model_.link_offset(link));
+  }
+  double link_mass(int link) const override { return d_->model_.link(link).mass_kg; }
+  void AddLinkForce(int link, const Vector3& f_W) override {
+    d_->force_.segment<3>(d_->model_.link_offset(link)) += f_W;
+  }
+  void AddJointMoment(int joint, int axis, double moment, double damping) override {
+    d_->AddEffectJointMoment(joint, axis, moment, damping);
+  }
+  void AddDissipation(double power_w) override { d_->dissipation_ += power_w; }
+
+ private:
+  ArmDynamics* d_;
+  double t_ = 0.0;
+  const double* qd_ = nullptr;
+};
+
+ArmDynamics::~ArmDynamics() = default;
+
 ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
                          const CableInputs& inputs, const SolverConfig& solver)
     : model_(model),
@@ -71,6 +104,19 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
     }
     pair_kernels_.push_back(k);
   }
+
+  // Effects: only those that act in the right-hand side are kept, each in
+  // the list of the hooks it uses; with every effect off the lists are
+  // empty and the evaluation is the model's alone.
+  effects_ = MakeEffects(parameters_);
+  for (const std::unique_ptr<Effect>& effect : effects_) {
+    if (effect->scales_pretension()) pretension_effects_.push_back(effect.get());
+    if (effect->deflects_couples()) deflection_effects_.push_back(effect.get());
+    if (effect->adds_loads()) load_effects_.push_back(effect.get());
+  }
+  // The couples' energy, k ∫D, is that of one deflection law.
+  CCSRM_CHECK(deflection_effects_.size() <= 1);
+  effect_loads_ = std::make_unique<EffectLoadsView>(this);
 
   const std::size_t holes = layout_.holes().size();
   modes_.assign(holes, has_stick_slip() ? HoleMode::kStuck : HoleMode::kSlipUp);
@@ -169,7 +215,9 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
   if (!AddCableElements(q, qd)) return false;    // eqs. 1-6, 13, 17-20
   AddHoleFriction(q, qd, y + memory_offset());   // eqs. 8-12, stick-slip
   ComputeJointAngles();                          // eqs. 23-29
-  AddConnectingMoments(q, y + memory_offset());  // eqs. 38-58
+  AddConnectingMoments(t, y + memory_offset());  // eqs. 38-53
+  AddEffectLoads(t, qd);                         // effects/effect.h
+  ApplyJointMoments(q);                          // eqs. 54-58
   AddLinkInertia(q, qd);                         // eqs. 30-34
   AddConstraints(t, q, qd);                      // eqs. 35-37, 61-63
   if (!SolveAugmentedSystem()) return false;     // eqs. 64-68
@@ -323,32 +371,51 @@ void ArmDynamics::ComputeJointAngles() {
   }
 }
 
-// Small-S and large-S moments on both joints of every pair and axis, their
-// model smoothing (added mass), and the joint moments mapped onto the two
-// links' quaternions (eqs. 54-58).
-void ArmDynamics::AddConnectingMoments(const double* q, const double* memory) {
+Eigen::Matrix<double, 1, 4> ArmDynamics::JointRateRow(int k, int link, int axis) const {
+  const Matrix32d b = UniversalJointRateMatrix(theta_[k - 1][1]);
+  if (link == k) return (b.transpose() * rate_matrix_[link - 1]).row(axis);
+  if (link == k - 1) {
+    return -(b.transpose() * relative_rotation_[k - 1].transpose() * rate_matrix_[link - 1])
+                .row(axis);
+  }
+  return Eigen::Matrix<double, 1, 4>::Zero();
+}
+
+// Small-S and large-S moments on both joints of every pair and axis and
+// their model smoothing (added mass), into the joint moments. Effects may
+// relax T_p (PretensionFactor) and put a dead band into the springs
+// (Deflect).
+void ArmDynamics::AddConnectingMoments(double t, const double* memory) {
   double* values = system_.values();
   const double h = solver_.smoothing_step_s;
-  const std::vector<Eigen::Matrix3d>& rel = relative_rotation_;
   std::fill(joint_moment_.begin(), joint_moment_.end(), Eigen::Vector2d::Zero());
-  // Row `axis` of d(theta_dot of joint k)/d(e_dot of link), 1-based k and link.
-  auto rate_row = [&](int k, int link, int axis) -> Eigen::Matrix<double, 1, 4> {
-    const Matrix32d b = UniversalJointRateMatrix(theta_[k - 1][1]);
-    if (link == k) return (b.transpose() * rate_matrix_[link - 1]).row(axis);
-    if (link == k - 1) {
-      return -(b.transpose() * rel[k - 1].transpose() * rate_matrix_[link - 1]).row(axis);
-    }
-    return Eigen::Matrix<double, 1, 4>::Zero();
-  };
+  auto rate_row = [&](int k, int link, int axis) { return JointRateRow(k, link, axis); };
+  double pretension_factor = 1.0;
+  for (const Effect* effect : pretension_effects_) pretension_factor *= effect->PretensionFactor(t);
+  const Effect* deflection = deflection_effects_.empty() ? nullptr : deflection_effects_[0];
   smoothing_power_.clear();
   for (std::size_t p = 0; p < pair_kernels_.size(); ++p) {
     const PairKernel& pair = pair_kernels_[p];
     const std::vector<int>& links = layout_.pair_links(static_cast<int>(p));
     const int i = pair.joint_i - 1, j = pair.joint_i;
     const int width = 4 * static_cast<int>(links.size());
+    LargeSParams relaxed;
+    const LargeSParams* large_params = &pair.large;
+    if (!pretension_effects_.empty() && pair.kind == ConnectingKind::kLargeS) {
+      relaxed = pair.large;
+      relaxed.pretension_n *= pretension_factor;
+      large_params = &relaxed;
+    }
     for (int axis = 0; axis < 2; ++axis) {
-      const double th_i = theta_[i][axis], th_j = theta_[j][axis];
+      const double th_i = theta_[i][axis];
       const double rt_i = theta_dot_[i][axis], rt_j = theta_dot_[j][axis];
+      // The spring sees th_j - th_i, or its dead-banded deflection.
+      CoupleDeflection bent;
+      double th_j = theta_[j][axis];
+      if (deflection != nullptr) {
+        bent = deflection->Deflect(th_j - th_i);
+        th_j = th_i + bent.value;
+      }
       ConnectingMoments m;
       // N·m/rad: the frictionless couple (energy bookkeeping), and the
       // stiffness it has right now (smoothing).
@@ -359,23 +426,25 @@ void ArmDynamics::AddConnectingMoments(const double* q, const double* memory) {
       if (pair.kind == ConnectingKind::kSmallS) {
         m = SmallSMoments(pair.small, th_i, th_j, rt_i, rt_j);
         k_conservative = k_now = SmallSStiffness(pair.small);
+        if (deflection != nullptr) k_now *= bent.slope;
         damping = pair.small.damping_nmsprad;
       } else {
         // The conduit's frictional memory follows eq. 45's static-to-kinetic
         // target over tau_c_f; with tau_c_f = 0 it is the target (eq. 45).
-        const ModifiedCoulombParams& law = pair.large.friction;
-        const double speed = std::abs(ConduitSlipVelocity(pair.large, rt_i, rt_j));
+        const ModifiedCoulombParams& law = large_params->friction;
+        const double speed = std::abs(ConduitSlipVelocity(*large_params, rt_i, rt_j));
         double target_slope = 0.0;
         const double target = ConduitMemoryTarget(law, speed, &target_slope);
         const bool remembers = parameters_.tau_c_f > 0.0;
         const int z_index = pair.memory + axis;
         const double z = remembers ? memory[z_index] : target;
         memory_rate_[z_index] = remembers ? (target - z) / parameters_.tau_c_f : 0.0;
-        const LargeSResult large = LargeSMoments(pair.large, th_i, th_j, rt_i, rt_j, z);
+        const LargeSResult large = LargeSMoments(*large_params, th_i, th_j, rt_i, rt_j, z);
         m = large.moments;
         k_conservative = SmallSStiffness({pair.large.axial_stiffness_n, pair.large.pulley_radius_m,
                                           pair.large.cable_length_m, 0.0});
         k_now = large.stiffness_i;
+        if (deflection != nullptr) k_now *= bent.slope;
         damping = pair.large.damping_nmsprad;
         if (solver_.smooth_connecting_friction && h > 0.0) {
           // Model smoothing of the conduit friction (interpretation beyond
@@ -392,7 +461,7 @@ void ArmDynamics::AddConnectingMoments(const double* q, const double* memory) {
           double c = large.conduit_damping;
           if (!remembers) {
             const double tp_r_theta =
-                pair.large.pretension_n * pair.large.pulley_radius_m * pair.large.wrap_angle_rad;
+                large_params->pretension_n * pair.large.pulley_radius_m * pair.large.wrap_angle_rad;
             c += 0.5 * tp_r_theta * pair.large.pulley_radius_m * (law.mu_static - law.mu_kinetic) *
                  target_slope;
           }
@@ -434,11 +503,61 @@ void ArmDynamics::AddConnectingMoments(const double* q, const double* memory) {
       joint_moment_[i][axis] += m.on_i;
       joint_moment_[j][axis] += m.on_j;
       const double d_theta = th_j - th_i, d_rate = rt_j - rt_i;
-      elastic_ += 0.5 * k_conservative * d_theta * d_theta;
+      // With a dead band the spring's energy is k ∫D and d_theta is D(d).
+      elastic_ += deflection == nullptr ? 0.5 * k_conservative * d_theta * d_theta
+                                        : k_conservative * bent.energy;
       // Dissipated = -(power of the moments) - d/dt(conservative energy).
       dissipation_ += -(m.on_i * rt_i + m.on_j * rt_j) - k_conservative * d_theta * d_rate;
     }
   }
+}
+
+// Forces and moments of the effects that are on (none: nothing to do).
+void ArmDynamics::AddEffectLoads(double t, const double* qd) {
+  if (load_effects_.empty()) return;
+  effect_loads_->Bind(t, qd);
+  for (const Effect* effect : load_effects_) effect->AddLoads(effect_loads_.get());
+}
+
+void ArmDynamics::AddEffectJointMoment(int joint, int axis, double moment, double damping) {
+  joint_moment_[joint - 1][axis] += moment;
+  const double h = solver_.smoothing_step_s;
+  if (!(damping > 0.0) || !(h > 0.0)) return;
+  // Model smoothing of the damping (as for the conduit friction, model
+  // notes row 6): the moment sees theta_dot + (h/2) theta_dd, which adds
+  // (h/2) damping J^T J to the mass, J the joint rate's row over the
+  // quaternions of links joint - 1 and joint. The joint's orientation row
+  // (eq. 37) spans exactly those columns, so its block holds the entries.
+  const int r = m_ - 4 * model_.num_joints() + 4 * (joint - 1) + 3;
+  const ConstraintRowLayout& cols = layout_.rows()[r];
+  const int first_link = joint > 1 ? joint - 1 : joint;
+  const int width = cols.count;
+  CCSRM_CHECK(width == 4 * (joint - first_link + 1) &&
+              cols.cols[0] == model_.link_offset(first_link) + 3);
+  Eigen::Matrix<double, 1, 8> jac = Eigen::Matrix<double, 1, 8>::Zero();
+  for (int link = first_link, l = 0; link <= joint; ++link, ++l) {
+    jac.segment<4>(4 * l) = JointRateRow(joint, link, axis);
+  }
+  const double mass = 0.5 * h * damping;
+  double* values = system_.values();
+  const int* block = layout_.row_block(r);
+  for (int a = 0; a < width; ++a)
+    for (int b = 0; b < width; ++b) values[block[width * a + b]] += mass * jac[a] * jac[b];
+  // The smoothing moment -mass theta_dd does work on the rate; booked once
+  // q_dd is known.
+  SmoothingPower power;
+  power.weights.setZero();
+  for (int a = 0; a < width; ++a) {
+    power.weights[a] = theta_dot_[joint - 1][axis] * mass * jac[a];
+    power.cols[a] = cols.cols[a];
+  }
+  power.count = width;
+  smoothing_power_.push_back(power);
+}
+
+// The joint moments mapped onto the two links' quaternions (eqs. 54-58).
+void ArmDynamics::ApplyJointMoments(const double* q) {
+  const std::vector<Eigen::Matrix3d>& rel = relative_rotation_;
   for (int j = 1; j <= model_.num_joints(); ++j) {
     if (joint_moment_[j - 1].isZero(0.0)) continue;
     const JointBodyMoments body =

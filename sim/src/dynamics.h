@@ -12,6 +12,7 @@
 // pair's x and y conduit (kernels/hole_friction.h, kernels/connecting.h).
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -21,6 +22,7 @@
 #include "ccsrm/sim/parameters.h"
 #include "ccsrm/sim/protocol.h"
 #include "ccsrm/sim/simulator.h"
+#include "effects/effect.h"
 #include "kernels/ale_element.h"
 #include "kernels/connecting.h"
 #include "kernels/hole_friction.h"
@@ -46,6 +48,7 @@ class ArmDynamics {
   // parameters valid, inputs for every cable of the model.
   ArmDynamics(const ArmModel& model, const ArmParameters& parameters, const CableInputs& inputs,
               const SolverConfig& solver);
+  ~ArmDynamics();
 
   int num_coordinates() const { return n_; }
   int state_size() const { return 2 * n_ + 1 + num_memory_; }
@@ -92,11 +95,20 @@ class ArmDynamics {
   bool AddCableElements(const double* q, const double* qd);
   void AddHoleFriction(const double* q, const double* qd, const double* memory);
   void ComputeJointAngles();
-  void AddConnectingMoments(const double* q, const double* memory);
+  void AddConnectingMoments(double t, const double* memory);
+  void AddEffectLoads(double t, const double* qd);
+  void ApplyJointMoments(const double* q);
   void AddLinkInertia(const double* q, const double* qd);
   void AddConstraints(double t, const double* q, const double* qd);
   bool SolveAugmentedSystem();
   bool FinishDerivative(const double* qd, double* ydot);
+
+  // Row `axis` of d(theta_dot of joint k)/d(e_dot of link), 1-based k and
+  // link (zero unless link is k or k - 1).
+  Eigen::Matrix<double, 1, 4> JointRateRow(int k, int link, int axis) const;
+  // Joint-space moment on joint `joint`'s `axis` from an effect, with the
+  // model smoothing of its damping (EffectLoads::AddJointMoment).
+  void AddEffectJointMoment(int joint, int axis, double moment, double damping);
 
   // Phi, its Baumgarte right-hand side b and (with_jacobian) Phi_q of every
   // row (eqs. 35-37, 61-63); needs the link rotations.
@@ -121,6 +133,13 @@ class ArmDynamics {
     LargeSParams large;
   };
   std::vector<PairKernel> pair_kernels_;
+
+  // The effects that are on (ccsrm/sim/effects.h), and those of them that
+  // act in the right-hand side, by hook; all empty when every effect is off.
+  class EffectLoadsView;
+  std::vector<std::unique_ptr<Effect>> effects_;
+  std::vector<const Effect*> pretension_effects_, deflection_effects_, load_effects_;
+  std::unique_ptr<EffectLoadsView> effect_loads_;
 
   std::vector<HoleMode> modes_;
   std::vector<double> stuck_s_;

@@ -9,14 +9,35 @@
 #include <string>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/sim/effects.h"
+#include "effects/effect.h"
+#include "effects/effects_yaml.h"
 
 namespace ccsrm::sim {
 namespace {
 
+// The model's names, then how effect parameters are named: listing all 35
+// of them would bury the line.
 std::string KnownNames() {
   std::string names;
   for (const ParameterInfo& p : Parameters()) names += (names.empty() ? "" : ", ") + p.name;
-  return names;
+  std::string effects;
+  for (const EffectInfo& e : Effects()) effects += (effects.empty() ? "" : ", ") + e.name;
+  return names + "; effects' parameters as <effect>.<parameter>, effects: " + effects;
+}
+
+// For "effect.x": that effect's parameters, when the effect exists.
+std::string KnownNamesFor(const std::string& name) {
+  const std::size_t dot = name.find('.');
+  if (dot != std::string::npos) {
+    for (const EffectInfo& e : Effects()) {
+      if (e.name != name.substr(0, dot)) continue;
+      std::string list;
+      for (const std::string& p : e.parameters) list += (list.empty() ? "" : ", ") + p;
+      return list;
+    }
+  }
+  return KnownNames();
 }
 
 std::string FormatValue(double value) {
@@ -26,7 +47,7 @@ std::string FormatValue(double value) {
 }
 
 const ParameterInfo* LookUp(const std::string& name) {
-  for (const ParameterInfo& p : Parameters()) {
+  for (const ParameterInfo& p : AllParameters()) {
     if (p.name == name) return &p;
   }
   return nullptr;
@@ -42,7 +63,55 @@ bool ArmParameters::IsValid(std::string* error) const {
       return false;
     }
   }
+  for (const std::string& effect : effects_on) {
+    bool known = false;
+    for (const EffectInfo& e : Effects()) known = known || e.name == effect;
+    if (!known) {
+      *error = "unknown effect '" + effect + "'";
+      return false;
+    }
+  }
+  for (const auto& [name, value] : effect_values) {
+    const ParameterInfo* info = LookUp(name);
+    if (info == nullptr || !info->is_effect()) {
+      *error = "unknown effect parameter '" + name + "'";
+      return false;
+    }
+    const std::string problem = ParameterValueProblem(*info, value);
+    if (!problem.empty()) {
+      *error = problem;
+      return false;
+    }
+  }
   return true;
+}
+
+bool ArmParameters::EffectOn(const std::string& effect) const {
+  return effects_on.count(effect) != 0;
+}
+
+void ArmParameters::EnableEffect(const std::string& effect, const std::string& where) {
+  FindEffect(effect, where);
+  effects_on.insert(effect);
+}
+
+void ArmParameters::DisableEffect(const std::string& effect) {
+  effects_on.erase(effect);
+  for (auto it = effect_values.begin(); it != effect_values.end();) {
+    if (it->first.compare(0, effect.size() + 1, effect + ".") == 0) {
+      it = effect_values.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
+std::vector<std::string> ArmParameters::EnabledEffects() const {
+  std::vector<std::string> names;
+  for (const EffectInfo& e : Effects()) {
+    if (EffectOn(e.name)) names.push_back(e.name);
+  }
+  return names;
 }
 
 const std::vector<ParameterInfo>& Parameters() {
@@ -93,10 +162,22 @@ const std::vector<ParameterInfo>& Parameters() {
   return parameters;
 }
 
+const std::vector<ParameterInfo>& AllParameters() {
+  static const std::vector<ParameterInfo> all = [] {
+    std::vector<ParameterInfo> list = Parameters();
+    for (const internal::EffectDefinition& d : internal::EffectDefinitions()) {
+      list.insert(list.end(), d.parameters.begin(), d.parameters.end());
+    }
+    return list;
+  }();
+  return all;
+}
+
 const ParameterInfo& FindParameter(const std::string& name, const std::string& where) {
   const ParameterInfo* info = LookUp(name);
   if (info == nullptr) {
-    ThrowInputError(where, "", "unknown parameter '" + name + "' (known: " + KnownNames() + ")");
+    ThrowInputError(where, "",
+                    "unknown parameter '" + name + "' (known: " + KnownNamesFor(name) + ")");
   }
   return *info;
 }
@@ -108,7 +189,10 @@ std::string ParameterValueProblem(const ParameterInfo& info, double value) {
 }
 
 double GetParameter(const ArmParameters& parameters, const std::string& name) {
-  return parameters.*FindParameter(name, "GetParameter").field;
+  const ParameterInfo& info = FindParameter(name, "GetParameter");
+  if (info.field != nullptr) return parameters.*info.field;
+  const auto it = parameters.effect_values.find(name);
+  return it != parameters.effect_values.end() ? it->second : info.absent_value;
 }
 
 void SetParameter(const std::string& name, double value, const std::string& where,
@@ -116,7 +200,12 @@ void SetParameter(const std::string& name, double value, const std::string& wher
   const ParameterInfo& info = FindParameter(name, where);
   const std::string problem = ParameterValueProblem(info, value);
   if (!problem.empty()) ThrowInputError(where, "", problem);
-  parameters->*info.field = value;
+  if (info.field != nullptr) {
+    parameters->*info.field = value;
+    return;
+  }
+  parameters->effect_values[name] = value;
+  parameters->effects_on.insert(info.effect);
 }
 
 std::pair<std::string, double> ParseParameterAssignment(const std::string& text,
@@ -149,9 +238,14 @@ std::vector<std::pair<std::string, double>> ApplyParameterYaml(const std::string
   // A truth file (`ccsrm generate`) keeps the values under `parameters:`
   // beside its other records; a plain file is the mapping itself.
   std::string prefix;
+  YAML::Node effects;
   if (root.IsMap() && root["parameters"]) {
+    effects = root["effects"];
     root = root["parameters"];
     prefix = "parameters.";
+  } else if (root.IsMap() && root["effects"] && root["effects"].IsMap()) {
+    // A plain file may carry effects like a configuration does.
+    effects = root["effects"];
   }
   if (!root.IsMap()) {
     ThrowInputError(file, "", "expected a mapping of parameter names to values (e.g. 'mu: 0.18')");
@@ -161,11 +255,12 @@ std::vector<std::pair<std::string, double>> ApplyParameterYaml(const std::string
   std::vector<std::pair<std::string, double>> applied;
   for (const auto& entry : root) {
     const std::string key = entry.first.as<std::string>();
+    if (prefix.empty() && key == "effects" && effects) continue;  // below
     const std::string where =
         "line " + std::to_string(entry.first.Mark().line + 1) + ", key '" + prefix + key + "'";
     const ParameterInfo* info = LookUp(key);
     if (info == nullptr) {
-      ThrowInputError(file, where, "unknown parameter (known: " + KnownNames() + ")");
+      ThrowInputError(file, where, "unknown parameter (known: " + KnownNamesFor(key) + ")");
     }
     double value = 0.0;
     try {
@@ -176,8 +271,17 @@ std::vector<std::pair<std::string, double>> ApplyParameterYaml(const std::string
     }
     const std::string problem = ParameterValueProblem(*info, value);
     if (!problem.empty()) ThrowInputError(file, where, problem);
-    updated.*info->field = value;
+    SetParameter(key, value, file, &updated);
     applied.emplace_back(key, value);
+  }
+  if (effects) {
+    const ArmParameters before = updated;
+    internal::ApplyEffectsNode(effects, file, "effects.", &updated);
+    for (const auto& [name, value] : updated.effect_values) {
+      const auto it = before.effect_values.find(name);
+      if (it == before.effect_values.end() || it->second != value)
+        applied.emplace_back(name, value);
+    }
   }
   *parameters = updated;
   return applied;

@@ -10,6 +10,7 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/gsl_errors.h"
 #include "dynamics.h"
+#include "effects/effect.h"
 #include "integrator.h"
 #include "output_sampler.h"
 #include "stick_slip.h"
@@ -321,7 +322,11 @@ SimulationResult Simulate(const ArmModel& model, const ArmParameters& parameters
                         std::to_string(model.num_cables()));
   }
   UseGslErrorCodes();
-  return StepLoop(model, parameters, inputs, options).Run();
+  // Actuator effects (delay, creep) drive the arm with what the actuators
+  // realise from the commanded inputs; with none on, the inputs as given.
+  const std::unique_ptr<CableInputs> realised =
+      internal::RealisedInputs(model, parameters, inputs, options.duration_s);
+  return StepLoop(model, parameters, realised ? *realised : inputs, options).Run();
 }
 
 }  // namespace ccsrm::sim

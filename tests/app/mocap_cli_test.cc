@@ -135,7 +135,8 @@ TEST(Generate, RejectsUnknownParametersAndBadValuesWithOneLine) {
   EXPECT_EQ(unknown.status, 2);
   EXPECT_EQ(ccsrm::testing::CountLines(unknown.err), 1) << unknown.err;
   EXPECT_THAT(unknown.err, HasSubstr("unknown parameter 'mu_x' (known: mu, mu_s, mu_c, mu_c_s, "
-                                     "beta, c_sc, c_lc, T_p, T_d0, v_s, v_c_s, tau_f, tau_c_f)"));
+                                     "beta, c_sc, c_lc, T_p, T_d0, v_s, v_c_s, tau_f, tau_c_f; "
+                                     "effects' parameters as <effect>.<parameter>"));
   const Outcome bounds =
       RunCcsrm("generate --config " + Paper() + " --set mu=3 --out /tmp/ccsrm_never.h5");
   EXPECT_EQ(bounds.status, 2);
@@ -386,3 +387,96 @@ TEST(MocapExport, RefusesOtherFormatsAndItsOwnInput) {
 }
 
 }  // namespace
+
+TEST(Generate, ListEffectsGivesEveryEffectWithUnitsBoundsAndRealisticMagnitude) {
+  const Outcome o = RunCcsrm("generate --list-effects --json");
+  ASSERT_EQ(o.status, 0) << o.err;
+  const nlohmann::json j = nlohmann::json::parse(o.out);
+  ASSERT_EQ(j["effects"].size(), 7u);
+  EXPECT_EQ(j["effects"][0]["name"], "joint_friction");
+  const nlohmann::json& p = j["effects"][0]["parameters"][0];
+  EXPECT_EQ(p["name"], "joint_friction.coulomb_nm");
+  EXPECT_EQ(p["units"], "N m");
+  EXPECT_LE(p["lower"].get<double>(), p["realistic"].get<double>());
+  EXPECT_LE(p["realistic"].get<double>(), p["upper"].get<double>());
+  const Outcome text = RunCcsrm("generate --list-effects");
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_THAT(text.out, HasSubstr("mocap_offset (measurement)"));
+  EXPECT_THAT(text.out, HasSubstr("table_tilt.lateral_rad"));
+}
+
+TEST(Generate, EffectsGoToTheTruthOnlyAndMocapOffsetIntoTheRecordedAngles) {
+  const fs::path dir = FreshDir("effects");
+  const std::string effects = (dir / "effects.yaml").string();
+  ccsrm::WriteTextFileAtomically(effects, "table_tilt: {lateral_rad: 0.001}\n");
+  const std::string exp = (dir / "exp.h5").string();
+  const Outcome g = RunCcsrm(
+      "generate --config " + Paper() +
+      " --case 1 --duration 0.3 --quiet --noise-mm 0 --no-occlusions "
+      "--effects " +
+      effects + " --effect mocap_offset:joint2_x_rad=0.01,joint9_y_rad=-0.004 --out " + exp);
+  ASSERT_EQ(g.status, 0) << g.err;
+  EXPECT_THAT(g.out, HasSubstr("effects on (truth only): table_tilt mocap_offset"));
+  const auto e = ccsrm::datasets::ReadExperimentFile(exp);
+  EXPECT_EQ(e.config_yaml, ccsrm::ReadTextFile(Paper()));  // nominal, no effects
+  const std::string truth_yaml = ccsrm::ReadTextFile((dir / "exp.truth.yaml").string());
+  EXPECT_THAT(truth_yaml, HasSubstr("table_tilt:\n    lateral_rad: 0.001"));
+  EXPECT_THAT(truth_yaml, HasSubstr("joint2_x_rad: 0.01"));
+  // The processed angles carry the offsets; the truth run does not.
+  const std::string processed = (dir / "processed.h5").string();
+  const Outcome p = RunCcsrm("mocap process --quiet --in " + exp + " --config " + Paper() +
+                             " --out " + processed);
+  ASSERT_EQ(p.status, 0) << p.err;
+  const auto measured = ccsrm::datasets::ReadExperimentFile(processed).measured_joint_angles;
+  ASSERT_TRUE(measured.has_value());
+  const auto truth = ccsrm::datasets::ReadRunFile((dir / "exp.truth.h5").string());
+  for (std::size_t f = 0; f < truth.frames(); ++f) {
+    for (std::size_t j = 0; j < 12; ++j) {
+      for (std::size_t a = 0; a < 2; ++a) {
+        const double offset = j == 1 && a == 0 ? 0.01 : j == 8 && a == 1 ? -0.004 : 0.0;
+        // 2e-4 rad: what processing noise-free markers resolves (above).
+        EXPECT_NEAR(measured->at(f, j, a) - truth.joint_angles.at(f, j, a), offset, 2e-4)
+            << "frame " << f << " joint " << j + 1 << " axis " << a;
+      }
+    }
+  }
+  // The truth file as --params brings the effects back.
+  const Outcome again =
+      RunCcsrm("generate --config " + Paper() + " --case 1 --duration 0.1 --quiet --params " +
+               (dir / "exp.truth.yaml").string() + " --out " + (dir / "again.h5").string());
+  ASSERT_EQ(again.status, 0) << again.err;
+  EXPECT_THAT(again.out, HasSubstr("effects on (truth only): table_tilt mocap_offset"));
+}
+
+TEST(Generate, BadEffectInputIsOneLine) {
+  for (const std::string& bad :
+       {std::string("--effect tilt"), std::string("--effect backlash:dead_band_rad=9"),
+        std::string("--effect backlash:dead_band_rad"),
+        std::string("--effects /nonexistent/e.yaml")}) {
+    SCOPED_TRACE(bad);
+    const Outcome o =
+        RunCcsrm("generate --config " + Paper() + " " + bad + " --out /tmp/ccsrm_never.h5");
+    EXPECT_EQ(o.status, 2);
+    EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
+  }
+}
+
+TEST(Generate, ExperimentRecordsTheCommandWhileTheTruthRunHasTheDelayedInputs) {
+  const fs::path dir = FreshDir("delay");
+  const std::string exp = (dir / "exp.h5").string();
+  const Outcome g = RunCcsrm("generate --config " + Paper() +
+                             " --case 1 --duration 0.3 --quiet --seed 7 --effect "
+                             "actuator_delay:dead_time_s=0.1 --out " +
+                             exp);
+  ASSERT_EQ(g.status, 0) << g.err;
+  const auto delayed = ccsrm::datasets::ReadExperimentFile(exp);
+  const auto nominal = ccsrm::datasets::ReadExperimentFile((Generated() / "exp.h5").string());
+  // The recorded inputs are the command, as without the effect.
+  EXPECT_EQ(delayed.input_length_change.values, nominal.input_length_change.values);
+  // The truth run drove the arm with the command 0.1 s late.
+  const auto truth = ccsrm::datasets::ReadRunFile((dir / "exp.truth.h5").string());
+  ASSERT_EQ(truth.input_length_change.shape, nominal.input_length_change.shape);
+  for (std::size_t c = 0; c < 6; ++c) {
+    EXPECT_NEAR(truth.input_length_change.at(30, c), nominal.input_length_change.at(20, c), 1e-9);
+  }
+}

@@ -95,7 +95,8 @@ TEST(Parameters, AssignmentsParseAndBadOnesNameTheProblem) {
               HasSubstr("--set: 'mu': expected name=value"));
   EXPECT_THAT(ErrorOf([] { ParseParameterAssignment("nu=1", "--set"); }),
               HasSubstr("unknown parameter 'nu' (known: mu, mu_s, mu_c, mu_c_s, beta, c_sc, c_lc, "
-                        "T_p, T_d0, v_s, v_c_s, tau_f, tau_c_f)"));
+                        "T_p, T_d0, v_s, v_c_s, tau_f, tau_c_f; effects' parameters as "
+                        "<effect>.<parameter>"));
   EXPECT_THAT(ErrorOf([] { ParseParameterAssignment("mu=0.1x", "--set"); }),
               HasSubstr("value '0.1x' is not a number"));
   ArmParameters c = Paper().parameters;

@@ -7,6 +7,8 @@
 // YAML key; configuration files, `--set`, `--params`, truth files and
 // identification all check values against it with the same message.
 #include <limits>
+#include <map>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -35,8 +37,30 @@ struct ArmParameters {
   double tau_f = 0.0;
   double tau_c_f = 0.0;
 
+  // Effects (ccsrm/sim/effects.h): the physics the paper's model lacks, each
+  // off by default. An effect is on once enabled (EnableEffect, a
+  // configuration's `effects:` section, or SetParameter on one of its
+  // parameters); its parameters "<effect>.<parameter>" are read and written
+  // by name with GetParameter / SetParameter like the fields above. A
+  // parameter of an effect that is on but was never given has its default
+  // (ParameterInfo::absent_value: the neutral value, e.g. 0 friction).
+  bool EffectOn(const std::string& effect) const;
+  // Throws InputError naming `where` for an effect that is not in Effects().
+  void EnableEffect(const std::string& effect, const std::string& where = "EnableEffect");
+  // Switches the effect off and forgets its parameter values.
+  void DisableEffect(const std::string& effect);
+  // The effects that are on, in the order of Effects().
+  std::vector<std::string> EnabledEffects() const;
+  bool AnyEffectOn() const { return !effects_on.empty(); }
+
+  // Values of effect parameters given so far, by full name; a name absent
+  // here reads as its default. Use the functions above and GetParameter /
+  // SetParameter rather than these two maps.
+  std::map<std::string, double> effect_values;
+  std::set<std::string> effects_on;
+
   // False (with the table's message in *error) when a value is outside its
-  // bounds or not finite.
+  // bounds or not finite, effect parameters included.
   bool IsValid(std::string* error) const;
 };
 
@@ -48,18 +72,36 @@ struct ParameterInfo {
   double lower = 0.0;  // the bounds every door checks (config, --set, --params, identification)
   double upper = 0.0;
   std::string description;
+  // The ArmParameters field of a model parameter; null for an effect
+  // parameter (read and write those with GetParameter / SetParameter).
   double ArmParameters::*field = nullptr;
   // What a configuration file written before the parameter existed means
   // by leaving it out (the paper's law); NaN: the key is required.
+  // For an effect parameter: its default while the effect is on.
   double absent_value = std::numeric_limits<double>::quiet_NaN();
+  // Effect parameters only: the effect ("joint_friction"), the parameter's
+  // name within it ("coulomb_nm") and the magnitude an air-table arm like
+  // the paper's realistically has (what `ccsrm generate --effect NAME`
+  // uses). Empty / NaN for a model parameter.
+  std::string effect{};
+  std::string short_name{};
+  double realistic = std::numeric_limits<double>::quiet_NaN();
+  bool is_effect() const { return !effect.empty(); }
 };
 
-// Every named parameter: SPEC 6's nine in its order (mu, mu_s, mu_c,
+// The model's named parameters: SPEC 6's nine in its order (mu, mu_s, mu_c,
 // mu_c_s, beta, c_sc, c_lc, T_p, T_d0), then v_s, v_c_s, tau_f, tau_c_f.
+// Every entry has a field.
 const std::vector<ParameterInfo>& Parameters();
 
-// The entry of `name`. Throws InputError("<where>: unknown parameter 'x'
-// (known: mu, mu_s, ...)") for a name that is not one of Parameters().
+// Every known parameter name: Parameters(), then the parameters of every
+// effect of Effects() in its order, named "<effect>.<parameter>" (their
+// `field` is null). This is the list identification offers.
+const std::vector<ParameterInfo>& AllParameters();
+
+// The entry of `name`, a model or an effect parameter. Throws
+// InputError("<where>: unknown parameter 'x' (known: mu, mu_s, ...)") for a
+// name that is not one of AllParameters().
 const ParameterInfo& FindParameter(const std::string& name, const std::string& where);
 
 // "" when `value` is finite and within the parameter's bounds, else the one
@@ -69,6 +111,9 @@ std::string ParameterValueProblem(const ParameterInfo& info, double value);
 // Reads / writes a parameter by name. SetParameter checks the value against
 // the bounds and throws InputError "<where>: <ParameterValueProblem>" when it
 // is outside them or not finite (the parameters are then unchanged).
+// SetParameter on an effect parameter switches that effect on; GetParameter
+// of an effect parameter reads its value, or its default when it was never
+// given (whether or not the effect is on).
 double GetParameter(const ArmParameters& parameters, const std::string& name);
 void SetParameter(const std::string& name, double value, const std::string& where,
                   ArmParameters* parameters);
@@ -81,10 +126,14 @@ std::pair<std::string, double> ParseParameterAssignment(const std::string& text,
 
 // Applies a YAML mapping of parameter names to numbers (e.g. "mu: 0.18\nT_d0:
 // 80"), as in a `--params truth.yaml` file; `file` names it in errors. A truth
-// file's `parameters:` section is read the same way. Throws InputError
+// file's `parameters:` section is read the same way, and its `effects:`
+// section (a map from effect name to a map of its parameters, as in a
+// configuration) switches those effects on with their values. Effect
+// parameters may also be given by full name ("joint_friction.coulomb_nm:
+// 0.01"), which switches the effect on too. Throws InputError
 // "<file>: line N, key 'x': ..." for an unknown name, a value that is not a
 // number or out of bounds, or text that is not a mapping. Returns the
-// assignments in file order.
+// assignments in file order (effect parameters by full name).
 std::vector<std::pair<std::string, double>> ApplyParameterYaml(const std::string& yaml_text,
                                                                const std::string& file,
                                                                ArmParameters* parameters);

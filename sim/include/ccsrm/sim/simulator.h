@@ -109,7 +109,11 @@ struct SimulationResult {
 };
 
 // Simulates the arm driven by `inputs` from the straight, pre-tensioned
-// state at rest. A divergence (non-finite state, constraint violation above
+// state at rest, with every effect that is on in `parameters`
+// (ccsrm/sim/effects.h): actuator effects change the inputs the arm sees
+// (the frames' input_length_change are those), dynamic effects act in the
+// equations; measurement effects do not act here (RecordedJointAngles).
+// A divergence (non-finite state, constraint violation above
 // solver.max_constraint_violation, a step below solver.min_step_s) or a
 // cancellation ends the run early with its status in the summary; it is not
 // thrown. Throws InputError only for invalid parameters or options, or

@@ -1,0 +1,92 @@
+#pragma once
+// The effect library (SPEC 7): physics a real arm has and the paper's model
+// lacks, each a switchable extension of the simulator with its own named
+// parameters "<effect>.<parameter>". Every effect is off by default, and a
+// run with every effect off is bit-identical to a run of a configuration
+// without an `effects:` section.
+//
+//   joint_friction    Coulomb + viscous friction in every universal joint
+//   table_tilt        gravity in the table plane from two small tilt angles
+//   actuator_delay    the input lengths lag the command (first order + dead time)
+//   backlash          a dead band in the connecting cables before they stretch
+//   pretension_creep  T_p and T_d0 relax exponentially over the experiment
+//   air_drag          air-bearing drag on the links, linear in velocity
+//   mocap_offset      constant zero offsets of the measured joint angles
+//                     (a measurement effect: what is recorded, not the dynamics)
+//
+// An effect is switched on by a configuration's `effects:` section, by
+// ArmParameters::EnableEffect, or by setting any of its parameters
+// (SetParameter, `--set`, `--params`). Each effect lives in its own file
+// under sim/src/effects/ behind one interface (sim/src/effects/effect.h);
+// docs/effects.md says how to add one.
+#include <Eigen/Core>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ccsrm/sim/parameters.h"
+#include "ccsrm/sim/simulator.h"
+
+namespace ccsrm::sim {
+
+struct EffectInfo {
+  std::string name;         // "joint_friction"
+  std::string description;  // one line
+  // True for an effect on what is measured (mocap_offset), not on the
+  // dynamics: Simulate ignores it; RecordedJointAngles applies it.
+  bool measurement = false;
+  // Its parameters, full names in AllParameters() ("joint_friction.coulomb_nm").
+  std::vector<std::string> parameters;
+};
+
+// Every effect, in a fixed order (the order above).
+const std::vector<EffectInfo>& Effects();
+
+// The entry of `name`. Throws InputError "<where>: unknown effect 'x'
+// (known: joint_friction, ...)".
+const EffectInfo& FindEffect(const std::string& name, const std::string& where);
+
+// Switches `effect` on with every parameter at its realistic magnitude
+// (ParameterInfo::realistic), as `ccsrm generate --effect NAME` does.
+// Throws InputError naming `where` for an unknown effect.
+void EnableEffectAtRealisticMagnitude(const std::string& effect, const std::string& where,
+                                      ArmParameters* parameters);
+
+// Parses "NAME" (the effect at its realistic magnitude) or
+// "NAME:param=value,param=value" (the effect on, the given parameters set,
+// the others at their defaults) and applies it. `where` names the option in
+// errors ("--effect"). Throws InputError for an unknown effect or
+// parameter, a value that is not a number or out of bounds, or a malformed
+// text. Returns the effect's name.
+std::string ApplyEffectSpec(const std::string& text, const std::string& where,
+                            ArmParameters* parameters);
+
+// Applies a YAML mapping from effect name to a mapping of its parameters
+// (`joint_friction: {coulomb_nm: 0.01}`; an empty mapping or null switches
+// the effect on at its defaults), the format of a configuration's
+// `effects:` section and of `ccsrm generate --effects FILE` (which may also
+// hold it under a top-level `effects:` key). `file` names the file in
+// errors: "<file>: line N, key 'effects.joint_friction.x': unknown
+// parameter ...". Checked whole before anything is applied.
+void ApplyEffectsYaml(const std::string& yaml_text, const std::string& file,
+                      ArmParameters* parameters);
+
+// The joint angles motion capture records of a simulated frame: the
+// physical angles (frame.joint_angles) with every measurement effect that
+// is on applied (mocap_offset adds its offsets). Exactly the physical
+// angles when no measurement effect is on. Identification compares
+// measured angles with this.
+std::vector<Eigen::Vector2d> RecordedJointAngles(const ArmParameters& parameters,
+                                                 const TrajectoryFrame& frame);
+
+// Link poses (x, y, z, e0..e3) whose joint angles are RecordedJointAngles:
+// the chain rebuilt from joint 1 (where the frame has it) through the
+// recorded joint angles, every joint where both its links put it. What a
+// virtual mocap sees, so that processing (joint-constrained or not) gives
+// the recorded angles. Exactly frame.link_pose when no measurement effect
+// is on. Precondition: the frame is of `model`'s arm.
+std::vector<Eigen::Matrix<double, 7, 1>> RecordedLinkPoses(const ArmModel& model,
+                                                           const ArmParameters& parameters,
+                                                           const TrajectoryFrame& frame);
+
+}  // namespace ccsrm::sim

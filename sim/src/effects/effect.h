@@ -1,0 +1,132 @@
+#pragma once
+// The one interface every effect implements (ccsrm/sim/effects.h lists the
+// effects). An Effect is built for one run from that run's ArmParameters
+// when the effect is on; the simulator calls its hooks at fixed places and
+// never asks which effect it is:
+//
+//   before the run      RealisedInputs     what the actuators do with the command
+//   every evaluation    PretensionFactor   the connecting cables' T_p(t) / T_p
+//                       CoupleDeflection   the deflection the couples' springs see
+//                       AddLoads           forces on links, moments on joints
+//   every sampled frame Record             what motion capture records
+//
+// Every hook has a neutral default, so an effect overrides only what it
+// changes. To add an effect: write sim/src/effects/<name>.cc with an
+// EffectDefinition (its parameters with units, bounds, default and
+// realistic magnitude, and a factory), and list it in registry.cc.
+#include <Eigen/Core>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ccsrm/sim/model.h"
+#include "ccsrm/sim/parameters.h"
+#include "ccsrm/sim/protocol.h"
+
+namespace ccsrm::sim::internal {
+
+// What an effect may read and add while the right-hand side is evaluated.
+// Joints and links are 1-based; angles, rates and moments follow SPEC 2's
+// X-Y Cardan convention (axis 0 = θx, 1 = θy).
+class EffectLoads {
+ public:
+  virtual ~EffectLoads() = default;
+  virtual double time() const = 0;  // [s]
+  virtual int num_links() const = 0;
+  virtual int num_joints() const = 0;
+  virtual const Eigen::Vector2d& joint_rate(int joint) const = 0;  // [rad/s]
+  virtual Eigen::Vector3d link_velocity(int link) const = 0;       // mass centre, world [m/s]
+  virtual double link_mass(int link) const = 0;                    // [kg]
+  // A force on link `link`'s mass centre, world frame [N].
+  virtual void AddLinkForce(int link, const Eigen::Vector3d& f_W) = 0;
+  // A joint-space moment [N m] on joint `joint`'s angle `axis`, and its
+  // damping -dM/dθ̇ >= 0 [N m s/rad]. The simulator model-smooths that
+  // damping as it does the conduit friction (docs/model-notes.md row 6):
+  // (h/2) damping is added to the joint's inertia, which keeps a steep
+  // friction law integrable by the explicit RK45.
+  virtual void AddJointMoment(int joint, int axis, double moment, double damping) = 0;
+  // Power the effect takes out of the arm [W] (>= 0 for a dissipative one),
+  // booked in the dissipated energy.
+  virtual void AddDissipation(double power_w) = 0;
+};
+
+// The deflection a connecting couple's spring sees for a relative rotation
+// d = θ_j − θ_i (value), its slope d value / d d, and the spring's energy
+// per unit stiffness, ∫ value dd.
+struct CoupleDeflection {
+  double value = 0.0;   // [rad]
+  double slope = 1.0;   // [1]
+  double energy = 0.0;  // [rad^2]
+};
+
+class Effect {
+ public:
+  virtual ~Effect() = default;
+
+  // The inputs the actuators realise from the commanded ones over
+  // [0, duration_s]; null when this effect leaves them as they are.
+  virtual std::unique_ptr<CableInputs> RealisedInputs(const ArmModel& /*model*/,
+                                                      const CableInputs& /*commanded*/,
+                                                      double /*duration_s*/) const {
+    return nullptr;
+  }
+
+  // Does this effect use the per-evaluation hooks below? The simulator
+  // calls only those an effect declares, so an effect that is on costs
+  // nothing where it acts nowhere.
+  virtual bool scales_pretension() const { return false; }
+  virtual bool deflects_couples() const { return false; }
+  virtual bool adds_loads() const { return false; }
+
+  // T_p(t) / T_p of the connecting cables.
+  virtual double PretensionFactor(double /*t*/) const { return 1.0; }
+  // The couples' deflection for relative rotation d [rad].
+  virtual CoupleDeflection Deflect(double d) const { return {d, 1.0, 0.5 * d * d}; }
+  // Forces and moments at the current state.
+  virtual void AddLoads(EffectLoads* /*loads*/) const {}
+
+  // Turns the physical joint angles of a frame into what is recorded.
+  virtual void Record(std::vector<Eigen::Vector2d>* /*joint_angles*/) const {}
+};
+
+// One effect's description and factory.
+struct EffectDefinition {
+  std::string name;
+  std::string description;
+  bool measurement = false;
+  // Its parameters with short names ("coulomb_nm") and `field` null; the
+  // registry fills in the full name, `effect` and `short_name`.
+  std::vector<ParameterInfo> parameters;
+  // Builds the effect from a run's parameters (read with GetParameter).
+  std::function<std::unique_ptr<Effect>(const ArmParameters&)> make;
+};
+
+// An effect parameter's entry: short name, SI units, bounds, its default
+// while the effect is on (the neutral value where there is one), its
+// realistic magnitude and a description.
+ParameterInfo EffectParameter(const std::string& short_name, const std::string& units, double lower,
+                              double upper, double default_value, double realistic,
+                              const std::string& description);
+
+// Every effect, in the order of Effects() (registry.cc).
+const std::vector<EffectDefinition>& EffectDefinitions();
+
+// The effects that are on in `parameters`, built, in registry order.
+std::vector<std::unique_ptr<Effect>> MakeEffects(const ArmParameters& parameters);
+
+// The inputs the actuators realise: `commanded` passed through every effect
+// that is on, in registry order; null when none changes them.
+std::unique_ptr<CableInputs> RealisedInputs(const ArmModel& model, const ArmParameters& parameters,
+                                            const CableInputs& commanded, double duration_s);
+
+// The definitions of the seven effects (one file each).
+EffectDefinition JointFrictionEffect();
+EffectDefinition TableTiltEffect();
+EffectDefinition ActuatorDelayEffect();
+EffectDefinition BacklashEffect();
+EffectDefinition PretensionCreepEffect();
+EffectDefinition AirDragEffect();
+EffectDefinition MocapOffsetEffect();
+
+}  // namespace ccsrm::sim::internal

@@ -1,0 +1,94 @@
+#pragma once
+// Small arms and short runs shared by the simulator's physics tests
+// (dynamics_test, effects_test): an arm built inline, inputs that pull one
+// cable and hold, and the energy balance of a run.
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "ccsrm/sim/config.h"
+#include "ccsrm/sim/model.h"
+#include "ccsrm/sim/protocol.h"
+#include "ccsrm/sim/simulator.h"
+
+namespace ccsrm::sim::test_support {
+
+inline std::string PaperConfigPath() {
+  return std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml";
+}
+
+// One segment of `links` links with the paper's geometry and three cables.
+inline Config SmallArm(int links) {
+  Config c = LoadConfig(PaperConfigPath());
+  c.arm.segments.resize(1);
+  c.arm.segments[0].links = links;
+  c.arm.segments[0].connecting_pattern.assign(links - 1, ConnectingKind::kSmallS);
+  for (int k = 1; k < links - 1; k += 2)
+    c.arm.segments[0].connecting_pattern[k] = ConnectingKind::kLargeS;
+  c.arm.driving.cables.resize(3);
+  Validate(c);
+  return c;
+}
+
+// Inputs that pull cable `pulled` in by `amount_m` along a quintic over
+// [0, ramp_s] and then hold it (and every other cable) fixed.
+inline CableInputs PullAndHold(const ArmModel& model, int pulled, double amount_m, double ramp_s,
+                               double end_s) {
+  const int n = static_cast<int>(end_s / 1e-3) + 1;
+  Eigen::VectorXd time(n);
+  Eigen::MatrixXd change = Eigen::MatrixXd::Zero(n, model.num_cables());
+  for (int i = 0; i < n; ++i) {
+    time[i] = i * 1e-3;
+    change(i, pulled) = amount_m * QuinticBlend(time[i] / ramp_s);
+  }
+  return CableInputs(time, change);
+}
+
+inline double TotalEnergy(const TrajectoryFrame& frame) {
+  return frame.kinetic_energy + frame.elastic_energy + frame.dissipated_energy;
+}
+
+// Energy figures of a run from `from_s` on (after the inputs have stopped).
+struct EnergyBalance {
+  double reference = 0.0;      // kinetic + elastic + dissipated at from_s [J]
+  double drift = 0.0;          // largest change of that total [J]
+  double kinetic_max = 0.0;    // [J]
+  double elastic_swing = 0.0;  // largest change of the elastic energy [J]
+  double dissipated = 0.0;     // dissipated from from_s to the end [J]
+  double span_s = 0.0;
+};
+
+inline EnergyBalance BalanceAfter(const Trajectory& run, double from_s) {
+  std::size_t start = 0;
+  while (run.time[start] < from_s) ++start;
+  const TrajectoryFrame& first = run.frames[start];
+  const TrajectoryFrame& last = run.frames.back();
+  EnergyBalance b;
+  b.reference = TotalEnergy(first);
+  for (std::size_t f = start; f < run.size(); ++f) {
+    const TrajectoryFrame& frame = run.frames[f];
+    b.drift = std::max(b.drift, std::abs(TotalEnergy(frame) - b.reference));
+    b.kinetic_max = std::max(b.kinetic_max, frame.kinetic_energy);
+    b.elastic_swing =
+        std::max(b.elastic_swing, std::abs(frame.elastic_energy - first.elastic_energy));
+  }
+  b.dissipated = last.dissipated_energy - first.dissipated_energy;
+  b.span_s = run.time.back() - run.time[start];
+  return b;
+}
+
+// No friction and no damping anywhere; the equations keep all their terms.
+inline void SwitchOffDissipation(ArmParameters* p) {
+  p->mu = p->mu_s = p->mu_c = p->mu_c_s = 0.0;
+  p->beta = p->c_sc = p->c_lc = 0.0;
+}
+
+inline SimulationOptions OptionsFor(const Config& c, double duration_s) {
+  SimulationOptions options;
+  options.duration_s = duration_s;
+  options.solver = c.solver;
+  return options;
+}
+
+}  // namespace ccsrm::sim::test_support
