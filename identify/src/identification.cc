@@ -788,11 +788,15 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     }
     summary.parameters.push_back(est);
   }
-  for (const std::string& name : AllParameterNames()) {
+  // Fixed: every model parameter, and the parameters of the effects that are on.
+  for (const sim::ParameterInfo& info_entry : sim::AllParameters()) {
+    const std::string& name = info_entry.name;
     if (std::find(summary.free_names.begin(), summary.free_names.end(), name) !=
         summary.free_names.end()) {
       continue;
     }
+    const std::size_t dot = name.find('.');
+    if (dot != std::string::npos && !base.front().EffectOn(name.substr(0, dot))) continue;
     const sim::ParameterInfo& info = sim::FindParameter(name, "parameters");
     ParameterEstimate est;
     est.name = name;

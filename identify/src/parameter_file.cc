@@ -47,10 +47,13 @@ void ApplyParameterFile(const std::string& yaml_text, const std::string& file,
     const sim::ParameterInfo* info = nullptr;
     try {
       info = &sim::FindParameter(name, file);
-    } catch (const InputError&) {
-      std::string known;
-      for (const std::string& n : AllParameterNames()) known += (known.empty() ? "" : ", ") + n;
-      ThrowInputError(file, where, "unknown parameter (known: " + known + ")");
+    } catch (const InputError& error) {
+      // FindParameter's message lists the known names after the file's.
+      const std::string text = error.what();
+      const std::size_t known = text.find("(known:");
+      ThrowInputError(file, where,
+                      "unknown parameter" +
+                          (known == std::string::npos ? std::string() : " " + text.substr(known)));
     }
     const auto set_value = [&](double value, const std::string& at) {
       const std::string problem = sim::ParameterValueProblem(*info, value);

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/sim/effects.h"
 
 namespace ccsrm::identify {
 namespace {
@@ -25,12 +26,14 @@ RunResult RunOne(const Experiment& e, const RunRequest& request) {
   const std::size_t frames =
       std::min(result.trajectory.size(), static_cast<std::size_t>(e.measured_rad.rows()));
   for (std::size_t f = 0; f < frames; ++f) {
-    const sim::TrajectoryFrame& frame = result.trajectory.frames[f];
+    // What motion capture records: measurement effects (mocap_offset) included.
+    const std::vector<Eigen::Vector2d> recorded =
+        sim::RecordedJointAngles(request.parameters, result.trajectory.frames[f]);
     for (int j = 0; j < e.joints; ++j) {
       out.angles_rad(static_cast<Eigen::Index>(f), 2 * j) =
-          frame.joint_angles[static_cast<std::size_t>(j)].x();
+          recorded[static_cast<std::size_t>(j)].x();
       out.angles_rad(static_cast<Eigen::Index>(f), 2 * j + 1) =
-          frame.joint_angles[static_cast<std::size_t>(j)].y();
+          recorded[static_cast<std::size_t>(j)].y();
     }
   }
   e.AsMeasured(&out.angles_rad);
