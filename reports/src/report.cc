@@ -146,6 +146,12 @@ ReportSummary MakeReport(const std::string& input, const std::string& output_fol
   std::error_code ec;
   if (!fs::exists(input, ec)) ThrowInputError(input, "", "no such file");
   const bool folder = fs::is_directory(input, ec);
+  if (!folder && fs::path(input).filename() == "fit.json") {
+    const fs::path parent = fs::path(input).parent_path();
+    ThrowInputError(input, "",
+                    "a fit is reported from its folder: ccsrm report --in " +
+                        (parent.empty() ? std::string(".") : parent.string()));
+  }
   if (folder && !internal::LooksLikeFitFolder(input)) {
     ThrowInputError(input, "",
                     "not a fit folder (no fit.json); expected a ccsrm-run/1 or ccsrm-dataset/1 "

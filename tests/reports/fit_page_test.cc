@@ -317,6 +317,29 @@ TEST(FitPage, AFitWithoutItsRunFileShowsAllJointsInOnePanelAndSaysWhy) {
   EXPECT_EQ(document.figures()[0]->figure.panels.size(), 1u);
 }
 
+TEST(FitPage, SeveralExperimentsGetASectionAndANoiseColumnEach) {
+  json fit = KnownFitJson();
+  json second = fit["experiments"][0];
+  second["name"] = "g5 slow";  // not a file stem: its figures get one
+  second["angles_from_pipeline"] = false;
+  second["noise_source"] = "given";
+  for (json& noise : second["noise_deg"]) noise = 0.05;
+  fit["experiments"].push_back(second);
+  const Document document = BuildFitDocument(WriteFitFolder("two", fit).string(), ReportOptions());
+  const json summary = ToJson(document);
+  EXPECT_EQ(summary["sections"][1]["id"], "angles-g4_1");
+  EXPECT_EQ(summary["sections"][2]["id"], "angles-g5_slow_2");
+  std::vector<std::string> names;
+  for (const FigureBlock* figure : document.figures()) names.push_back(figure->figure.name);
+  EXPECT_THAT(names, ::testing::IsSupersetOf({"angles_x_g4_1", "residuals_g4_1",
+                                              "angles_y_g5_slow_2", "residuals_g5_slow_2"}));
+  EXPECT_EQ(RowOf(summary, "experiments", "experiment", "g5 slow")["angles"],
+            "stored in the experiment");
+  const json joint1 = RowOf(summary, "noise", "joint", 1);
+  EXPECT_EQ(joint1["noise_deg_g4"], 0.03);
+  EXPECT_EQ(joint1["noise_deg_g5_slow"], 0.05);
+}
+
 std::string ErrorOf(const fs::path& dir) {
   try {
     BuildFitDocument(dir.string(), ReportOptions());

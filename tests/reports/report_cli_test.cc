@@ -229,6 +229,9 @@ TEST(ReportCli, BadInputGetsOneLineAndExitStatus2) {
   fs::create_directories(dir / "fit");
   ccsrm::WriteTextFileAtomically((dir / "fit" / "fit.json").string(),
                                  "{\"schema\": \"ccsrm-run/1\"}");
+  ExpectOneLineError(
+      RunCcsrm("report --in " + (dir / "fit" / "fit.json").string() + " --out " + out),
+      "fit.json: a fit is reported from its folder: ccsrm report --in " + (dir / "fit").string());
   ExpectOneLineError(RunCcsrm("report --in " + (dir / "fit").string() + " --out " + out),
                      "fit.json: key 'schema': is \"ccsrm-run/1\", expected \"ccsrm-fit/1\"");
   ExpectOneLineError(RunCcsrm("report --in " + Paper() + " --out " + out), "paper.yaml: ");
