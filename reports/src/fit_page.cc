@@ -565,7 +565,8 @@ Section ErrorSection(const FitFolder& fit) {
   section.blocks.push_back(FigureBlock{
       ErrorFigure(fit), "Before and after, per joint",
       "RMS error (top) and fit percent (bottom) of θx (left) and θy (right) per joint over every "
-      "experiment: grey at the start values, blue with the fitted parameters.",
+      "experiment: grey at the start values, blue with the fitted parameters. The fit-percent axes "
+      "span the data, not 0 to 100 %.",
       ""});
   section.blocks.push_back(std::move(table));
   return section;
