@@ -70,7 +70,17 @@ bool Drawable(double x, double y, const Panel& panel) {
 bool WriteBlock(const Series& s, const Panel& panel, std::ostream& out) {
   std::ostringstream block;
   bool any = false;
-  if (s.style == SeriesStyle::kRanges) {
+  if (s.style == SeriesStyle::kCells) {
+    // x y z valid: a cell without a value keeps its square (grey) and gets
+    // z = 0, valid = 0, so gnuplot never meets a NaN it would skip.
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      if (!Drawable(s.x[i], s.y[i], panel)) continue;
+      const bool valid = std::isfinite(s.z[i]);
+      block << Number(s.x[i]) << ' ' << Number(s.y[i]) << ' ' << Number(valid ? s.z[i] : 0.0) << ' '
+            << (valid ? 1 : 0) << '\n';
+      any = true;
+    }
+  } else if (s.style == SeriesStyle::kRanges) {
     for (std::size_t i = 0; i < s.y.size(); ++i) {
       const double x0 = s.x[2 * i], x1 = s.x[2 * i + 1], y = s.y[i];
       if (!Drawable(x0, y, panel) || !Drawable(x1, y, panel)) continue;
@@ -110,13 +120,29 @@ std::string StyleClause(const Series& s) {
     case SeriesStyle::kSteps:
       return "with steps" + color + width;
     case SeriesStyle::kPoints:
-      return "with points" + color + " pt 7 ps 0.6";
+      return "with points" + color + " pt 7 ps " + Number(s.point_size);
     case SeriesStyle::kLinePoints:
       return "with linespoints" + color + width + " pt 7 ps 0.7";
     case SeriesStyle::kBars:
       return "with boxes" + color + " fs solid 0.85 noborder";
+    case SeriesStyle::kCells:
+      break;  // three clauses of their own (CellClauses)
   }
   return "with lines";
+}
+
+// A heat map: every cell as a grey square, the cells with a value on top in
+// the colour of their value (an undefined x skips the others), then the
+// values as text.
+std::vector<std::string> CellClauses(const Series& s, const std::string& source) {
+  const std::string box = "($1-0.5):($1+0.5):($2-0.5):($2+0.5)";
+  const std::string style = " with boxxyerror fs solid 1.0 border lc rgb \"#ffffff\"";
+  const std::string label = "sprintf(\"%." + std::to_string(s.cell_decimals) + "f\", $3)";
+  return {source + " using 1:2:" + box + style + " lc rgb \"#d9d9d9\" notitle",
+          source + " using ($4 > 0 ? $1 : 1/0):2:" + box + ":3" + style + " fc palette" +
+              (s.label.empty() ? " notitle" : " title " + Quote(s.label)),
+          source + " using 1:2:($4 > 0 ? " + label +
+              " : \"–\") with labels tc rgb \"#222222\" notitle"};
 }
 
 void WriteAxis(const char* name, const Axis& axis, std::ostream& gp) {
@@ -202,11 +228,22 @@ void WriteScript(const Figure& figure, const PlotOptions& options, const std::st
         gp << "set rmargin 4\nunset key\n";
         break;
     }
+    // The colour bar sits right of the plot, with its tics and title.
+    if (panel.color) gp << "set rmargin 18\n";
     // Autoscaled y ranges get 5 % of air above and below, so a line at its
     // extreme (a cable stuck at all its holes) is not hidden in the border;
     // a legend inside the panel gets a third of the height above the data.
     gp << "set offsets 0, 0, graph " << (panel.legend == LegendPlace::kInside ? "0.35" : "0.05")
        << ", graph 0.05\n";
+    if (panel.color) {
+      // Blue–white–red (ColorBrewer RdBu, its lighter ends so black cell
+      // labels stay readable), white at the middle of the range.
+      gp << "set palette defined (0 \"#4393c3\", 1 \"#ffffff\", 2 \"#d6604d\")\n"
+         << "set cbrange [" << Number(*panel.color->min) << ':' << Number(*panel.color->max)
+         << "]\nset cblabel " << Quote(panel.color->Title()) << "\nset colorbox\n";
+    } else {
+      gp << "unset colorbox\n";
+    }
     gp << "unset label\n";
     if (!panel.note.empty()) {
       gp << "set label 1 " << Quote(panel.note)
@@ -216,12 +253,17 @@ void WriteScript(const Figure& figure, const PlotOptions& options, const std::st
     for (const Series& s : panel.series) {
       if (!WriteBlock(s, panel, dat)) continue;
       // Columns: x y [width] per point; x0 x1 y per bar of a range.
+      const std::string source = "'" + figure.name + ".dat' index " + std::to_string(index);
+      if (s.style == SeriesStyle::kCells) {
+        for (std::string& clause : CellClauses(s, source)) clauses.push_back(std::move(clause));
+        ++index;
+        continue;
+      }
       const char* columns = s.style == SeriesStyle::kBars ? "1:2:3"
                             : s.style == SeriesStyle::kRanges
                                 ? "(($1+$2)/2):3:1:2:($3-0.3):($3+0.3)"
                                 : "1:2";
-      clauses.push_back("'" + figure.name + ".dat' index " + std::to_string(index) + " using " +
-                        columns + " " + StyleClause(s) +
+      clauses.push_back(source + " using " + columns + " " + StyleClause(s) +
                         (s.label.empty() ? " notitle" : " title " + Quote(s.label)));
       ++index;
     }
@@ -313,7 +355,7 @@ bool Figure::IsValid(std::string* error) const {
   if (columns < 1) return fail("columns must be >= 1");
   if (panel_width_px < 100 || panel_height_px < 100) return fail("panels must be >= 100 px");
   for (const Panel& panel : panels) {
-    for (const Axis* axis : {&panel.x, &panel.y}) {
+    for (const Axis* axis : {&panel.x, &panel.y, panel.color ? &*panel.color : &panel.y}) {
       if (axis->label.empty() || axis->unit.empty()) {
         return fail("panel '" + panel.title + "': every axis needs a label and a unit");
       }
@@ -324,8 +366,18 @@ bool Figure::IsValid(std::string* error) const {
         return fail("series '" + s.label + "': x and y lengths disagree");
       }
       if (!IsColor(s.color)) return fail("series '" + s.label + "': colour must be #rrggbb");
-      if (!(s.line_width > 0.0) || !(s.bar_width > 0.0)) {
+      if (!(s.line_width > 0.0) || !(s.bar_width > 0.0) || !(s.point_size > 0.0)) {
         return fail("series '" + s.label + "': widths must be > 0");
+      }
+      if (s.style == SeriesStyle::kCells) {
+        if (s.z.size() != s.x.size()) return fail("series '" + s.label + "': needs a z per cell");
+        if (!panel.color || !panel.color->min || !panel.color->max ||
+            !(*panel.color->min < *panel.color->max)) {
+          return fail("panel '" + panel.title + "': cells need a colour scale with min < max");
+        }
+        if (s.cell_decimals < 0 || s.cell_decimals > 6) {
+          return fail("series '" + s.label + "': cell_decimals must be in [0, 6]");
+        }
       }
     }
   }

@@ -13,6 +13,7 @@
 #include "ccsrm/common/clock.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/datasets/inspect.h"
+#include "fit_folder.h"
 
 namespace ccsrm::reports {
 namespace {
@@ -144,10 +145,17 @@ ReportSummary MakeReport(const std::string& input, const std::string& output_fol
   if (!options.IsValid(&why)) ThrowInputError("report options", "", why);
   std::error_code ec;
   if (!fs::exists(input, ec)) ThrowInputError(input, "", "no such file");
-  if (fs::is_directory(input, ec)) {
+  const bool folder = fs::is_directory(input, ec);
+  if (!folder && fs::path(input).filename() == "fit.json") {
+    const fs::path parent = fs::path(input).parent_path();
     ThrowInputError(input, "",
-                    "is a folder; expected a ccsrm-run/1 or ccsrm-dataset/1 file (reports of "
-                    "identify and loop folders are not available yet)");
+                    "a fit is reported from its folder: ccsrm report --in " +
+                        (parent.empty() ? std::string(".") : parent.string()));
+  }
+  if (folder && !internal::LooksLikeFitFolder(input)) {
+    ThrowInputError(input, "",
+                    "not a fit folder (no fit.json); expected a ccsrm-run/1 or ccsrm-dataset/1 "
+                    "file, or a folder written by ccsrm identify");
   }
   if (IsInside(input, output_folder)) {
     ThrowInputError(output_folder, "",
@@ -155,12 +163,18 @@ ReportSummary MakeReport(const std::string& input, const std::string& output_fol
                         ", which replacing the folder would delete: choose another output folder");
   }
   CheckOutputFolder(output_folder);
-  const datasets::AnyFile file = datasets::ReadAnyFile(input);
-  FindGnuplot(options.plot);
-  Document document =
-      std::holds_alternative<datasets::RunFile>(file)
-          ? BuildRunDocument(std::get<datasets::RunFile>(file), input, options)
-          : BuildExperimentDocument(std::get<datasets::ExperimentFile>(file), input, options);
+  Document document;
+  if (folder) {
+    FindGnuplot(options.plot);
+    document = BuildFitDocument(input, options);
+  } else {
+    const datasets::AnyFile file = datasets::ReadAnyFile(input);
+    FindGnuplot(options.plot);
+    document =
+        std::holds_alternative<datasets::RunFile>(file)
+            ? BuildRunDocument(std::get<datasets::RunFile>(file), input, options)
+            : BuildExperimentDocument(std::get<datasets::ExperimentFile>(file), input, options);
+  }
   WriteReport(&document, output_folder, options);
 
   ReportSummary summary;

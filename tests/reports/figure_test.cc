@@ -150,5 +150,59 @@ TEST(Figure, BarsRangesAndLabelledTicsRender) {
   EXPECT_THAT(ReadTextFile((dir / "bars.gp").string()), HasSubstr("\"L01_A\" 1"));
 }
 
+// A 2 × 2 heat map with one cell without a value (a correlation that does
+// not exist).
+Figure HeatMap() {
+  Figure figure;
+  figure.name = "heat";
+  Panel panel;
+  panel.x = Axis{"parameter", "1"};
+  panel.y = Axis{"parameter", "1"};
+  Axis color{"correlation", "1"};
+  color.min = -1.0;
+  color.max = 1.0;
+  panel.color = color;
+  Series cells;
+  cells.style = SeriesStyle::kCells;
+  cells.x = {1, 2, 1, 2};
+  cells.y = {2, 2, 1, 1};
+  cells.z = {1.0, -0.625, -0.625, NAN};
+  panel.series.push_back(cells);
+  figure.panels = {panel};
+  return figure;
+}
+
+TEST(Figure, CellsNeedAValueEachAndAColourScale) {
+  std::string why;
+  Figure figure = HeatMap();
+  EXPECT_TRUE(figure.IsValid(&why)) << why;
+  figure.panels[0].series[0].z.pop_back();
+  EXPECT_FALSE(figure.IsValid(&why));
+  EXPECT_THAT(why, HasSubstr("needs a z per cell"));
+  figure = HeatMap();
+  figure.panels[0].color->max = -1.0;
+  EXPECT_FALSE(figure.IsValid(&why));
+  EXPECT_THAT(why, HasSubstr("colour scale with min < max"));
+  figure = HeatMap();
+  figure.panels[0].color->unit = "";
+  EXPECT_FALSE(figure.IsValid(&why));
+  EXPECT_THAT(why, HasSubstr("label and a unit"));
+}
+
+TEST(Figure, HeatMapRendersEveryCellWithItsValue) {
+  if (!testing::ProgramOnPath("gnuplot")) GTEST_SKIP() << "gnuplot not installed";
+  const fs::path dir = FreshDir("heat");
+  EXPECT_EQ(RenderFigure(HeatMap(), dir.string(), PlotOptions()), "heat.png");
+  // A cell without a value keeps its place (z 0, flagged 0) so gnuplot
+  // draws it grey instead of skipping it.
+  EXPECT_THAT(ReadTextFile((dir / "heat.dat").string()),
+              HasSubstr("1 2 1 1\n2 2 -0.625 1\n1 1 -0.625 1\n2 1 0 0\n"));
+  const std::string script = ReadTextFile((dir / "heat.gp").string());
+  EXPECT_THAT(script, HasSubstr("set cbrange [-1:1]"));
+  EXPECT_THAT(script, HasSubstr("set cblabel \"correlation\""));
+  EXPECT_THAT(script, HasSubstr("fc palette"));
+  EXPECT_THAT(script, HasSubstr("sprintf(\"%.2f\", $3)"));
+}
+
 }  // namespace
 }  // namespace ccsrm::reports

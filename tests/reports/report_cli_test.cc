@@ -35,7 +35,7 @@ fs::path FreshDir(const std::string& name) {
 
 // Inputs made once by the program itself (the suite is one process): 2 s of
 // paper case 2, and 2 s of case 2 recorded by virtual motion capture, then
-// processed.
+// processed; and (MadeFit) a fit of T_p to that experiment.
 struct Inputs {
   fs::path dir;
   std::string run, raw_experiment, experiment;
@@ -61,6 +61,20 @@ const Inputs& Made() {
     return in;
   }();
   return inputs;
+}
+
+// ccsrm identify on the processed experiment: T_p from a start 20 % off its
+// nominal value, at most 3 iterations (a few seconds on two threads).
+std::string MadeFit() {
+  static const std::string fit = [] {
+    const std::string out = (Made().dir / "fit").string();
+    const Outcome identify =
+        RunCcsrm("identify --data " + Made().experiment +
+                 " --free T_p --set T_p=60 --max-iterations 3 --threads 2 --quiet --out " + out);
+    EXPECT_EQ(identify.status, 0) << identify.err;
+    return out;
+  }();
+  return fit;
 }
 
 bool HaveGnuplot() { return rt::ProgramOnPath("gnuplot"); }
@@ -169,6 +183,35 @@ TEST(ReportCli, UnprocessedExperimentSaysSo) {
   EXPECT_THAT(r.outcome.out, HasSubstr("note: "));
 }
 
+TEST(ReportCli, FitReportShowsTheFitJsonNumbers) {
+  if (!HaveGnuplot()) GTEST_SKIP() << "gnuplot not installed";
+  const fs::path out = FreshDir("fit") / "report";
+  const Report r = MakeReport(MadeFit(), out);
+  ASSERT_EQ(r.outcome.status, 0) << r.outcome.err;
+  ExpectReferencedFilesExist(r.html, out);
+  EXPECT_GT(rt::ExpectTablesMatchJson(r.html, r.summary), 50);
+  EXPECT_EQ(r.summary["kind"], "fit");
+  const nlohmann::json fit =
+      nlohmann::json::parse(ReadTextFile((fs::path(MadeFit()) / "fit.json").string()));
+  const nlohmann::json& tp = fit["parameters"]["T_p"];
+  const nlohmann::json row = RowOf(r.summary, "parameters", "parameter", "T_p");
+  EXPECT_EQ(row["start"].get<double>(), 60.0);
+  // Shown to 4 significant digits.
+  EXPECT_NEAR(row["estimate"].get<double>(), tp["value"].get<double>(),
+              5e-4 * tp["value"].get<double>());
+  EXPECT_EQ(RowOf(r.summary, "fit", "quantity", "iterations")["value"], fit["iterations"]);
+  EXPECT_NEAR(RowOf(r.summary, "fit", "quantity", "RMS error fitted")["value"].get<double>(),
+              fit["rms_deg"].get<double>(), 5e-5);
+  // At most the note that 3 iterations were not enough.
+  for (const nlohmann::json& notice : r.summary["notices"]) {
+    EXPECT_THAT(notice.get<std::string>(), HasSubstr("did not converge"));
+  }
+  // The paper arm's two segments, from the fitted run's configuration.
+  const std::string first = r.summary["figures"][0]["script"];
+  EXPECT_THAT(first, HasSubstr("figures/angles_x_"));
+  EXPECT_THAT(ReadTextFile((out / first).string()), HasSubstr("Segment 2 (joints 7–12)"));
+}
+
 void ExpectOneLineError(const Outcome& o, const std::string& what) {
   EXPECT_EQ(o.status, 2) << o.out << o.err;
   EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
@@ -181,7 +224,16 @@ TEST(ReportCli, BadInputGetsOneLineAndExitStatus2) {
   ExpectOneLineError(RunCcsrm("report --in " + (dir / "missing.h5").string() + " --out " + out),
                      "missing.h5: no such file");
   ExpectOneLineError(RunCcsrm("report --in " + dir.string() + " --out " + out),
-                     "is a folder; expected a ccsrm-run/1 or ccsrm-dataset/1 file");
+                     "not a fit folder (no fit.json); expected a ccsrm-run/1 or ccsrm-dataset/1 "
+                     "file, or a folder written by ccsrm identify");
+  fs::create_directories(dir / "fit");
+  ccsrm::WriteTextFileAtomically((dir / "fit" / "fit.json").string(),
+                                 "{\"schema\": \"ccsrm-run/1\"}");
+  ExpectOneLineError(
+      RunCcsrm("report --in " + (dir / "fit" / "fit.json").string() + " --out " + out),
+      "fit.json: a fit is reported from its folder: ccsrm report --in " + (dir / "fit").string());
+  ExpectOneLineError(RunCcsrm("report --in " + (dir / "fit").string() + " --out " + out),
+                     "fit.json: key 'schema': is \"ccsrm-run/1\", expected \"ccsrm-fit/1\"");
   ExpectOneLineError(RunCcsrm("report --in " + Paper() + " --out " + out), "paper.yaml: ");
   EXPECT_FALSE(fs::exists(out));
   // Output: inside a missing folder, onto a file, onto a folder of other
@@ -231,15 +283,15 @@ TEST(ReportCli, AFailedReportLeavesTheOldOneUntouched) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
 }
 
-// Renders both reports in headless Chromium into <build>/report_screenshots
+// Renders the run, experiment and fit reports in headless Chromium into <build>/report_screenshots
 // for a person to look at; checks only that an image of some size came out.
 TEST(ReportCli, ScreenshotsInHeadlessChromium) {
   if (!HaveGnuplot()) GTEST_SKIP() << "gnuplot not installed";
   if (!rt::ProgramOnPath("chromium")) GTEST_SKIP() << "chromium not installed";
   const fs::path shots = fs::path(CCSRM_BINARY_DIR) / "report_screenshots";
   fs::create_directories(shots);
-  const std::pair<std::string, std::string> reports[] = {{"run", Made().run},
-                                                         {"experiment", Made().experiment}};
+  const std::pair<std::string, std::string> reports[] = {
+      {"run", Made().run}, {"experiment", Made().experiment}, {"fit", MadeFit()}};
   for (const auto& [name, input] : reports) {
     const fs::path out = FreshDir("shot_" + name) / "report";
     ASSERT_EQ(MakeReport(input, out).outcome.status, 0);

@@ -91,7 +91,7 @@ struct Section {
 };
 
 struct Document {
-  std::string kind;           // "run" or "experiment"
+  std::string kind;           // "run", "experiment" or "fit"
   std::string title;          // e.g. "Simulation run — paper case 2"
   std::string source;         // the input file as given on the command line
   std::string created;        // ISO 8601 UTC time the report was made

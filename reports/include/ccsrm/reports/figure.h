@@ -30,6 +30,10 @@ enum class SeriesStyle {
   kBars,    // vertical bars from 0 (per-marker or per-body figures)
   kRanges,  // horizontal bars 0.6 high: x holds start, end pairs (x0, x1, x0, x1,
             // ...) and y one value per bar (timelines of gaps)
+  kCells,   // a heat map: unit squares centred at (x, y), filled with the colour
+            // of z on the panel's colour scale (Panel::color) and labelled with
+            // z to Series::cell_decimals; a non-finite z is a light grey
+            // square labelled "–" (a correlation that does not exist)
 };
 
 struct Series {
@@ -49,6 +53,9 @@ struct Series {
   SeriesStyle style = SeriesStyle::kLine;
   double line_width = 1.5;  // in gnuplot's line-width units
   double bar_width = 0.8;   // kBars: width in x units (categories sit 1 apart)
+  double point_size = 0.6;  // kPoints: marker size in gnuplot's units
+  std::vector<double> z;    // kCells: the value of each cell (same length as x)
+  int cell_decimals = 2;    // kCells: decimals of the cell labels
 };
 
 struct Axis {
@@ -84,6 +91,10 @@ struct Panel {
   LegendPlace legend = LegendPlace::kRight;
   // Text in the top-left corner of an empty or special panel (e.g. "no data").
   std::string note;
+  // The colour scale of kCells series (label, unit, min and max required),
+  // drawn as a colour bar right of the panel: a diverging blue–white–red
+  // scale, white at the middle of [min, max]. Unset: no colour bar.
+  std::optional<Axis> color;
 };
 
 struct Figure {
@@ -95,7 +106,9 @@ struct Figure {
   int panel_height_px = 280;
 
   // Checks the name, that there is a panel, that every axis has a unit,
-  // that every series' x and y agree in length and its colour is #rrggbb.
+  // that every series' x and y agree in length and its colour is #rrggbb,
+  // and that kCells series have a z per cell and a panel colour scale with
+  // min < max.
   bool IsValid(std::string* error) const;
 };
 
@@ -145,6 +158,10 @@ inline const std::string kPlan = "#000000";      // planned motion: black dashed
 inline const std::string kMeasured = "#333333";  // measured reference
 inline const std::string kNeutral = "#4e79a7";   // single-series bar charts
 inline const std::string kWarning = "#d62728";   // gaps, losses
+// A fit's values at its start (grey) and fitted (the neutral blue), in every
+// before/after figure of a fit page.
+inline const std::string kStart = "#a0a0a0";
+inline const std::string kFitted = "#4e79a7";
 // Instants of a run (end of ramp, mid-hold, ...), in time order: Dark2.
 const std::string& Instant(int k);
 }  // namespace palette

@@ -38,7 +38,7 @@ struct ReportOptions {
 struct ReportSummary {
   std::string input;   // the file reported on
   std::string output;  // the report folder
-  std::string kind;    // "run" or "experiment"
+  std::string kind;    // "run", "experiment" or "fit"
   std::string title;
   int figures = 0;
   int tables = 0;
@@ -64,6 +64,18 @@ Document BuildRunDocument(const datasets::RunFile& run, const std::string& sourc
 Document BuildExperimentDocument(const datasets::ExperimentFile& experiment,
                                  const std::string& source, const ReportOptions& options);
 
+// The page of a fit folder written by `ccsrm identify` (fit.json of schema
+// ccsrm-fit/1, and per experiment <name>.angles.csv and <name>.fit.h5):
+// measured against fitted angles and the residuals per experiment, the
+// parameters with standard errors and 95 % intervals, the correlation
+// matrix, singular values and the directions the data do not pin down,
+// per-joint errors at the start and fitted, cost per step, the experiments
+// and their noise. Every number as fit.json and the angles files give it.
+// Throws InputError for invalid options, "<folder>: not a fit folder (no
+// fit.json)", a fit.json of another schema, or a missing key or malformed
+// file (naming the file and the key or line).
+Document BuildFitDocument(const std::string& folder, const ReportOptions& options);
+
 // Renders every figure of `document` with gnuplot into <folder>/figures,
 // then writes <folder>/index.html and <folder>/summary.json, all inside a
 // temporary folder beside the target that replaces it only when complete
@@ -76,10 +88,10 @@ void WriteReport(Document* document, const std::string& folder, const ReportOpti
 
 // What `ccsrm report` does: checks the options, that gnuplot is there and
 // that the output may be written (as WriteReport; and the input must not lie
-// inside it), reads `input` once (a ccsrm-run/1 or ccsrm-dataset/1 file),
-// builds its page and writes it. Throws InputError naming the path for a
-// missing input, a folder, or a file of another kind; PlotError as
-// WriteReport.
+// inside it), reads `input` once (a ccsrm-run/1 or ccsrm-dataset/1 file,
+// or a fit folder), builds its page and writes it. Throws InputError naming
+// the path for a missing input, a folder without fit.json, or a file of
+// another kind; PlotError as WriteReport.
 ReportSummary MakeReport(const std::string& input, const std::string& output_folder,
                          const ReportOptions& options);
 

@@ -1,0 +1,399 @@
+#include "fit_folder.h"
+
+#include <cerrno>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "ccsrm/common/error.h"
+#include "ccsrm/datasets/run_file.h"
+
+namespace ccsrm::reports::internal {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Reads values out of fit.json; every error names the file and the key's
+// path ("parameters.T_p.value").
+class FitJson {
+ public:
+  explicit FitJson(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
+    ThrowInputError(file_, "key '" + key + "'", what);
+  }
+
+  const json& At(const json& object, const std::string& parent, const std::string& key) const {
+    const std::string path = parent.empty() ? key : parent + "." + key;
+    if (!object.is_object()) Fail(parent, "expected an object");
+    const auto it = object.find(key);
+    if (it == object.end()) Fail(path, "missing");
+    return *it;
+  }
+
+  // A number; null is NaN where `nullable` (JSON has no NaN or infinity).
+  double Number(const json& value, const std::string& key, bool nullable = false) const {
+    if (value.is_null() && nullable) return kUnknown;
+    if (!value.is_number()) Fail(key, nullable ? "expected a number or null" : "expected a number");
+    return value.get<double>();
+  }
+  double NumberAt(const json& object, const std::string& parent, const std::string& key,
+                  bool nullable = false) const {
+    return Number(At(object, parent, key), Join(parent, key), nullable);
+  }
+  std::string Text(const json& object, const std::string& parent, const std::string& key) const {
+    const json& value = At(object, parent, key);
+    if (!value.is_string()) Fail(Join(parent, key), "expected a string");
+    return value.get<std::string>();
+  }
+  bool Flag(const json& object, const std::string& parent, const std::string& key) const {
+    const json& value = At(object, parent, key);
+    if (!value.is_boolean()) Fail(Join(parent, key), "expected true or false");
+    return value.get<bool>();
+  }
+  const json& List(const json& object, const std::string& parent, const std::string& key) const {
+    const json& value = At(object, parent, key);
+    if (!value.is_array()) Fail(Join(parent, key), "expected a list");
+    return value;
+  }
+  std::vector<double> Numbers(const json& object, const std::string& parent, const std::string& key,
+                              bool nullable = false) const {
+    const json& list = List(object, parent, key);
+    std::vector<double> out;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      out.push_back(Number(list[i], Join(parent, key) + "[" + std::to_string(i) + "]", nullable));
+    }
+    return out;
+  }
+  // A pair [a, b] of numbers.
+  std::array<double, 2> Pair(const json& value, const std::string& key, bool nullable) const {
+    if (!value.is_array() || value.size() != 2) Fail(key, "expected a list of two numbers");
+    return {Number(value[0], key + "[0]", nullable), Number(value[1], key + "[1]", nullable)};
+  }
+
+  static std::string Join(const std::string& parent, const std::string& key) {
+    return parent.empty() ? key : parent + "." + key;
+  }
+
+ private:
+  std::string file_;
+};
+
+FitErrors ReadErrors(const FitJson& in, const json& object, const std::string& key) {
+  FitErrors errors;
+  errors.rms_deg = in.NumberAt(object, key, "rms_deg", true);
+  errors.fit_percent = in.NumberAt(object, key, "fit_percent", true);
+  const json& joints = in.List(object, key, "per_joint");
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    const std::string at = key + ".per_joint[" + std::to_string(j) + "]";
+    FitErrors::Joint joint;
+    joint.joint = static_cast<int>(in.NumberAt(joints[j], at, "joint"));
+    if (joint.joint != static_cast<int>(j) + 1) in.Fail(at + ".joint", "expected joints 1, 2, ...");
+    joint.rms_deg = in.Pair(in.At(joints[j], at, "rms_deg"), at + ".rms_deg", true);
+    joint.fit_percent = in.Pair(in.At(joints[j], at, "fit_percent"), at + ".fit_percent", true);
+    joint.samples = in.Pair(in.At(joints[j], at, "samples"), at + ".samples", false);
+    errors.per_joint.push_back(joint);
+  }
+  return errors;
+}
+
+FitParameter ReadParameter(const FitJson& in, const json& entry, const std::string& name) {
+  const std::string at = "parameters." + name;
+  FitParameter p;
+  p.name = name;
+  p.units = in.Text(entry, at, "units");
+  p.free = in.Flag(entry, at, "free");
+  p.start = in.NumberAt(entry, at, "start");
+  p.value = in.NumberAt(entry, at, "value");
+  if (!p.free) return p;
+  p.identifiable = in.Flag(entry, at, "identifiable");
+  p.at_bound = in.Flag(entry, at, "at_bound");
+  p.std_error = in.NumberAt(entry, at, "std_error", true);
+  const json& ci = in.At(entry, at, "ci95");
+  if (!ci.is_null()) {
+    const std::array<double, 2> interval = in.Pair(ci, at + ".ci95", true);
+    p.ci95_lower = interval[0];
+    p.ci95_upper = interval[1];
+  }
+  const std::array<double, 2> bounds = in.Pair(in.At(entry, at, "bounds"), at + ".bounds", false);
+  p.lower = bounds[0];
+  p.upper = bounds[1];
+  return p;
+}
+
+// One row of the angles file: comma-separated cells, empty = not measured.
+std::vector<std::string> SplitCells(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string cell;
+  std::istringstream stream(line);
+  while (std::getline(stream, cell, ',')) cells.push_back(cell);
+  if (!line.empty() && line.back() == ',') cells.push_back("");
+  return cells;
+}
+
+// <name>.angles.csv: a comment line, the header time_s, then for joint
+// j = 1..J and axis x, y: measured_theta<axis><j>_deg,
+// fitted_theta<axis><j>_deg, residual_theta<axis><j>_deg.
+void ReadAnglesFile(const std::string& file, FitExperiment* e) {
+  std::ifstream in(file);
+  if (!in) ThrowInputError(file, "", "cannot be read (the angles file fit.json names)");
+  std::string line;
+  int number = 0;
+  std::vector<std::string> header;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    header = SplitCells(line);
+    break;
+  }
+  const std::string where = "line " + std::to_string(number);
+  if (header.empty() || header[0] != "time_s" || (header.size() - 1) % 6 != 0 ||
+      header.size() < 7) {
+    ThrowInputError(file, where,
+                    "expected the header time_s,measured_thetax1_deg,fitted_thetax1_deg,"
+                    "residual_thetax1_deg,... (6 columns per joint)");
+  }
+  const std::size_t joints = (header.size() - 1) / 6;
+  const char* kinds[] = {"measured", "fitted", "residual"};
+  for (std::size_t j = 0; j < joints; ++j) {
+    for (std::size_t c = 0; c < 2; ++c) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        const std::string want = std::string(kinds[k]) + "_theta" + (c == 0 ? "x" : "y") +
+                                 std::to_string(j + 1) + "_deg";
+        const std::size_t column = 1 + 6 * j + 3 * c + k;
+        if (header[column] != want) {
+          ThrowInputError(file, where,
+                          "column " + std::to_string(column + 1) + " is '" + header[column] +
+                              "', expected '" + want + "'");
+        }
+      }
+    }
+  }
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    const std::vector<std::string> cells = SplitCells(line);
+    if (cells.size() != header.size()) {
+      ThrowInputError(
+          file, "line " + std::to_string(number),
+          std::to_string(cells.size()) + " cells, expected " + std::to_string(header.size()));
+    }
+    std::vector<double> row(cells.size(), kUnknown);
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      if (cells[i].empty() && i > 0) continue;
+      char* end = nullptr;
+      errno = 0;
+      row[i] = std::strtod(cells[i].c_str(), &end);
+      if (cells[i].empty() || *end != '\0' || errno != 0) {
+        ThrowInputError(file, "line " + std::to_string(number),
+                        "column " + std::to_string(i + 1) + " ('" + header[i] + "'): '" + cells[i] +
+                            "' is not a number");
+      }
+    }
+    if (!rows.empty() && !(row[0] > rows.back()[0])) {
+      ThrowInputError(file, "line " + std::to_string(number), "times must increase");
+    }
+    rows.push_back(std::move(row));
+  }
+  if (rows.empty()) ThrowInputError(file, "", "has no frames");
+  const std::size_t frames = rows.size();
+  e->measured_deg = datasets::Array({frames, joints, 2});
+  e->fitted_deg = datasets::Array({frames, joints, 2});
+  e->residual_deg = datasets::Array({frames, joints, 2});
+  for (std::size_t f = 0; f < frames; ++f) {
+    e->time_s.push_back(rows[f][0]);
+    for (std::size_t j = 0; j < joints; ++j) {
+      for (std::size_t c = 0; c < 2; ++c) {
+        const std::size_t column = 1 + 6 * j + 3 * c;
+        e->measured_deg.at(f, j, c) = rows[f][column];
+        e->fitted_deg.at(f, j, c) = rows[f][column + 1];
+        e->residual_deg.at(f, j, c) = rows[f][column + 2];
+      }
+    }
+  }
+}
+
+// The segments of the arm the experiment was fitted with, from the fitted
+// run's stored configuration.
+void ReadSegments(const std::string& run_file, FitExperiment* e) {
+  const std::size_t joints = e->measured_deg.shape[1];
+  std::string config_yaml;
+  if (e->run_file.empty()) {
+    e->problems.push_back("Experiment " + e->name +
+                          ": fit.json names no fitted run file (the fitted run failed), so the "
+                          "arm's segments are unknown: its joints are shown in one panel.");
+  } else {
+    try {
+      config_yaml = datasets::ReadRunFile(run_file).config_yaml;
+    } catch (const std::exception& error) {
+      e->problems.push_back("Experiment " + e->name + ": the fitted run file cannot be read (" +
+                            error.what() + "): its joints are shown in one panel.");
+    }
+  }
+  if (config_yaml.empty()) {
+    e->segments = {{"All joints (1–" + std::to_string(joints) + ")", 1, static_cast<int>(joints)}};
+    return;
+  }
+  ArmFacts facts =
+      ReadArmFacts(config_yaml, run_file + ": attribute 'config_yaml'", joints, 0, nullptr);
+  e->segments = std::move(facts.segments);
+  for (std::string& problem : facts.problems) {
+    e->problems.push_back("Experiment " + e->name + ": " + problem);
+  }
+}
+
+FitExperiment ReadExperiment(const FitJson& in, const json& entry, std::size_t index,
+                             const fs::path& folder) {
+  const std::string at = "experiments[" + std::to_string(index) + "]";
+  FitExperiment e;
+  e.name = in.Text(entry, at, "name");
+  e.path = in.Text(entry, at, "path");
+  e.angles_from_pipeline = in.Flag(entry, at, "angles_from_pipeline");
+  e.noise_deg = in.Numbers(entry, at, "noise_deg");
+  e.noise_source = in.Text(entry, at, "noise_source");
+  e.start = ReadErrors(in, in.At(entry, at, "start"), at + ".start");
+  e.fitted = ReadErrors(in, in.At(entry, at, "fitted"), at + ".fitted");
+  const json& run = in.At(entry, at, "run");
+  e.run_status = in.Text(run, at + ".run", "status");
+  e.run_message = in.Text(run, at + ".run", "message");
+  const json& run_file = in.At(entry, at, "run_file");
+  if (!run_file.is_null() && !run_file.is_string()) {
+    in.Fail(at + ".run_file", "expected a file name or null");
+  }
+  if (run_file.is_string()) e.run_file = run_file.get<std::string>();
+  e.angles_file = in.Text(entry, at, "angles_file");
+  // Both files sit in the fit folder: a name with a folder in it is not one
+  // identify writes.
+  for (const std::string* name : {&e.angles_file, &e.run_file}) {
+    if (name->find('/') != std::string::npos || *name == ".." || *name == ".") {
+      in.Fail(at + (name == &e.angles_file ? ".angles_file" : ".run_file"),
+              "expected a file name in the fit folder, not '" + *name + "'");
+    }
+  }
+  ReadAnglesFile((folder / e.angles_file).string(), &e);
+  const std::size_t joints = e.measured_deg.shape[1];
+  if (e.noise_deg.size() != joints || e.fitted.per_joint.size() != joints ||
+      e.start.per_joint.size() != joints) {
+    in.Fail(at, "noise_deg, start and fitted must have one entry per joint of " + e.angles_file +
+                    " (" + std::to_string(joints) + ")");
+  }
+  ReadSegments((folder / e.run_file).string(), &e);
+  return e;
+}
+
+}  // namespace
+
+bool LooksLikeFitFolder(const std::string& folder) {
+  std::error_code ec;
+  return fs::is_directory(folder, ec) && fs::is_regular_file(fs::path(folder) / "fit.json", ec);
+}
+
+FitFolder ReadFitFolder(const std::string& folder) {
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) ThrowInputError(folder, "", "not a folder");
+  const fs::path path = fs::path(folder) / "fit.json";
+  if (!fs::is_regular_file(path, ec)) ThrowInputError(folder, "", "not a fit folder (no fit.json)");
+  const std::string file = path.string();
+  std::ifstream stream(path);
+  const json root = json::parse(stream, nullptr, /*allow_exceptions=*/false);
+  if (root.is_discarded()) ThrowInputError(file, "", "not valid JSON");
+  if (!root.is_object() || !root.contains("schema")) {
+    ThrowInputError(file, "", std::string("no 'schema' key; expected schema ") + kFitSchema);
+  }
+  if (root["schema"] != kFitSchema) {
+    ThrowInputError(file, "key 'schema'",
+                    "is " + root["schema"].dump() + ", expected \"" + kFitSchema +
+                        "\" (written by ccsrm identify)");
+  }
+  const FitJson in(file);
+  FitFolder fit;
+  fit.folder = folder;
+  fit.converged = in.Flag(root, "", "converged");
+  fit.termination = in.Text(root, "", "termination");
+  fit.message = in.Text(root, "", "message");
+  fit.iterations = in.NumberAt(root, "", "iterations");
+  fit.simulations = in.NumberAt(root, "", "simulations");
+  fit.threads = in.NumberAt(root, "", "threads");
+  fit.wall_time_s = in.NumberAt(root, "", "wall_time_s");
+  const json& free = in.List(root, "", "free");
+  for (std::size_t i = 0; i < free.size(); ++i) {
+    if (!free[i].is_string()) in.Fail("free[" + std::to_string(i) + "]", "expected a name");
+    fit.free.push_back(free[i].get<std::string>());
+  }
+  const json& parameters = in.At(root, "", "parameters");
+  if (!parameters.is_object()) in.Fail("parameters", "expected an object");
+  for (const std::string& name : fit.free) {
+    const FitParameter p = ReadParameter(in, in.At(parameters, "parameters", name), name);
+    if (!p.free) in.Fail("parameters." + name + ".free", "is false, but 'free' lists " + name);
+    fit.parameters.push_back(p);
+  }
+  for (const auto& [name, entry] : parameters.items()) {
+    const FitParameter p = ReadParameter(in, entry, name);
+    if (p.free) {
+      bool listed = false;
+      for (const std::string& f : fit.free) listed = listed || f == name;
+      if (!listed) in.Fail("parameters." + name + ".free", "is true, but 'free' does not list it");
+      continue;
+    }
+    fit.parameters.push_back(p);
+  }
+  const json& correlation = in.List(root, "", "correlation");
+  if (correlation.size() != fit.free.size()) {
+    in.Fail("correlation",
+            "expected " + std::to_string(fit.free.size()) + " rows (one per free parameter)");
+  }
+  for (std::size_t i = 0; i < correlation.size(); ++i) {
+    const std::string at = "correlation[" + std::to_string(i) + "]";
+    if (!correlation[i].is_array() || correlation[i].size() != fit.free.size()) {
+      in.Fail(at, "expected " + std::to_string(fit.free.size()) + " numbers or nulls");
+    }
+    std::vector<double> row;
+    for (std::size_t j = 0; j < correlation[i].size(); ++j) {
+      row.push_back(in.Number(correlation[i][j], at + "[" + std::to_string(j) + "]", true));
+    }
+    fit.correlation.push_back(std::move(row));
+  }
+  fit.singular_values = in.Numbers(root, "", "singular_values");
+  const json& directions = in.List(root, "", "unidentifiable");
+  for (std::size_t i = 0; i < directions.size(); ++i) {
+    const std::string at = "unidentifiable[" + std::to_string(i) + "]";
+    FitDirection d;
+    d.combination = in.Text(directions[i], at, "combination");
+    d.singular_value = in.NumberAt(directions[i], at, "singular_value");
+    d.relative_std_error = in.NumberAt(directions[i], at, "relative_std_error", true);
+    const json& components = in.At(directions[i], at, "components");
+    if (!components.is_object()) in.Fail(at + ".components", "expected an object");
+    for (const auto& [name, c] : components.items()) {
+      d.components.push_back({name, in.Number(c, at + ".components." + name)});
+    }
+    fit.unidentifiable.push_back(std::move(d));
+  }
+  fit.rms_deg = in.NumberAt(root, "", "rms_deg", true);
+  fit.rms_deg_start = in.NumberAt(root, "", "rms_deg_start", true);
+  fit.fit_percent = in.NumberAt(root, "", "fit_percent", true);
+  fit.errors = ReadErrors(in, in.At(root, "", "errors"), "errors");
+  fit.start_errors = ReadErrors(in, in.At(root, "", "start_errors"), "start_errors");
+  if (fit.errors.per_joint.size() != fit.start_errors.per_joint.size()) {
+    in.Fail("start_errors.per_joint", "has not as many joints as errors.per_joint");
+  }
+  fit.cost_history = in.Numbers(root, "", "cost_history");
+  fit.residuals = in.NumberAt(root, "", "residuals");
+  fit.effective_samples = in.NumberAt(root, "", "effective_samples", true);
+  fit.residual_variance = in.NumberAt(root, "", "residual_variance", true);
+  const json& experiments = in.List(root, "", "experiments");
+  if (experiments.empty()) in.Fail("experiments", "is empty");
+  for (std::size_t e = 0; e < experiments.size(); ++e) {
+    fit.experiments.push_back(ReadExperiment(in, experiments[e], e, fs::path(folder)));
+  }
+  return fit;
+}
+
+}  // namespace ccsrm::reports::internal

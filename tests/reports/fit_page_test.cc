@@ -1,0 +1,398 @@
+// The fit page built from a small fit folder whose every number is known
+// (fit.json, the angles file and a fitted run file written here, in the
+// layout of identify/src/fit_output.cc), so the tables can be checked value
+// by value; and the one-line errors for folders that are not fit folders.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/common/error.h"
+#include "ccsrm/datasets/run_file.h"
+#include "ccsrm/reports/report.h"
+#include "report_test_util.h"
+#include "run_ccsrm.h"
+
+namespace ccsrm::reports {
+namespace {
+namespace fs = std::filesystem;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+constexpr std::size_t kJoints = 12;  // the paper arm: two segments of 6
+constexpr std::size_t kFrames = 5;
+
+// The measured θx of joint j (0-based) in frame i, deg; fitted adds
+// 0.01 (j + 1); θy is measured only in even frames.
+double MeasuredX(std::size_t i, std::size_t j) { return 0.5 * i + 0.1 * j; }
+double FittedX(std::size_t i, std::size_t j) { return MeasuredX(i, j) + 0.01 * (j + 1); }
+
+json Errors(double scale) {
+  json joints = json::array();
+  for (std::size_t j = 0; j < kJoints; ++j) {
+    joints.push_back({{"joint", j + 1},
+                      {"rms_deg", {scale * 0.01 * (j + 1), scale * 0.002 * (j + 1)}},
+                      {"fit_percent", {100.0 - scale * (j + 1), -scale * 0.5 * (j + 1)}},
+                      {"samples", {kFrames, 3}}});
+  }
+  return {{"rms_deg", scale * 0.031164149880225006},
+          {"fit_percent", 100.0 - scale * 1.78716750501047},
+          {"per_joint", joints},
+          {"axes", {"theta_x", "theta_y"}}};
+}
+
+// fit.json of a fit of T_p (identifiable) and c_lc (not), with mu fixed.
+json KnownFitJson() {
+  json parameters = {{"T_p",
+                      {{"value", 65.2939046830209},
+                       {"units", "N"},
+                       {"free", true},
+                       {"start", 50.0},
+                       {"std_error", 0.37239821776687093},
+                       {"ci95", {64.56039846616547, 66.02741089987633}},
+                       {"identifiable", true},
+                       {"bounds", {1.0, 500.0}},
+                       {"scale", 50.0},
+                       {"at_bound", false}}},
+                     {"c_lc",
+                      {{"value", 0.6125325149326545},
+                       {"units", "N m s/rad"},
+                       {"free", true},
+                       {"start", 0.05},
+                       {"std_error", nullptr},
+                       {"ci95", nullptr},
+                       {"identifiable", false},
+                       {"bounds", {0.0, 10.0}},
+                       {"scale", 0.05},
+                       {"at_bound", false}}},
+                     {"mu", {{"value", 0.0}, {"units", "1"}, {"free", false}, {"start", 0.0}}}};
+  json experiment = {{"name", "g4"},
+                     {"path", "data/g4.h5"},
+                     {"angles_from_pipeline", true},
+                     {"noise_deg", json::array()},
+                     {"noise_source", "joint twist scatter"},
+                     {"start", Errors(2.0)},
+                     {"fitted", Errors(1.0)},
+                     {"run",
+                      {{"status", "completed"},
+                       {"message", "completed"},
+                       {"wall_time_s", 2.0},
+                       {"real_time_factor", 2.75}}},
+                     {"run_file", "g4.fit.h5"},
+                     {"angles_file", "g4.angles.csv"}};
+  for (std::size_t j = 0; j < kJoints; ++j) experiment["noise_deg"].push_back(0.03 + 0.001 * j);
+  return {{"schema", "ccsrm-fit/1"},
+          {"converged", true},
+          {"termination", "converged"},
+          {"message", "the last step moved every parameter by less than 0.1 of its std error"},
+          {"iterations", 11},
+          {"simulations", 33},
+          {"threads", 2},
+          {"wall_time_s", 64.540907955},
+          {"relative_step", 0.01},
+          {"free", {"T_p", "c_lc"}},
+          {"parameters", parameters},
+          {"rms_deg", 0.031164149880225006},
+          {"fit_percent", 98.21283249498953},
+          {"rms_deg_start", 0.08273468465977663},
+          {"errors", Errors(1.0)},
+          {"start_errors", Errors(2.0)},
+          {"cost_history", {48948.15073811071, 6245.828414384231, 6203.168114212665}},
+          {"initial_cost", 48948.15073811071},
+          {"final_cost", 6203.168114212665},
+          {"residuals", 13172},
+          {"effective_samples", 247.2889211724696},
+          {"residual_variance", 0.9420148996526447},
+          {"covariance_available", true},
+          {"covariance_message", ""},
+          {"correlation", {{1.0, nullptr}, {nullptr, nullptr}}},
+          {"singular_values", {955.7614774152829, 0.5142213050620882}},
+          {"unidentifiable",
+           {{{"combination", "1.00 c_lc"},
+             {"components", {{"c_lc", 0.9999999985701546}}},
+             {"singular_value", 0.5142213050620882},
+             {"relative_std_error", 13.775340761434506}}}},
+          {"experiments", {experiment}}};
+}
+
+std::string KnownAnglesCsv() {
+  std::string csv = "# g4: measured and fitted joint angles [deg]\ntime_s";
+  for (std::size_t j = 1; j <= kJoints; ++j) {
+    for (const char* axis : {"x", "y"}) {
+      for (const char* kind : {"measured", "fitted", "residual"}) {
+        csv += std::string(",") + kind + "_theta" + axis + std::to_string(j) + "_deg";
+      }
+    }
+  }
+  csv += "\n";
+  char cell[64];
+  for (std::size_t i = 0; i < kFrames; ++i) {
+    std::snprintf(cell, sizeof(cell), "%.6f", 0.01 * i);
+    csv += cell;
+    for (std::size_t j = 0; j < kJoints; ++j) {
+      const double m = MeasuredX(i, j), f = FittedX(i, j);
+      std::snprintf(cell, sizeof(cell), ",%.6f,%.6f,%.6f", m, f, f - m);
+      csv += cell;
+      if (i % 2 == 0) {
+        std::snprintf(cell, sizeof(cell), ",%.6f,%.6f,%.6f", 0.01, 0.0, -0.01);
+        csv += cell;
+      } else {
+        csv += ",,0.000000,";  // θy not measured in this frame
+      }
+    }
+    csv += "\n";
+  }
+  return csv;
+}
+
+// The fitted run: only its configuration (the paper arm's two segments)
+// matters to the page.
+datasets::RunFile FittedRun() {
+  const std::size_t t = 2, j = kJoints, c = 6;
+  datasets::RunFile run;
+  run.case_name = "custom";
+  run.config_yaml = ReadTextFile(std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml");
+  run.time = datasets::Array({t});
+  run.time.at(1) = 0.01;
+  run.joint_angles = datasets::Array({t, j, 2});
+  run.joint_rates = datasets::Array({t, j, 2});
+  run.link_pose = datasets::Array({t, j, 7});
+  run.input_tension = datasets::Array({t, c});
+  run.input_length_change = datasets::Array({t, c});
+  run.stuck_nodes = datasets::Array({t, c});
+  run.constraint_violation = datasets::Array({t});
+  run.energy = datasets::Array({t, 3});
+  for (std::size_t k = 0; k < c; ++k) {
+    run.cables.push_back(
+        {datasets::Array({t, 14}, 100.0), datasets::Array({t, 13}), datasets::Array({t, 13})});
+  }
+  return run;
+}
+
+fs::path WriteFitFolder(const std::string& name, const json& fit) {
+  const fs::path dir = ccsrm::testing::ScratchDirectory("fit_page_" + name) / "fit";
+  fs::create_directories(dir);
+  WriteTextFileAtomically((dir / "fit.json").string(), fit.dump(2));
+  WriteTextFileAtomically((dir / "g4.angles.csv").string(), KnownAnglesCsv());
+  datasets::WriteRunFile((dir / "g4.fit.h5").string(), FittedRun());
+  return dir;
+}
+
+json RowOf(const json& summary, const std::string& table, const std::string& key,
+           const json& first) {
+  for (const json& row : summary["tables"][table]["rows"]) {
+    if (row[key] == first) return row;
+  }
+  ADD_FAILURE() << "table " << table << " has no row " << first;
+  return json();
+}
+
+TEST(FitPage, KnownFitShowsItsNumbers) {
+  const fs::path dir = WriteFitFolder("known", KnownFitJson());
+  const Document document = BuildFitDocument(dir.string(), ReportOptions());
+  const json summary = ToJson(document);
+  EXPECT_EQ(summary["kind"], "fit");
+  EXPECT_TRUE(summary["notices"].empty()) << summary["notices"];
+
+  const json tp = RowOf(summary, "parameters", "parameter", "T_p");
+  EXPECT_EQ(tp["unit"], "N");
+  EXPECT_EQ(tp["start"], 50.0);
+  EXPECT_EQ(tp["estimate"], 65.29);
+  EXPECT_EQ(tp["std_error"], 0.372);
+  EXPECT_EQ(tp["ci95_lower"], 64.56);
+  EXPECT_EQ(tp["ci95_upper"], 66.03);
+  EXPECT_EQ(tp["upper_bound"], 500.0);
+  EXPECT_EQ(tp["status"], "identifiable");
+  const json clc = RowOf(summary, "parameters", "parameter", "c_lc");
+  EXPECT_EQ(clc["estimate"], 0.6125);
+  EXPECT_EQ(clc["std_error"], "not identifiable");
+  EXPECT_TRUE(clc["ci95_lower"].is_null());
+  EXPECT_EQ(clc["status"], "not identifiable");
+  EXPECT_EQ(RowOf(summary, "fixed_parameters", "parameter", "mu")["value"], 0.0);
+
+  const json r = RowOf(summary, "correlation", "parameter", "T_p");
+  EXPECT_EQ(r["t_p"], 1.0);
+  EXPECT_TRUE(r["c_lc"].is_null());
+  const json sv = RowOf(summary, "singular_values", "k", 2);
+  EXPECT_EQ(sv["singular_value"], 0.5142);
+  EXPECT_EQ(sv["direction"], "1.00 c_lc");
+  EXPECT_EQ(sv["relative_std_error"], 13.8);
+  EXPECT_TRUE(RowOf(summary, "singular_values", "k", 1)["direction"].is_null());
+
+  const json joint3 = RowOf(summary, "errors_per_joint", "joint", 3);
+  EXPECT_EQ(joint3["rms_x_start_deg"], 0.06);
+  EXPECT_EQ(joint3["rms_x_fitted_deg"], 0.03);
+  EXPECT_EQ(joint3["rms_y_fitted_deg"], 0.006);
+  EXPECT_EQ(joint3["fit_x_fitted_percent"], 97.0);
+  EXPECT_EQ(joint3["fit_y_start_percent"], -3.0);
+  EXPECT_EQ(joint3["samples_x"], 5);
+
+  auto fit = [&](const std::string& quantity) {
+    return RowOf(summary, "fit", "quantity", quantity)["value"];
+  };
+  EXPECT_EQ(fit("iterations"), 11);
+  EXPECT_EQ(fit("RMS error at start"), 0.0827);
+  EXPECT_EQ(fit("RMS error fitted"), 0.0312);
+  EXPECT_EQ(fit("fit percent fitted"), 98.2);
+  EXPECT_EQ(fit("residual variance"), 0.942);
+  EXPECT_EQ(fit("cost fitted"), 6203.17);
+  EXPECT_EQ(RowOf(summary, "cost_history", "step", 1)["cost"], 6245.83);
+
+  const json g4 = RowOf(summary, "experiments", "experiment", "g4");
+  EXPECT_EQ(g4["angles"], "from the mocap pipeline");
+  EXPECT_EQ(g4["noise_source"], "joint twist scatter");
+  EXPECT_EQ(g4["rms_fitted_deg"], 0.0312);
+  EXPECT_EQ(RowOf(summary, "noise", "joint", 12)["noise_deg_g4"], 0.041);
+
+  // The text a lab reader reads first says what happened, in the tables' numbers.
+  const Paragraph& headline = std::get<Paragraph>(document.sections[0].blocks[0]);
+  EXPECT_THAT(headline.text, HasSubstr("converged after 11 iterations"));
+  EXPECT_THAT(headline.text, HasSubstr("from 0.0827 deg at the start values to 0.0312 deg"));
+  const Paragraph& estimates = std::get<Paragraph>(document.sections[0].blocks[1]);
+  EXPECT_THAT(estimates.text, HasSubstr("T_p = 65.29 N (standard error 0.372 N, 95 % interval "
+                                        "64.56 to 66.03 N"));
+  EXPECT_THAT(estimates.text, HasSubstr("c_lc could not be determined"));
+  EXPECT_THAT(estimates.text, HasSubstr("1.00 c_lc"));
+
+  // Two segments, from the fitted run's configuration: two panels per
+  // angle figure; measured (dashed) and fitted (solid) of joint 7 are the
+  // angles file's.
+  const std::vector<const FigureBlock*> figures = document.figures();
+  ASSERT_FALSE(figures.empty());
+  const Figure& theta_x = figures[0]->figure;
+  EXPECT_EQ(theta_x.name, "angles_x_g4");
+  ASSERT_EQ(theta_x.panels.size(), 2u);
+  const Series& measured7 = theta_x.panels[1].series[0];
+  const Series& fitted7 = theta_x.panels[1].series[6];
+  EXPECT_EQ(fitted7.label, "joint 7");
+  EXPECT_EQ(measured7.style, SeriesStyle::kDashed);
+  EXPECT_EQ(measured7.color, fitted7.color);
+  EXPECT_DOUBLE_EQ(measured7.y[3], MeasuredX(3, 6));
+  EXPECT_DOUBLE_EQ(fitted7.y[3], FittedX(3, 6));
+  const Figure& theta_y = figures[1]->figure;
+  EXPECT_TRUE(std::isnan(theta_y.panels[0].series[0].y[1]));  // not measured
+}
+
+TEST(FitPage, ReportAgreesWithItsJsonAndReferencesItsFiles) {
+  if (!testing::ProgramOnPath("gnuplot")) GTEST_SKIP() << "gnuplot not installed";
+  const fs::path dir = WriteFitFolder("written", KnownFitJson());
+  const fs::path out = dir.parent_path() / "report";
+  const ReportSummary summary = MakeReport(dir.string(), out.string(), ReportOptions());
+  EXPECT_EQ(summary.kind, "fit");
+  const std::string html = ReadTextFile((out / "index.html").string());
+  const json report = json::parse(ReadTextFile((out / "summary.json").string()));
+  EXPECT_GT(testing::ExpectTablesMatchJson(html, report), 150);
+  int files = 0;
+  for (const std::string& ref : testing::HtmlReferences(html)) {
+    if (ref.rfind("#", 0) == 0) continue;
+    EXPECT_TRUE(fs::is_regular_file(out / ref)) << ref;
+    ++files;
+  }
+  EXPECT_EQ(files, 1 + summary.figures);  // summary.json and every figure
+  // The heat map's cells: the correlation of T_p with itself, and a grey
+  // cell for the unidentifiable c_lc.
+  const std::string dat = ReadTextFile((out / "figures" / "correlation.dat").string());
+  EXPECT_THAT(dat, HasSubstr("1 2 1 1\n"));
+  EXPECT_THAT(dat, HasSubstr("2 1 0 0\n"));
+}
+
+TEST(FitPage, AFitWithoutItsRunFileShowsAllJointsInOnePanelAndSaysWhy) {
+  json fit = KnownFitJson();
+  fit["experiments"][0]["run_file"] = nullptr;
+  fit["experiments"][0]["run"]["status"] = "failed";
+  fit["experiments"][0]["run"]["message"] = "diverged at t = 1 s";
+  fit["converged"] = false;
+  fit["termination"] = "no_convergence";
+  const fs::path dir = WriteFitFolder("norun", fit);
+  const Document document = BuildFitDocument(dir.string(), ReportOptions());
+  const std::vector<std::string> notices = document.notices();
+  ASSERT_EQ(notices.size(), 3u);
+  EXPECT_THAT(notices[0], HasSubstr("did not converge"));
+  EXPECT_THAT(notices[1], HasSubstr("diverged at t = 1 s"));
+  EXPECT_THAT(notices[2], HasSubstr("one panel"));
+  EXPECT_EQ(document.figures()[0]->figure.panels.size(), 1u);
+}
+
+TEST(FitPage, SeveralExperimentsGetASectionAndANoiseColumnEach) {
+  json fit = KnownFitJson();
+  json second = fit["experiments"][0];
+  second["name"] = "g5 slow";  // not a file stem: its figures get one
+  second["angles_from_pipeline"] = false;
+  second["noise_source"] = "given";
+  for (json& noise : second["noise_deg"]) noise = 0.05;
+  fit["experiments"].push_back(second);
+  const Document document = BuildFitDocument(WriteFitFolder("two", fit).string(), ReportOptions());
+  const json summary = ToJson(document);
+  EXPECT_EQ(summary["sections"][1]["id"], "angles-g4_1");
+  EXPECT_EQ(summary["sections"][2]["id"], "angles-g5_slow_2");
+  std::vector<std::string> names;
+  for (const FigureBlock* figure : document.figures()) names.push_back(figure->figure.name);
+  EXPECT_THAT(names, ::testing::IsSupersetOf({"angles_x_g4_1", "residuals_g4_1",
+                                              "angles_y_g5_slow_2", "residuals_g5_slow_2"}));
+  EXPECT_EQ(RowOf(summary, "experiments", "experiment", "g5 slow")["angles"],
+            "stored in the experiment");
+  const json joint1 = RowOf(summary, "noise", "joint", 1);
+  EXPECT_EQ(joint1["noise_deg_g4"], 0.03);
+  EXPECT_EQ(joint1["noise_deg_g5_slow"], 0.05);
+}
+
+std::string ErrorOf(const fs::path& dir) {
+  try {
+    BuildFitDocument(dir.string(), ReportOptions());
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(FitPage, BadFitFoldersAreNamedInOneLine) {
+  const fs::path empty = ccsrm::testing::ScratchDirectory("fit_page_empty");
+  EXPECT_EQ(ErrorOf(empty), empty.string() + ": not a fit folder (no fit.json)");
+
+  json wrong = KnownFitJson();
+  wrong["schema"] = "ccsrm-loop/1";
+  EXPECT_THAT(ErrorOf(WriteFitFolder("schema", wrong)),
+              HasSubstr("fit.json: key 'schema': is \"ccsrm-loop/1\", expected \"ccsrm-fit/1\""));
+  json missing = KnownFitJson();
+  missing["parameters"]["T_p"].erase("ci95");
+  EXPECT_THAT(ErrorOf(WriteFitFolder("missing", missing)),
+              HasSubstr("fit.json: key 'parameters.T_p.ci95': missing"));
+  json type = KnownFitJson();
+  type["errors"]["per_joint"][2]["rms_deg"][1] = "small";
+  EXPECT_THAT(ErrorOf(WriteFitFolder("type", type)),
+              HasSubstr("key 'errors.per_joint[2].rms_deg[1]': expected a number or null"));
+  json outside = KnownFitJson();
+  outside["experiments"][0]["angles_file"] = "../g4.angles.csv";
+  EXPECT_THAT(ErrorOf(WriteFitFolder("outside", outside)),
+              HasSubstr("expected a file name in the fit folder"));
+
+  const fs::path not_json = WriteFitFolder("notjson", KnownFitJson());
+  WriteTextFileAtomically((not_json / "fit.json").string(), "{\"schema\": ");
+  EXPECT_EQ(ErrorOf(not_json), (not_json / "fit.json").string() + ": not valid JSON");
+
+  const fs::path header = WriteFitFolder("header", KnownFitJson());
+  std::string csv = KnownAnglesCsv();
+  csv.replace(csv.find("fitted_thetay2"), 14, "fitted_thetaz2");
+  WriteTextFileAtomically((header / "g4.angles.csv").string(), csv);
+  EXPECT_THAT(ErrorOf(header),
+              HasSubstr("g4.angles.csv: line 2: column 12 is 'fitted_thetaz2_deg', "
+                        "expected 'fitted_thetay2_deg'"));
+
+  const fs::path cell = WriteFitFolder("cell", KnownFitJson());
+  csv = KnownAnglesCsv();
+  csv.replace(csv.rfind("\n", csv.size() - 2) + 1, 8, "0.04000x");
+  WriteTextFileAtomically((cell / "g4.angles.csv").string(), csv);
+  EXPECT_THAT(ErrorOf(cell), HasSubstr("g4.angles.csv: line 7: column 1 ('time_s'): '0.04000x' "
+                                       "is not a number"));
+
+  const fs::path gone = WriteFitFolder("gone", KnownFitJson());
+  fs::remove(gone / "g4.angles.csv");
+  EXPECT_THAT(ErrorOf(gone), HasSubstr("g4.angles.csv: cannot be read"));
+}
+
+}  // namespace
+}  // namespace ccsrm::reports
