@@ -7,9 +7,11 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/sim/config.h"
+#include "ccsrm/sim/effects.h"
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/protocol.h"
 #include "ccsrm/sim/simulator.h"
@@ -79,10 +81,13 @@ inline datasets::ExperimentFile Record(const sim::ArmParameters& truth, double n
   file.measured_joint_angles = datasets::Array({frames, joints, 2});
   file.measured_joint_twist = datasets::Array({frames, joints});
   for (std::size_t f = 0; f < frames; ++f) {
+    // What motion capture records: measurement effects (mocap_offset) included.
+    const std::vector<Eigen::Vector2d> recorded =
+        sim::RecordedJointAngles(truth, run.trajectory.frames[f]);
     for (std::size_t j = 0; j < joints; ++j) {
       for (int a = 0; a < 2; ++a) {
         file.measured_joint_angles->values[(f * joints + j) * 2 + static_cast<std::size_t>(a)] =
-            run.trajectory.frames[f].joint_angles[j][a] + noise(rng);
+            recorded[j][a] + noise(rng);
       }
       file.measured_joint_twist->at(f, j) = noise(rng);
     }

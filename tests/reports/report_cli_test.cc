@@ -71,7 +71,8 @@ std::string MadeFit() {
     const Outcome identify =
         RunCcsrm("identify --data " + Made().experiment +
                  " --free T_p --set T_p=60 --max-iterations 3 --threads 2 --quiet --out " + out);
-    EXPECT_EQ(identify.status, 0) << identify.err;
+    // Converged (0) or not within the 3 iterations (4): a folder either way.
+    EXPECT_TRUE(identify.status == 0 || identify.status == 4) << identify.err;
     return out;
   }();
   return fit;
