@@ -221,6 +221,30 @@ class FitProblem {
     return std::sqrt(sum / static_cast<double>(std::max<std::size_t>(index_.size(), 1)));
   }
 
+  // N_eff of weighted residuals laid out as index(): every (experiment,
+  // joint, axis) series over its measured frames.
+  double EffectiveSamples(const Eigen::VectorXd& residuals) const {
+    std::vector<std::vector<double>> series;
+    std::size_t k = 0;
+    for (std::size_t e = 0; e < experiments_.size(); ++e) {
+      std::vector<std::vector<double>> per_column(
+          static_cast<std::size_t>(2 * experiments_[e].joints));
+      for (; k < index_.size() && index_[k].experiment == e; ++k) {
+        per_column[index_[k].column].push_back(residuals[static_cast<Eigen::Index>(k)]);
+      }
+      for (auto& c : per_column) series.push_back(std::move(c));
+    }
+    return internal::EffectiveSampleSize(series);
+  }
+
+  std::optional<Eigen::VectorXd> CachedResiduals(const double* u) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (const Evaluation& e : cache_) {
+      if (e.ok && std::equal(e.u.begin(), e.u.end(), u)) return e.residuals;
+    }
+    return std::nullopt;
+  }
+
   std::optional<double> CachedRmsDeg(const double* u) {
     const std::lock_guard<std::mutex> lock(mutex_);
     for (const Evaluation& e : cache_) {
@@ -300,6 +324,14 @@ class SimulatedAnglesCost final : public ceres::CostFunction {
   mutable std::string last_failure_;
 };
 
+std::string StepRuleMessage(double fraction) {
+  char text[160];
+  std::snprintf(text, sizeof(text),
+                "the last step moved every parameter by less than %g of its standard error",
+                fraction);
+  return text;
+}
+
 class IterationReporter final : public ceres::IterationCallback {
  public:
   IterationReporter(FitProblem* problem, const double* u, const IdentificationOptions& options,
@@ -310,35 +342,49 @@ class IterationReporter final : public ceres::IterationCallback {
     if (s.step_is_successful || s.iteration == 0) costs_->push_back(s.cost);
     Report(s);
     if (s.iteration == 0) previous_.assign(u_, u_ + problem_->num_free());
-    if (s.iteration == 0 || !s.step_is_successful) return ceres::SOLVER_CONTINUE;
-    const bool small = StepWithinStandardErrors(s.cost);
-    previous_.assign(u_, u_ + problem_->num_free());
-    if (small) {
-      converged_by_step_ = true;
-      return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+    if (s.iteration == 0 || !s.step_is_successful) {
+      if (s.iteration == 0) previous_cost_ = s.cost;
+      return ceres::SOLVER_CONTINUE;
     }
-    return ceres::SOLVER_CONTINUE;
+    const bool small = StepWithinStandardErrors(s.cost);
+    const bool insignificant = DecreaseInsignificant(s.cost);
+    previous_.assign(u_, u_ + problem_->num_free());
+    previous_cost_ = s.cost;
+    if (small) stop_reason_ = StepRuleMessage(options_.converged_step_fraction);
+    if (!small && insignificant) {
+      char text[200];
+      std::snprintf(text, sizeof(text),
+                    "the last step lowered the effective chi-square by less than %g "
+                    "(a difference the data cannot tell apart)",
+                    options_.min_effective_chi2_decrease);
+      stop_reason_ = text;
+    }
+    return small || insignificant ? ceres::SOLVER_TERMINATE_SUCCESSFULLY : ceres::SOLVER_CONTINUE;
   }
 
-  bool converged_by_step() const { return converged_by_step_; }
+  // Why the callback stopped the fit; empty when it did not.
+  const std::string& stop_reason() const { return stop_reason_; }
 
  private:
   // The statistical stopping rule: the last step moved every free parameter
-  // by less than options.converged_step_fraction of its standard error
-  // (from the Jacobian at the new point, residual variance 2 cost / (N - p),
-  // without the autocorrelation factor, which only makes errors larger).
-  // Further steps would move the estimate by amounts the data cannot tell
-  // apart, so the fit stops instead of creeping along a flat valley.
+  // by less than options.converged_step_fraction of its standard error, as
+  // the summary will report it (Jacobian at the new point, residual variance
+  // 2 cost / (N - p), times N / N_eff). Further steps would move the
+  // estimate by amounts the data cannot tell apart, so the fit stops instead
+  // of creeping along a flat valley, a whole Jacobian per step.
   bool StepWithinStandardErrors(double cost) const {
     const std::optional<Eigen::MatrixXd> jacobian = problem_->CachedJacobian(u_);
+    const std::optional<Eigen::VectorXd> residuals = problem_->CachedResiduals(u_);
     const std::size_t p = problem_->num_free();
     const double n = static_cast<double>(problem_->num_residuals());
-    if (!jacobian || n <= static_cast<double>(p)) return false;
+    if (!jacobian || !residuals || n <= static_cast<double>(p)) return false;
+    const double n_eff = problem_->EffectiveSamples(*residuals);
+    const double inflation = n_eff > 0.0 ? n / n_eff : 1.0;
     const Eigen::MatrixXd h = jacobian->transpose() * *jacobian;
     const Eigen::LDLT<Eigen::MatrixXd> ldlt(h);
     if (ldlt.info() != Eigen::Success) return false;
     const Eigen::MatrixXd inverse = ldlt.solve(Eigen::MatrixXd::Identity(h.rows(), h.cols()));
-    const double variance = 2.0 * cost / (n - static_cast<double>(p));
+    const double variance = 2.0 * cost / (n - static_cast<double>(p)) * inflation;
     for (std::size_t i = 0; i < p; ++i) {
       const double se =
           std::sqrt(variance * inverse(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)));
@@ -347,6 +393,20 @@ class IterationReporter final : public ceres::IterationCallback {
       if (std::isfinite(se) && step > options_.converged_step_fraction * se) return false;
     }
     return true;
+  }
+
+  // The second statistical rule: the accepted step lowered the cost by an
+  // amount the data cannot tell apart, 2 (cost before - cost after) N_eff / N
+  // below options.min_effective_chi2_decrease. Where the cost is slightly
+  // rough in a poorly determined parameter, Levenberg-Marquardt otherwise
+  // zigzags along the valley at a constant RMS, a whole Jacobian per step.
+  bool DecreaseInsignificant(double cost) const {
+    if (!(options_.min_effective_chi2_decrease > 0.0)) return false;
+    const std::optional<Eigen::VectorXd> residuals = problem_->CachedResiduals(u_);
+    if (!residuals) return false;
+    const double n = static_cast<double>(problem_->num_residuals());
+    const double n_eff = problem_->EffectiveSamples(*residuals);
+    return 2.0 * (previous_cost_ - cost) * (n_eff / n) < options_.min_effective_chi2_decrease;
   }
 
   void Report(const ceres::IterationSummary& s) {
@@ -375,7 +435,8 @@ class IterationReporter final : public ceres::IterationCallback {
   std::chrono::steady_clock::time_point start_;
   std::vector<double>* costs_;
   std::vector<double> previous_;
-  bool converged_by_step_ = false;
+  double previous_cost_ = 0.0;
+  std::string stop_reason_;
 };
 
 ChannelErrors ErrorsOf(const std::vector<const Experiment*>& experiments,
@@ -513,6 +574,8 @@ bool IdentificationOptions::IsValid(std::string* error) const {
   if (!(max_relative_standard_error > 0.0)) return fail("max_relative_standard_error must be > 0");
   if (!(converged_step_fraction >= 0.0)) return fail("converged_step_fraction must be >= 0");
   if (!(initial_trust_region_radius > 0.0)) return fail("initial_trust_region_radius must be > 0");
+  if (!(min_effective_chi2_decrease >= 0.0))
+    return fail("min_effective_chi2_decrease must be >= 0");
   return true;
 }
 
@@ -637,11 +700,8 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     ceres::Solver::Summary ceres_summary;
     ceres::Solve(solver, &ceres_problem, &ceres_summary);
     summary.termination = FromCeres(ceres_summary.termination_type);
-    summary.message = progress.converged_by_step()
-                          ? "the last step moved every parameter by less than " +
-                                std::to_string(options.converged_step_fraction) +
-                                " of its standard error"
-                          : ceres_summary.message;
+    summary.message =
+        progress.stop_reason().empty() ? ceres_summary.message : progress.stop_reason();
     if (summary.termination == IdentificationTermination::kFailed && !cost.last_failure().empty()) {
       summary.message += " (" + cost.last_failure() + ")";
     }
@@ -666,19 +726,7 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
   Eigen::MatrixXd covariance_u;  // free × free, scaled space, times σ_res²
   std::vector<bool> identifiable(p_count, true);
   if (final_eval.ok) {
-    // Effective samples from the residual series of every experiment, joint and axis.
-    std::vector<std::vector<double>> series;
-    std::size_t k = 0;
-    const std::vector<ResidualIndex>& index = problem.index();
-    for (std::size_t e = 0; e < experiments.size(); ++e) {
-      const int columns = 2 * experiments[e].joints;
-      std::vector<std::vector<double>> per_column(static_cast<std::size_t>(columns));
-      for (; k < index.size() && index[k].experiment == e; ++k) {
-        per_column[index[k].column].push_back(final_eval.residuals[static_cast<Eigen::Index>(k)]);
-      }
-      for (auto& c : per_column) series.push_back(std::move(c));
-    }
-    summary.effective_samples = internal::EffectiveSampleSize(series);
+    summary.effective_samples = problem.EffectiveSamples(final_eval.residuals);
     const double n = static_cast<double>(summary.residuals);
     summary.residual_variance = n > static_cast<double>(p_count)
                                     ? 2.0 * summary.final_cost / (n - static_cast<double>(p_count))

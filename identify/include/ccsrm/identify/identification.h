@@ -36,8 +36,8 @@
 // standard error of σ_res / σ_k (σ_res² the variance factor above). A
 // parameter is identifiable when its standard error in this space, the
 // root of Σ_k v_ik² (σ_res / σ_k)², is below max_relative_standard_error of
-// its estimate (at least a tenth of its scale s); otherwise it gets no standard error and no interval, and the
-// directions that make it so are named as combinations.
+// its estimate (at least a tenth of its scale s); otherwise it gets no standard error and no
+// interval, and the directions that make it so are named as combinations.
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
@@ -111,10 +111,15 @@ struct IdentificationOptions {
   // friction exceeds kinetic) and stall there.
   double initial_trust_region_radius = 1.0;
   // The fit also stops, as converged, once an accepted step moved every free
-  // parameter by less than this fraction of its standard error: further
+  // parameter by less than this fraction of its standard error (as reported,
+  // autocorrelation included): further
   // steps would change the estimate by amounts the data cannot tell apart
   // (and each costs a Jacobian). Default 0.1. 0 turns the rule off.
   double converged_step_fraction = 0.1;
+  // And once an accepted step lowered the effective chi-square,
+  // 2 cost N_eff / N, by less than this: a difference the data cannot tell
+  // apart. Default 1. 0 turns the rule off.
+  double min_effective_chi2_decrease = 1.0;
   // A parameter whose standard error exceeds this fraction of its scale is
   // reported as not identifiable. Default 0.25: its 95 % interval would
   // then span about ±50 % of the value, which says only its order of
@@ -129,7 +134,7 @@ struct IdentificationOptions {
   // free, bounds outside the parameter's own or not increasing, a value out
   // of bounds, relative_step outside (0, 0.1], threads < 1,
   // max_iterations < 0, tolerances <= 0, max_relative_standard_error <= 0,
-  // converged_step_fraction < 0.
+  // converged_step_fraction < 0, min_effective_chi2_decrease < 0.
   bool IsValid(std::string* error) const;
 };
 
