@@ -766,10 +766,19 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
             std::isfinite(relative) && relative <= options.max_relative_standard_error;
       }
       for (Eigen::Index d = 0; d < sv.size(); ++d) {
-        if (direction_error[d] <= options.max_relative_standard_error) continue;
+        // The largest relative error the direction gives any parameter, on
+        // the same footing as the parameters' own test above.
+        double worst = 0.0;
+        for (std::size_t i = 0; i < p_count; ++i) {
+          const double c = std::abs(v(static_cast<Eigen::Index>(i), d));
+          if (c == 0.0) continue;
+          worst = std::max(worst, c * direction_error[d] * free[i].scale /
+                                      std::max(std::abs(p_final[i]), 0.1 * free[i].scale));
+        }
+        if (!(worst > options.max_relative_standard_error)) continue;
         UnidentifiableDirection dir;
         dir.singular_value = sv[d];
-        dir.relative_std_error = direction_error[d];
+        dir.relative_std_error = worst;
         std::vector<std::pair<std::string, double>> parts;
         for (std::size_t i = 0; i < p_count; ++i) {
           const double c = v(static_cast<Eigen::Index>(i), d);

@@ -163,7 +163,9 @@ struct ParameterEstimate {
 // A direction of the scaled parameters that the data do not pin down.
 struct UnidentifiableDirection {
   double singular_value = 0.0;
-  double relative_std_error = 0.0;  // σ_res / σ_k, in units of the scales (inf for σ_k = 0)
+  // The largest standard error the direction gives a parameter, relative to
+  // its estimate as in the parameters' test (inf for σ_k = 0).
+  double relative_std_error = 0.0;
   // The parameters that make up the direction, largest share first, with
   // their component in the (unit) singular vector.
   std::vector<std::pair<std::string, double>> components;
