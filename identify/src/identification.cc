@@ -630,8 +630,9 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     f.scale = f.start != 0.0   ? std::abs(f.start)
               : nominal != 0.0 ? std::abs(nominal)
                                : 0.01 * (f.upper - f.lower);
-    // Every difference plan must fit inside the bounds (see PlanDifference).
-    if (f.upper - f.lower < 2.0 * options.relative_step * f.scale) {
+    // Every difference plan must fit inside the bounds (see PlanDifference):
+    // within h of one bound, a one-sided plan needs 2h towards the other.
+    if (f.upper - f.lower < 4.0 * options.relative_step * f.scale) {
       ThrowInputError("parameter '" + name + "'", "bounds",
                       "too narrow for a finite-difference step of " +
                           std::to_string(options.relative_step * f.scale));
