@@ -120,19 +120,19 @@ Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::s
     e.pipeline_report = processed->result.summary.BriefReport();
   }
   const datasets::Array& measured = *file.measured_joint_angles;
-  if (measured.rank() != 3 || measured.shape[1] != static_cast<std::size_t>(e.joints) ||
-      measured.shape[2] != 2) {
-    ThrowInputError(
-        path, "/measured/joint_angles",
-        "must be F x " + std::to_string(e.joints) + " x 2 (the joints of its config_yaml)");
+  if (measured.rank() != 3 || measured.shape[0] != file.mocap_time.rows() ||
+      measured.shape[1] != static_cast<std::size_t>(e.joints) || measured.shape[2] != 2) {
+    ThrowInputError(path, "/measured/joint_angles",
+                    "must be F x " + std::to_string(e.joints) +
+                        " x 2 (F the frames of /mocap/time, the joints of its config_yaml)");
   }
   std::size_t first = 0;
   while (first < file.mocap_time.rows() && file.mocap_time.at(first) < e.start_time_s) ++first;
   const std::size_t frames = file.mocap_time.rows() - first;
-  if (frames == 0) {
+  if (frames < 2) {
     ThrowInputError(path, "/mocap/time",
-                    "has no frame at or after the first input sample (t = " +
-                        std::to_string(e.start_time_s) + " s)");
+                    "has fewer than 2 frames at or after the first input sample (t = " +
+                        std::to_string(e.start_time_s) + " s): nothing to simulate");
   }
   e.measured_rad.resize(static_cast<Eigen::Index>(frames), 2 * e.joints);
   for (std::size_t f = 0; f < frames; ++f) {
