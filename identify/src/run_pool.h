@@ -1,5 +1,6 @@
 #pragma once
 // Many runs of one model with different parameters, on a pool of threads.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,14 @@
 #include "ccsrm/sim/simulator.h"
 
 namespace ccsrm::identify::internal {
+
+// Calls task(k) for every k in [0, count) on `threads` threads (the calling
+// thread is one of them), then finished(k, n) under a lock, n counting the
+// tasks done so far. After the first exception no new task starts; it is
+// rethrown once every thread has stopped. Each task must write only its own
+// slot, so results do not depend on the number of threads.
+void ForEachInParallel(std::size_t count, int threads, const std::function<void(std::size_t)>& task,
+                       const std::function<void(std::size_t, std::size_t)>& finished);
 
 struct RunRequest {
   sim::ArmParameters parameters;

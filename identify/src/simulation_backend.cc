@@ -1,14 +1,11 @@
 #include "ccsrm/identify/simulation_backend.h"
 
 #include <algorithm>
-#include <atomic>
-#include <exception>
 #include <limits>
-#include <mutex>
-#include <thread>
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/sim/effects.h"
+#include "run_pool.h"
 
 namespace ccsrm::identify {
 namespace {
@@ -53,33 +50,14 @@ class ThreadBackend final : public SimulationBackend {
                                   const RunFinishedCallback& on_finished) override {
     for (const RunRequest& r : requests) CCSRM_CHECK(r.experiment < experiments_->size());
     std::vector<RunResult> results(requests.size());
-    std::atomic<std::size_t> next{0};
-    std::atomic<bool> failed{false};
-    std::mutex mutex;  // guards first_error, finished and the callback
-    std::exception_ptr first_error;
-    std::size_t finished = 0;
-    const auto work = [&] {
-      for (std::size_t k = next++; k < requests.size() && !failed; k = next++) {
-        try {
+    internal::ForEachInParallel(
+        requests.size(), threads_,
+        [&](std::size_t k) {
           results[k] = RunOne((*experiments_)[requests[k].experiment], requests[k]);
-        } catch (...) {
-          const std::lock_guard<std::mutex> lock(mutex);
-          if (!first_error) first_error = std::current_exception();
-          failed = true;
-          return;
-        }
-        const std::lock_guard<std::mutex> lock(mutex);
-        ++finished;
-        if (on_finished) on_finished(finished, requests.size(), results[k]);
-      }
-    };
-    const std::size_t count =
-        std::min<std::size_t>(static_cast<std::size_t>(threads_), requests.size());
-    std::vector<std::thread> pool;
-    for (std::size_t t = 1; t < count; ++t) pool.emplace_back(work);
-    work();  // the calling thread is one of the workers
-    for (std::thread& t : pool) t.join();
-    if (first_error) std::rethrow_exception(first_error);
+        },
+        [&](std::size_t k, std::size_t done) {
+          if (on_finished) on_finished(done, requests.size(), results[k]);
+        });
     return results;
   }
 
