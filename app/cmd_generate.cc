@@ -191,14 +191,23 @@ int RunGenerate(const GenerateArgs& a) {
   options.nominal_config_yaml = run.config_text;
   {
     // A configuration that itself switches effects on is written without
-    // them: the experiment states the nominal model only.
+    // them: the experiment states the nominal model only. A paper case is
+    // part of the arm as built (which cables have friction), so the nominal
+    // configuration carries it; --set, --params and effects are the truth
+    // that identification must find, so it does not.
     sim::Config nominal = sim::ParseConfig(run.config_text, a.run.config_path);
+    bool changed = false;
     if (nominal.parameters.AnyEffectOn()) {
       for (const std::string& effect : nominal.parameters.EnabledEffects()) {
         nominal.parameters.DisableEffect(effect);
       }
-      options.nominal_config_yaml = sim::ToYaml(nominal);
+      changed = true;
     }
+    if (a.run.case_number != 0) {
+      sim::ApplyPaperCase(a.run.case_number, &nominal.parameters);
+      changed = true;
+    }
+    if (changed) options.nominal_config_yaml = sim::ToYaml(nominal);
   }
   options.recording.noise_sigma_m = a.noise_mm * 1e-3;
   options.recording.seed = a.seed;

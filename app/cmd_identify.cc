@@ -13,12 +13,11 @@
 #include "ccsrm/identify/identification.h"
 #include "ccsrm/sim/parameters.h"
 #include "commands.h"
+#include "fit_inputs.h"
 #include "option_checks.h"
 
 namespace ccsrm::app {
 namespace {
-
-namespace fs = std::filesystem;
 
 // Exit status of a fit that did not converge (its outputs are written) and
 // of one that failed.
@@ -45,76 +44,19 @@ int RunIdentify(const IdentifyArgs& a) {
   options.threads = a.threads;
   options.max_iterations = a.max_iterations;
   options.relative_step = a.relative_step;
-  if (!a.free.empty()) options.free_parameters = SplitList(a.free, "--free");
-  for (const std::string& name : options.free_parameters) sim::FindParameter(name, "--free");
-  if (!a.params.empty()) {
-    identify::ApplyParameterFile(ReadTextFile(a.params), a.params, &options);
-  }
-  for (const std::string& text : a.set) {
-    const auto [name, value] = sim::ParseParameterAssignment(text, "--set");
-    const std::string problem =
-        sim::ParameterValueProblem(sim::FindParameter(name, "--set"), value);
-    if (!problem.empty()) ThrowInputError("--set", "", problem);
-    options.values[name] = value;
-  }
+  ApplyFitOptions(a.free, a.params, a.set, &options);
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError("identify", "", error);
-  for (const std::string& path : a.data) {
-    std::error_code ec;
-    if (fs::equivalent(path, a.out, ec)) {
-      ThrowInputError(a.out, "--out", "is an input file; inputs are never modified");
-    }
-  }
-  if (fs::exists(a.out) && !fs::is_directory(a.out)) {
-    ThrowInputError(a.out, "--out", "exists and is not a folder");
-  }
-  { const AtomicOutputDirectory probe(a.out); }  // a bad output path fails now
-
-  identify::ExperimentLoadOptions load;
-  if (a.noise_deg > 0.0) load.noise_deg = a.noise_deg;
-  std::vector<identify::Experiment> experiments;
-  for (const std::string& path : a.data) {
-    experiments.push_back(identify::LoadExperiment(path, load));
-    const identify::Experiment& e = experiments.back();
-    if (e.angles_from_pipeline)
-      std::printf("mocap %s: %s\n", path.c_str(), e.pipeline_report.c_str());
-    double noise = 0.0;
-    for (double s : e.noise_deg) noise += s / static_cast<double>(e.noise_deg.size());
-    std::printf(
-        "experiment %s (%s): %zu frames, %.4g s, %zu measured angles, noise %.4f deg (%s)%s\n",
-        e.name.c_str(), path.c_str(), e.frame_time_s.size(), e.duration_s(), e.measured_samples,
-        noise, e.noise_source.c_str(),
-        e.angles_from_pipeline ? "; no measured joint angles in the file: computed by the mocap "
-                                 "pipeline with default settings"
-                               : "");
-  }
+  CheckOutputFolder(a.out, a.data);
+  std::vector<identify::Experiment> experiments =
+      LoadExperiments(a.data, a.noise_deg, "experiment");
   std::string free_list;
   for (const std::string& n : options.free_parameters)
     free_list += (free_list.empty() ? "" : ", ") + n;
   std::printf("fitting %s on %d thread%s\n", free_list.c_str(), options.threads,
               options.threads == 1 ? "" : "s");
   std::fflush(stdout);
-
-  if (!a.quiet) {
-    options.on_iteration = [](const identify::IterationProgress& p) {
-      std::string values;
-      for (const auto& [name, value] : p.values) {
-        char text[64];
-        std::snprintf(text, sizeof(text), " %s=%.6g", name.c_str(), value);
-        values += text;
-      }
-      std::fprintf(stderr, "\r%-100s\r", "");
-      std::printf("iteration %2d: cost %.6g, RMS %.4f deg%s, %lld simulations, %.0f s;%s\n",
-                  p.iteration, p.cost, p.rms_deg, p.step_accepted ? "" : " (step rejected)",
-                  static_cast<long long>(p.simulations), p.wall_time_s, values.c_str());
-      std::fflush(stdout);
-    };
-    options.on_run = [](std::size_t finished, std::size_t total, const identify::RunResult& r) {
-      std::fprintf(stderr, "\r  simulation %zu / %zu (%.1f s wall)", finished, total,
-                   r.summary.wall_time_s);
-      if (finished == total) std::fprintf(stderr, "\r%-60s\r", "");
-    };
-  }
+  if (!a.quiet) PrintFitProgress(&options, "");
   const identify::IdentificationSummary summary = identify::Identify(experiments, options);
   std::printf("%s", summary.FullReport().c_str());
   const std::vector<std::string> written = identify::WriteFitDirectory(summary, experiments, a.out);

@@ -16,4 +16,5 @@ void AddCamerasCommands(CLI::App& root);
 void AddReportCommand(CLI::App& root);
 void AddDerivativesCommand(CLI::App& root);
 void AddIdentifyCommand(CLI::App& root);
+void AddLoopCommand(CLI::App& root);
 }  // namespace ccsrm::app

@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
   ccsrm::app::AddReportCommand(root);
   ccsrm::app::AddDerivativesCommand(root);
   ccsrm::app::AddIdentifyCommand(root);
+  ccsrm::app::AddLoopCommand(root);
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -12,6 +12,7 @@
 #include <set>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/sim/effects.h"
 #include "finite_difference.h"
 #include "statistics.h"
 
@@ -27,6 +28,9 @@ struct FreeParameter {
   double lower = 0.0, upper = 0.0;  // [parameter units]
   double start = 0.0;
   double scale = 1.0;
+  // A measurement effect's parameter (mocap_offset): its trial points are
+  // the base runs recorded again, not new simulations.
+  bool measurement = false;
 };
 
 // Where each residual comes from: experiment, frame, column (2 joint + axis).
@@ -41,6 +45,10 @@ struct Evaluation {
   std::vector<double> u;
   std::vector<Eigen::MatrixXd> angles_rad;  // per experiment
   std::vector<sim::SimulationSummary> summaries;
+  // Per free parameter of a measurement effect (others: empty), per
+  // difference-plan trial, per experiment: the base runs recorded at the
+  // trial value.
+  std::vector<std::array<std::vector<Eigen::MatrixXd>, 2>> measurement_trials;
   Eigen::VectorXd residuals;  // weighted
   bool ok = false;
   std::string failure;
@@ -108,9 +116,29 @@ class FitProblem {
     const std::vector<double> p = ValuesAt(u);
     std::vector<RunRequest> requests;
     for (std::size_t e = 0; e < experiments_.size(); ++e) {
-      requests.push_back({e, ParametersAt(e, p), keep_trajectories});
+      RunRequest request{e, ParametersAt(e, p), keep_trajectories, {}};
+      for (std::size_t i = 0; i < free_.size(); ++i) {
+        if (!free_[i].measurement) continue;
+        for (const double trial : PlanFor(i, p[i]).trial_values) {
+          std::vector<double> q = p;
+          q[i] = trial;
+          request.measurement_variants.push_back(ParametersAt(e, q));
+        }
+      }
+      requests.push_back(std::move(request));
     }
     std::vector<RunResult> results = Run(requests);
+    ev.measurement_trials.resize(free_.size());
+    for (std::size_t e = 0; e < results.size(); ++e) {
+      std::size_t v = 0;
+      for (std::size_t i = 0; i < free_.size(); ++i) {
+        if (!free_[i].measurement) continue;
+        for (int t = 0; t < 2; ++t) {
+          ev.measurement_trials[i][static_cast<std::size_t>(t)].push_back(
+              std::move(results[e].variant_angles_rad[v++]));
+        }
+      }
+    }
     ev.ok = true;
     for (std::size_t e = 0; e < results.size(); ++e) {
       if (!results[e].summary.completed() && ev.ok) {
@@ -149,16 +177,13 @@ class FitProblem {
     std::vector<internal::DifferencePlan> plans;
     std::vector<RunRequest> requests;
     for (std::size_t i = 0; i < free_.size(); ++i) {
-      const double h = options_.relative_step * free_[i].scale;
-      const std::optional<internal::DifferencePlan> plan =
-          internal::PlanDifference(p[i], h, free_[i].lower, free_[i].upper);
-      CCSRM_CHECK(plan.has_value());  // Identify checked the bounds' width
-      plans.push_back(*plan);
+      plans.push_back(PlanFor(i, p[i]));
+      if (free_[i].measurement) continue;  // recorded with the base runs
       for (int t = 0; t < 2; ++t) {
         std::vector<double> trial = p;
-        trial[i] = plan->trial_values[static_cast<std::size_t>(t)];
+        trial[i] = plans.back().trial_values[static_cast<std::size_t>(t)];
         for (std::size_t e = 0; e < experiments_.size(); ++e) {
-          requests.push_back({e, ParametersAt(e, trial), false});
+          requests.push_back({e, ParametersAt(e, trial), false, {}});
         }
       }
     }
@@ -166,11 +191,16 @@ class FitProblem {
     jacobian->resize(static_cast<Eigen::Index>(index_.size()),
                      static_cast<Eigen::Index>(free_.size()));
     const std::size_t ne = experiments_.size();
+    std::size_t simulated = 0;  // simulated free parameters before i
     for (std::size_t i = 0; i < free_.size(); ++i) {
       std::vector<Eigen::MatrixXd> trial_angles[2];
       for (int t = 0; t < 2; ++t) {
+        if (free_[i].measurement) {
+          trial_angles[t] = base.measurement_trials[i][static_cast<std::size_t>(t)];
+          continue;
+        }
         for (std::size_t e = 0; e < ne; ++e) {
-          const RunResult& r = results[(i * 2 + static_cast<std::size_t>(t)) * ne + e];
+          const RunResult& r = results[(simulated * 2 + static_cast<std::size_t>(t)) * ne + e];
           if (!r.summary.completed()) {
             *failure = "finite difference of " + free_[i].name + ": " + experiments_[e].name +
                        ": " + r.summary.message;
@@ -179,6 +209,7 @@ class FitProblem {
           trial_angles[t].push_back(r.angles_rad);
         }
       }
+      if (!free_[i].measurement) ++simulated;
       const Eigen::VectorXd r0 = Residuals(trial_angles[0]);
       const Eigen::VectorXd r1 = Residuals(trial_angles[1]);
       const internal::DifferencePlan& plan = plans[i];
@@ -193,6 +224,15 @@ class FitProblem {
     jacobian_u_.assign(u, u + free_.size());
     jacobian_ = *jacobian;
     return true;
+  }
+
+  // The difference plan of free parameter i at value p_i.
+  internal::DifferencePlan PlanFor(std::size_t i, double p_i) const {
+    const double h = options_.relative_step * free_[i].scale;
+    const std::optional<internal::DifferencePlan> plan =
+        internal::PlanDifference(p_i, h, free_[i].lower, free_[i].upper);
+    CCSRM_CHECK(plan.has_value());  // Identify checked the bounds' width
+    return *plan;
   }
 
   // (simulated - measured) / noise at every residual index.
@@ -439,8 +479,22 @@ class IterationReporter final : public ceres::IterationCallback {
   std::string stop_reason_;
 };
 
-ChannelErrors ErrorsOf(const std::vector<const Experiment*>& experiments,
-                       const std::vector<const Eigen::MatrixXd*>& simulated) {
+IdentificationTermination FromCeres(ceres::TerminationType type) {
+  switch (type) {
+    case ceres::CONVERGENCE:
+    case ceres::USER_SUCCESS:
+      return IdentificationTermination::kConverged;
+    case ceres::NO_CONVERGENCE:
+      return IdentificationTermination::kNoConvergence;
+    default:
+      return IdentificationTermination::kFailed;
+  }
+}
+
+}  // namespace
+
+ChannelErrors AngleErrors(const std::vector<const Experiment*>& experiments,
+                          const std::vector<const Eigen::MatrixXd*>& simulated) {
   const int joints = experiments.front()->joints;
   ChannelErrors out;
   out.rms_deg.assign(static_cast<std::size_t>(joints), {kNaN, kNaN});
@@ -492,20 +546,6 @@ ChannelErrors ErrorsOf(const std::vector<const Experiment*>& experiments,
       total_spread > 0.0 ? 100.0 * (1.0 - std::sqrt(total_sq / total_spread)) : kNaN;
   return out;
 }
-
-IdentificationTermination FromCeres(ceres::TerminationType type) {
-  switch (type) {
-    case ceres::CONVERGENCE:
-    case ceres::USER_SUCCESS:
-      return IdentificationTermination::kConverged;
-    case ceres::NO_CONVERGENCE:
-      return IdentificationTermination::kNoConvergence;
-    default:
-      return IdentificationTermination::kFailed;
-  }
-}
-
-}  // namespace
 
 std::vector<std::string> Spec6ParameterNames() {
   return {"mu", "mu_s", "mu_c", "mu_c_s", "beta", "c_sc", "c_lc", "T_p", "T_d0"};
@@ -561,6 +601,12 @@ bool IdentificationOptions::IsValid(std::string* error) const {
       std::snprintf(text, sizeof(text), "bounds of '%s': [%g, %g] leave its own bounds [%g, %g]",
                     name.c_str(), range.first, range.second, info.lower, info.upper);
       return fail(text);
+    }
+  }
+  for (const auto& [name, scale] : scales) {
+    if (seen.count(name) == 0) return fail("scales: '" + name + "' is not a free parameter");
+    if (!(scale > 0.0) || !std::isfinite(scale)) {
+      return fail("scales: the scale of '" + name + "' must be > 0");
     }
   }
   if (!(relative_step > 0.0 && relative_step <= 0.1)) {
@@ -630,6 +676,8 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     f.scale = f.start != 0.0   ? std::abs(f.start)
               : nominal != 0.0 ? std::abs(nominal)
                                : 0.01 * (f.upper - f.lower);
+    if (const auto it = options.scales.find(name); it != options.scales.end()) f.scale = it->second;
+    f.measurement = info.is_effect() && sim::FindEffect(info.effect, "--free").measurement;
     // Every difference plan must fit inside the bounds (see PlanDifference):
     // within h of one bound, a one-sided plan needs 2h towards the other.
     if (f.upper - f.lower < 4.0 * options.relative_step * f.scale) {
@@ -739,6 +787,8 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     Eigen::MatrixXd jacobian;
     std::string failure;
     if (problem.Jacobian(u.data(), &jacobian, &failure)) {
+      summary.jacobian = jacobian;
+      summary.weighted_residuals = final_eval.residuals;
       const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian, Eigen::ComputeThinV);
       const Eigen::VectorXd sv = svd.singularValues();
       const Eigen::MatrixXd v = svd.matrixV();
@@ -890,9 +940,9 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     fit.noise_deg = experiments[e].noise_deg;
     fit.noise_source = experiments[e].noise_source;
     if (start_eval.ok || !start_eval.angles_rad.empty()) {
-      fit.start = ErrorsOf({&experiments[e]}, {&start_eval.angles_rad[e]});
+      fit.start = AngleErrors({&experiments[e]}, {&start_eval.angles_rad[e]});
     }
-    fit.fitted = ErrorsOf({&experiments[e]}, {&final_eval.angles_rad[e]});
+    fit.fitted = AngleErrors({&experiments[e]}, {&final_eval.angles_rad[e]});
     fit.run.summary = final_eval.summaries[e];
     if (e < trajectories.size()) fit.run.trajectory = std::move(trajectories[e]);
     fit.parameters = problem.ParametersAt(e, p_final);
@@ -902,8 +952,8 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     start_angles.push_back(&start_eval.angles_rad[e]);
     final_angles.push_back(&final_eval.angles_rad[e]);
   }
-  summary.start_errors = ErrorsOf(all, start_angles);
-  summary.errors = ErrorsOf(all, final_angles);
+  summary.start_errors = AngleErrors(all, start_angles);
+  summary.errors = AngleErrors(all, final_angles);
   summary.simulations = problem.simulations();
   summary.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();

@@ -18,22 +18,27 @@ RunResult RunOne(const Experiment& e, const RunRequest& request) {
   sim::SimulationResult result = sim::Simulate(*e.model, request.parameters, *e.inputs, options);
 
   RunResult out;
-  out.angles_rad = Eigen::MatrixXd::Constant(e.measured_rad.rows(), e.measured_rad.cols(),
-                                             std::numeric_limits<double>::quiet_NaN());
-  const std::size_t frames =
-      std::min(result.trajectory.size(), static_cast<std::size_t>(e.measured_rad.rows()));
-  for (std::size_t f = 0; f < frames; ++f) {
-    // What motion capture records: measurement effects (mocap_offset) included.
-    const std::vector<Eigen::Vector2d> recorded =
-        sim::RecordedJointAngles(request.parameters, result.trajectory.frames[f]);
-    for (int j = 0; j < e.joints; ++j) {
-      out.angles_rad(static_cast<Eigen::Index>(f), 2 * j) =
-          recorded[static_cast<std::size_t>(j)].x();
-      out.angles_rad(static_cast<Eigen::Index>(f), 2 * j + 1) =
-          recorded[static_cast<std::size_t>(j)].y();
+  const auto record = [&](const sim::ArmParameters& parameters) {
+    Eigen::MatrixXd angles = Eigen::MatrixXd::Constant(e.measured_rad.rows(), e.measured_rad.cols(),
+                                                       std::numeric_limits<double>::quiet_NaN());
+    const std::size_t frames =
+        std::min(result.trajectory.size(), static_cast<std::size_t>(e.measured_rad.rows()));
+    for (std::size_t f = 0; f < frames; ++f) {
+      // What motion capture records: measurement effects (mocap_offset) included.
+      const std::vector<Eigen::Vector2d> recorded =
+          sim::RecordedJointAngles(parameters, result.trajectory.frames[f]);
+      for (int j = 0; j < e.joints; ++j) {
+        angles(static_cast<Eigen::Index>(f), 2 * j) = recorded[static_cast<std::size_t>(j)].x();
+        angles(static_cast<Eigen::Index>(f), 2 * j + 1) = recorded[static_cast<std::size_t>(j)].y();
+      }
     }
+    e.AsMeasured(&angles);
+    return angles;
+  };
+  out.angles_rad = record(request.parameters);
+  for (const sim::ArmParameters& variant : request.measurement_variants) {
+    out.variant_angles_rad.push_back(record(variant));
   }
-  e.AsMeasured(&out.angles_rad);
   out.summary = std::move(result.summary);
   if (request.keep_trajectory) out.trajectory = std::move(result.trajectory);
   return out;

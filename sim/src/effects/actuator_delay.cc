@@ -72,6 +72,7 @@ class ActuatorDelay final : public Effect {
 EffectDefinition ActuatorDelayEffect() {
   EffectDefinition d;
   d.name = "actuator_delay";
+  d.fingerprint = {"rate", "input_rate", "lag"};
   d.description = "the input lengths lag the command: a dead time then a first-order lag";
   // Realistic: a servo-driven linear actuator's position loop of 5-10 Hz
   // bandwidth (τ = 16-32 ms) and a 10 ms control and communication cycle.

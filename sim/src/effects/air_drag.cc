@@ -35,6 +35,7 @@ class AirDrag final : public Effect {
 EffectDefinition AirDragEffect() {
   EffectDefinition d;
   d.name = "air_drag";
+  d.fingerprint = {"rate", "lag"};
   d.description = "air-bearing drag on the links, linear in the velocity of each link";
   // Realistic: air (η = 1.8e-5 Pa s) under a 30 mm x 30 mm pad with a 10 µm
   // gap gives η A / h = 1.6e-3 N s/m; 2e-3 N s/m. Upper bound 1 N s/m (a

@@ -47,6 +47,7 @@ class Backlash final : public Effect {
 EffectDefinition BacklashEffect() {
   EffectDefinition d;
   d.name = "backlash";
+  d.fingerprint = {"constant", "angle", "rate_sign", "hysteresis"};
   d.description = "a dead band in the connecting cables before their stiffness acts";
   // Realistic: play of a crimped cable loop on ~5 mm pulleys: 10 µm of slack
   // per side is 2e-3 rad of relative rotation (0.11°). Upper bound 0.05 rad

@@ -95,6 +95,8 @@ struct EffectDefinition {
   std::string name;
   std::string description;
   bool measurement = false;
+  // The residual signals it leaves (EffectInfo::fingerprint).
+  std::vector<std::string> fingerprint;
   // Its parameters with short names ("coulomb_nm") and `field` null; the
   // registry fills in the full name, `effect` and `short_name`.
   std::vector<ParameterInfo> parameters;

@@ -52,6 +52,7 @@ class JointFriction final : public Effect {
 EffectDefinition JointFrictionEffect() {
   EffectDefinition d;
   d.name = "joint_friction";
+  d.fingerprint = {"rate_sign", "rate", "hysteresis"};
   d.description = "Coulomb and viscous friction in every universal joint (both axes)";
   // Realistic: the joints carry the driving cables' pre-tension as
   // compression (6 x 100 N in segment 1); on rolling bearings (friction

@@ -47,6 +47,7 @@ class MocapOffset final : public Effect {
 EffectDefinition MocapOffsetEffect() {
   EffectDefinition d;
   d.name = "mocap_offset";
+  d.fingerprint = {"constant"};
   d.description =
       "constant zero offsets of the measured joint angles (measurement only, not the dynamics)";
   d.measurement = true;

@@ -74,6 +74,7 @@ class PretensionCreep final : public Effect {
 EffectDefinition PretensionCreepEffect() {
   EffectDefinition d;
   d.name = "pretension_creep";
+  d.fingerprint = {"time", "hold_drift", "angle"};
   d.description = "the cables' pre-tensions T_p and T_d0 relax exponentially over the experiment";
   // Realistic: steel wire ropes lose a few percent of their tension in the
   // first minutes after tensioning (constructional stretch, termination

@@ -69,7 +69,7 @@ const std::vector<EffectInfo>& Effects() {
   static const std::vector<EffectInfo> effects = [] {
     std::vector<EffectInfo> list;
     for (const internal::EffectDefinition& d : internal::EffectDefinitions()) {
-      EffectInfo info{d.name, d.description, d.measurement, {}};
+      EffectInfo info{d.name, d.description, d.measurement, d.fingerprint, {}};
       for (const ParameterInfo& p : d.parameters) info.parameters.push_back(p.name);
       list.push_back(info);
     }

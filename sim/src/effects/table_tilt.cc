@@ -43,6 +43,7 @@ class TableTilt final : public Effect {
 EffectDefinition TableTiltEffect() {
   EffectDefinition d;
   d.name = "table_tilt";
+  d.fingerprint = {"constant", "heading"};
   d.description = "the table is not level: gravity in the table plane from two small tilt angles";
   // Realistic: an air table levelled with a machinist's spirit level is
   // within ~0.1 mm/m (1e-4 rad); levelled by eye or settled since, ~1 mm/m.

@@ -88,6 +88,12 @@ struct IdentificationOptions {
   // lie inside the parameter's own bounds (sim::Parameters()) and contain
   // the start value. Default: the parameter's own bounds.
   std::map<std::string, std::pair<double, double>> bounds;
+  // The scale s of a free parameter in the scaled space u = p / s, name ->
+  // s > 0. Default: the magnitude of its start value, else of its nominal
+  // value, else 1 % of its bounds' width. Give one where the start is 0 or
+  // tiny but the parameter's natural size is known (an effect's realistic
+  // magnitude): the finite-difference step is relative_step s.
+  std::map<std::string, double> scales;
   // Relative finite-difference step: a parameter p moves by r s. Default
   // 1e-2 (see above).
   double relative_step = 1e-2;
@@ -134,7 +140,8 @@ struct IdentificationOptions {
   // free, bounds outside the parameter's own or not increasing, a value out
   // of bounds, relative_step outside (0, 0.1], threads < 1,
   // max_iterations < 0, tolerances <= 0, max_relative_standard_error <= 0,
-  // converged_step_fraction < 0, min_effective_chi2_decrease < 0.
+  // converged_step_fraction < 0, min_effective_chi2_decrease < 0, a scale
+  // for a parameter that is not free or not positive.
   bool IsValid(std::string* error) const;
 };
 
@@ -183,6 +190,12 @@ struct ChannelErrors {
   double fit_percent_overall = 0.0;
 };
 
+// The errors of simulated angles [rad] (one matrix per experiment, laid out
+// as Experiment::measured_rad) against the experiments' measured angles,
+// every experiment together.
+ChannelErrors AngleErrors(const std::vector<const Experiment*>& experiments,
+                          const std::vector<const Eigen::MatrixXd*>& simulated);
+
 struct ExperimentFit {
   std::string name;
   std::string path;
@@ -216,6 +229,13 @@ struct IdentificationSummary {
   std::vector<std::string> free_names;
   Eigen::MatrixXd correlation;          // free × free; NaN rows of unidentifiable parameters
   std::vector<double> singular_values;  // scaled Jacobian, descending
+  // At the final point: the weighted residuals (simulated - measured) /
+  // noise, and their Jacobian with respect to the scaled free parameters
+  // u = p / scale (columns in free_names' order). Rows: experiment by
+  // experiment, frame by frame, columns 2 joint + axis, measured entries
+  // only. Empty when the final point did not run.
+  Eigen::VectorXd weighted_residuals;
+  Eigen::MatrixXd jacobian;
   std::vector<UnidentifiableDirection> unidentifiable;
   ChannelErrors start_errors;  // every experiment together
   ChannelErrors errors;

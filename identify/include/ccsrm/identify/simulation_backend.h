@@ -21,6 +21,10 @@ struct RunRequest {
   std::size_t experiment = 0;  // index into the experiments the backend was given
   sim::ArmParameters parameters;
   bool keep_trajectory = false;  // also return every sampled frame
+  // Parameter sets that differ from `parameters` only in measurement
+  // effects' parameters (mocap_offset): the same run is recorded once more
+  // through each, without simulating again (RunResult::variant_angles_rad).
+  std::vector<sim::ArmParameters> measurement_variants;
 };
 
 struct RunResult {
@@ -31,6 +35,8 @@ struct RunResult {
   // beyond a run that ended early are NaN.
   Eigen::MatrixXd angles_rad;
   sim::Trajectory trajectory;  // only with keep_trajectory
+  // The angles as recorded through each of the request's measurement_variants.
+  std::vector<Eigen::MatrixXd> variant_angles_rad;
 };
 
 // Called after each finished run, one call at a time.

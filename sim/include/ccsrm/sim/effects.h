@@ -35,6 +35,12 @@ struct EffectInfo {
   // True for an effect on what is measured (mocap_offset), not on the
   // dynamics: Simulate ignores it; RecordedJointAngles applies it.
   bool measurement = false;
+  // The signals its residual follows (docs/model-notes.md, "Effect
+  // fingerprints"), by the names of the loop's residual diagnostics:
+  // "rate_sign", "rate", "angle", "heading", "time", "input_rate",
+  // "constant", "hold_drift", "hysteresis", "lag". Evidence that points to
+  // the effect, reported beside its score; the ranking itself is by score.
+  std::vector<std::string> fingerprint;
   // Its parameters, full names in AllParameters() ("joint_friction.coulomb_nm").
   std::vector<std::string> parameters;
 };

@@ -1,0 +1,120 @@
+// ccsrm loop --data exp1.h5 [exp2.h5 ...] [--holdout exp3.h5 ...] [--candidates a,b,...]
+//            [--free ...] [--params p.yaml] [--set name=value ...] [--threads N] --out loop/
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ccsrm/common/error.h"
+#include "ccsrm/identify/loop.h"
+#include "commands.h"
+#include "fit_inputs.h"
+#include "option_checks.h"
+
+namespace ccsrm::app {
+namespace {
+
+struct LoopArgs {
+  std::vector<std::string> data;
+  std::vector<std::string> holdout;
+  std::string candidates;
+  std::string free;
+  std::string params;
+  std::vector<std::string> set;
+  int threads = identify::DefaultThreads();
+  int max_rounds = identify::LoopOptions().max_rounds;
+  int max_iterations = identify::IdentificationOptions().max_iterations;
+  double noise_deg = 0.0;  // 0: estimated
+  std::string out;
+  bool quiet = false;
+};
+
+int RunLoop(const LoopArgs& a) {
+  identify::LoopOptions options;
+  options.fit.threads = a.threads;
+  options.fit.max_iterations = a.max_iterations;
+  options.max_rounds = a.max_rounds;
+  ApplyFitOptions(a.free, a.params, a.set, &options.fit);
+  if (!a.candidates.empty()) options.candidates = SplitList(a.candidates, "--candidates");
+  std::string error;
+  if (!options.IsValid(&error)) ThrowInputError("loop", "", error);
+  std::vector<std::string> inputs = a.data;
+  inputs.insert(inputs.end(), a.holdout.begin(), a.holdout.end());
+  CheckOutputFolder(a.out, inputs);
+  const std::vector<identify::Experiment> training =
+      LoadExperiments(a.data, a.noise_deg, "training");
+  const std::vector<identify::Experiment> holdout =
+      LoadExperiments(a.holdout, a.noise_deg, "held out");
+
+  std::string free_list;
+  for (const std::string& n : options.fit.free_parameters)
+    free_list += (free_list.empty() ? "" : ", ") + n;
+  std::printf("declared model: %s free; %zu training, %zu held-out experiment%s; %d thread%s\n",
+              free_list.c_str(), training.size(), holdout.size(), holdout.size() == 1 ? "" : "s",
+              options.fit.threads, options.fit.threads == 1 ? "" : "s");
+  std::fflush(stdout);
+  if (!a.quiet) {
+    PrintFitProgress(&options.fit, "    ");
+    options.on_progress = [](const identify::LoopProgress& p) {
+      std::fprintf(stderr, "\r%-100s\r", "");
+      std::printf("%s\n", p.message.c_str());
+      std::fflush(stdout);
+    };
+  }
+  const identify::LoopSummary summary = identify::CloseLoop(training, holdout, options);
+  std::printf("\n%s", summary.FullReport().c_str());
+  const std::vector<std::string> written =
+      identify::WriteLoopDirectory(summary, training, holdout, a.out);
+  std::printf("  output: %s (%zu files)\n", a.out.c_str(), written.size());
+  if (summary.declared.termination == identify::IdentificationTermination::kFailed) {
+    std::fprintf(stderr, "ccsrm: the declared model's fit failed: %s (outputs written)\n",
+                 summary.declared.message.c_str());
+    return 3;
+  }
+  return 0;
+}
+
+}  // namespace
+
+void AddLoopCommand(CLI::App& root) {
+  CLI::App* cmd = root.add_subcommand(
+      "loop",
+      "Fit the declared model, trace what its residual lacks to an effect of the effect "
+      "library, add it, refit, and report the error before and after (writes loop.json and the "
+      "fitted runs; exit 3 if the declared fit failed)");
+  auto a = std::make_shared<LoopArgs>();
+  cmd->add_option("--data", a->data, "Training experiments (ccsrm-dataset/1), one or more")
+      ->required()
+      ->expected(1, -1);
+  cmd->add_option("--holdout", a->holdout,
+                  "Held-out experiments: not fitted, each candidate's refit is scored on them")
+      ->expected(1, -1);
+  cmd->add_option("--candidates", a->candidates,
+                  "Candidate effects, comma-separated (default: every effect of the library "
+                  "that is off; ccsrm generate --list-effects)");
+  cmd->add_option("--free", a->free,
+                  "The declared model's free parameters, comma-separated (default: mu,mu_c,T_p)");
+  cmd->add_option("--params", a->params,
+                  "YAML file: name: value, or name: {value, free, bounds: [lo, hi]}");
+  cmd->add_option("--set", a->set, "Value of a parameter, name=value (repeatable)");
+  cmd->add_option("--threads", a->threads, "Simulations at a time (default: every core)")
+      ->check(ValidIn(&identify::IdentificationOptions::threads));
+  cmd->add_option("--max-rounds", a->max_rounds, "Effects added at most")
+      ->capture_default_str()
+      ->check(ValidIn(&identify::LoopOptions::max_rounds));
+  cmd->add_option("--max-iterations", a->max_iterations, "Levenberg-Marquardt iterations per fit")
+      ->capture_default_str()
+      ->check(ValidIn(&identify::IdentificationOptions::max_iterations));
+  cmd->add_option("--noise-deg", a->noise_deg,
+                  "Measurement noise of the joint angles [deg] (default: estimated per joint "
+                  "from the measured twist)")
+      ->check(Above(0.0, "deg"));
+  cmd->add_option("--out", a->out, "Output folder")->required();
+  cmd->add_flag("--quiet", a->quiet, "No progress lines");
+  cmd->callback([a] {
+    const int code = RunLoop(*a);
+    if (code != 0) throw CLI::RuntimeError(code);
+  });
+}
+
+}  // namespace ccsrm::app

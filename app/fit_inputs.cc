@@ -1,0 +1,89 @@
+#include "fit_inputs.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/common/error.h"
+#include "ccsrm/sim/parameters.h"
+#include "option_checks.h"
+
+namespace ccsrm::app {
+
+namespace fs = std::filesystem;
+
+void ApplyFitOptions(const std::string& free, const std::string& params,
+                     const std::vector<std::string>& set,
+                     identify::IdentificationOptions* options) {
+  if (!free.empty()) options->free_parameters = SplitList(free, "--free");
+  for (const std::string& name : options->free_parameters) sim::FindParameter(name, "--free");
+  if (!params.empty()) identify::ApplyParameterFile(ReadTextFile(params), params, options);
+  for (const std::string& text : set) {
+    const auto [name, value] = sim::ParseParameterAssignment(text, "--set");
+    const std::string problem =
+        sim::ParameterValueProblem(sim::FindParameter(name, "--set"), value);
+    if (!problem.empty()) ThrowInputError("--set", "", problem);
+    options->values[name] = value;
+  }
+}
+
+void CheckOutputFolder(const std::string& out, const std::vector<std::string>& inputs) {
+  for (const std::string& path : inputs) {
+    std::error_code ec;
+    if (fs::equivalent(path, out, ec)) {
+      ThrowInputError(out, "--out", "is an input file; inputs are never modified");
+    }
+  }
+  if (fs::exists(out) && !fs::is_directory(out)) {
+    ThrowInputError(out, "--out", "exists and is not a folder");
+  }
+  { const AtomicOutputDirectory probe(out); }  // a bad output path fails now
+}
+
+std::vector<identify::Experiment> LoadExperiments(const std::vector<std::string>& paths,
+                                                  double noise_deg, const char* role) {
+  identify::ExperimentLoadOptions load;
+  if (noise_deg > 0.0) load.noise_deg = noise_deg;
+  std::vector<identify::Experiment> experiments;
+  for (const std::string& path : paths) {
+    experiments.push_back(identify::LoadExperiment(path, load));
+    const identify::Experiment& e = experiments.back();
+    if (e.angles_from_pipeline)
+      std::printf("mocap %s: %s\n", path.c_str(), e.pipeline_report.c_str());
+    double noise = 0.0;
+    for (double s : e.noise_deg) noise += s / static_cast<double>(e.noise_deg.size());
+    std::printf("%s %s (%s): %zu frames, %.4g s, %zu measured angles, noise %.4f deg (%s)%s\n",
+                role, e.name.c_str(), path.c_str(), e.frame_time_s.size(), e.duration_s(),
+                e.measured_samples, noise, e.noise_source.c_str(),
+                e.angles_from_pipeline
+                    ? "; no measured joint angles in the file: computed by the mocap "
+                      "pipeline with default settings"
+                    : "");
+  }
+  std::fflush(stdout);
+  return experiments;
+}
+
+void PrintFitProgress(identify::IdentificationOptions* options, const std::string& indent) {
+  options->on_iteration = [indent](const identify::IterationProgress& p) {
+    std::string values;
+    for (const auto& [name, value] : p.values) {
+      char text[96];
+      std::snprintf(text, sizeof(text), " %s=%.6g", name.c_str(), value);
+      values += text;
+    }
+    std::fprintf(stderr, "\r%-100s\r", "");
+    std::printf("%siteration %2d: cost %.6g, RMS %.4f deg%s, %lld simulations, %.0f s;%s\n",
+                indent.c_str(), p.iteration, p.cost, p.rms_deg,
+                p.step_accepted ? "" : " (step rejected)", static_cast<long long>(p.simulations),
+                p.wall_time_s, values.c_str());
+    std::fflush(stdout);
+  };
+  options->on_run = [](std::size_t finished, std::size_t total, const identify::RunResult& r) {
+    std::fprintf(stderr, "\r  simulation %zu / %zu (%.1f s wall)", finished, total,
+                 r.summary.wall_time_s);
+    if (finished == total) std::fprintf(stderr, "\r%-60s\r", "");
+  };
+}
+
+}  // namespace ccsrm::app

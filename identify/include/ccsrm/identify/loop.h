@@ -1,0 +1,190 @@
+#pragma once
+// Closing the loop (SPEC 7): fit the declared model, find the evidence its
+// residual leaves, trace it to an effect of the effect library, add the
+// effect, refit, and report the error before and after.
+//
+// One round:
+//  1. Diagnose the residual of the current fit (diagnostics.h): the
+//     evidence reported beside each candidate.
+//  2. Score every candidate not yet added, cheaply: at the fitted point, the
+//     sensitivity of the simulated angles to each of the candidate's size
+//     parameters (one simulation per parameter and training experiment, a
+//     secant from 0 to the parameter's realistic magnitude; a measurement
+//     effect's columns come from the fitted runs, with no simulation) is
+//     added to the fitted Jacobian, and the score is how much of the
+//     weighted residual the augmented linear model removes beyond the
+//     declared one, in effective chi-square units (times N_eff / N): the
+//     score test. Its p-value is that of a chi-square with as many degrees
+//     of freedom as the candidate has size parameters.
+//  3. Refit the best few whose score is significant (p below
+//     score_significance over the number of candidates: Bonferroni), with
+//     the declared free parameters and the candidate's size parameters
+//     free, starting from the linearised estimate.
+//  4. Accept a refit only if all three hold:
+//     - information criterion: ΔBIC = Δχ²_eff - k ln N_eff > min_delta_bic
+//       (10: "very strong" evidence on Kass & Raftery's scale), with
+//       Δχ²_eff = 2 (cost before - cost after) N_eff / N and N_eff the
+//       smaller of the two fits' (the more autocorrelated residual: the
+//       conservative count);
+//     - held-out error (when held-out experiments are given): their mean
+//       square error falls by more than holdout_z standard errors of a mean
+//       square of N_eff,holdout independent samples, MS_after · sqrt(2 /
+//       N_eff) (2: chance alone gives such a gain about 2 % of the time);
+//     - size: at least one of its size parameters is identifiable with a
+//       95 % interval that excludes 0 (an effect indistinguishable from
+//       absent is not added).
+//  5. The winner has the largest ΔBIC. Candidates within tie_delta_bic of
+//     it (2: "not worth more than a bare mention") tie; of those the one
+//     with the fewest parameters wins, and the tie is reported.
+// Rounds repeat until no candidate earns its place or max_rounds.
+//
+// At the end, every (experiment, joint, axis) whose RMS residual exceeds
+// unexplained_noise_ratio (1.5) times its noise is reported as
+// unexplained, with the phase of the protocol where it is largest.
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ccsrm/identify/diagnostics.h"
+#include "ccsrm/identify/experiment.h"
+#include "ccsrm/identify/identification.h"
+
+namespace ccsrm::identify {
+
+// The loop's default declared free parameters: the kinetic friction of the
+// driving and the connecting cables and the connecting cables' pre-tension,
+// the three that every case of the paper's arm is sensitive to and that
+// effects most often trade with. Fewer than SPEC 6's nine keep every
+// candidate's refit affordable (each Jacobian is 2 runs per free parameter
+// and experiment).
+std::vector<std::string> LoopDeclaredParameterNames();
+
+struct LoopProgress {
+  int round = 0;          // 0: the declared model's fit
+  std::string stage;      // "declared fit", "scoring", "refit", "holdout", "done"
+  std::string candidate;  // when it concerns one
+  std::string message;    // one line for the terminal
+};
+
+struct LoopOptions {
+  // The declared model's fit: free parameters (default
+  // LoopDeclaredParameterNames()), values, bounds, threads, solver settings.
+  // Every refit uses the same settings with the candidate's size parameters
+  // added.
+  IdentificationOptions fit = [] {
+    IdentificationOptions o;
+    o.free_parameters = LoopDeclaredParameterNames();
+    return o;
+  }();
+  // The candidate effects, by name. Default: every effect of the library
+  // (sim::Effects()) that the declared model does not have on.
+  std::vector<std::string> candidates;
+  // At most this many rounds (effects added). Default 3.
+  int max_rounds = 3;
+  // Refits per round: the best-scoring significant candidates. Default 2.
+  int refits_per_round = 2;
+  // Family-wise significance of the score test over a round's candidates.
+  // Default 0.01.
+  double score_significance = 0.01;
+  // Acceptance thresholds (see above). Defaults 10, 2, 2.
+  double min_delta_bic = 10.0;
+  double holdout_z = 2.0;
+  double tie_delta_bic = 2.0;
+  // A channel is unexplained above this RMS over its noise. Default 1.5.
+  double unexplained_noise_ratio = 1.5;
+  std::function<void(const LoopProgress&)> on_progress;
+
+  bool IsValid(std::string* error) const;
+};
+
+struct CandidateResult {
+  std::string name;
+  std::vector<std::string> parameters;  // its size parameters (free in its refit)
+  // Score test.
+  double score = 0.0;  // Δχ²_eff the linearised candidate removes
+  double p_value = 1.0;
+  bool significant = false;
+  std::map<std::string, double> linearised;  // its size parameters' linear estimates
+  // Its fingerprint's signals in the residual (pooled), for the report.
+  std::vector<SignalEvidence> evidence;
+  // Refit (when refitted).
+  bool refitted = false;
+  double delta_bic = 0.0;
+  double rms_deg = 0.0;  // training, after its refit
+  std::optional<double> holdout_rms_deg;
+  bool holdout_improved = false;
+  bool size_significant = false;
+  std::string termination;
+  std::map<std::string, ParameterEstimate> estimates;  // its size parameters
+  std::int64_t simulations = 0;
+  bool accepted = false;
+  std::string reason;  // why (not) accepted, one line
+};
+
+struct LoopRound {
+  int index = 1;
+  std::vector<std::string> effects_on;  // at the round's start
+  double rms_deg = 0.0;                 // training, at the round's start
+  std::optional<double> holdout_rms_deg;
+  ResidualDiagnostics evidence;
+  std::vector<CandidateResult> candidates;  // by score, best first
+  std::string winner;                       // empty: none
+  std::vector<std::string> tie;             // candidates tied with the winner
+  std::string decision;                     // one or two sentences
+};
+
+struct UnexplainedChannel {
+  std::string experiment;
+  int joint = 0;
+  int axis = 0;
+  double rms_deg = 0.0;
+  double noise_deg = 0.0;
+  std::string worst_phase;
+  double worst_phase_rms_deg = 0.0;
+};
+
+struct LoopSummary {
+  std::vector<LoopRound> rounds;
+  std::vector<std::string> added_effects;
+  IdentificationSummary declared;   // the declared model's fit
+  IdentificationSummary final_fit;  // the final model's (== declared when nothing was added)
+  double rms_before_deg = 0.0, rms_after_deg = 0.0;
+  std::optional<double> holdout_rms_before_deg, holdout_rms_after_deg;
+  // Per joint and axis, overall over the experiments: before and after.
+  ChannelErrors before, after;
+  std::optional<ChannelErrors> holdout_before, holdout_after;
+  // Held-out runs of the declared and the final model (for reports).
+  std::vector<Eigen::MatrixXd> holdout_declared_rad, holdout_final_rad;
+  ResidualDiagnostics final_evidence;
+  std::vector<UnexplainedChannel> unexplained;
+  std::string conclusion;  // what was found, or that nothing explains the residual
+  std::int64_t simulations = 0;
+  double wall_time_s = 0.0;
+  int threads = 0;
+
+  std::string FullReport() const;
+};
+
+// Runs the loop. Throws InputError for invalid options or experiments
+// before any simulation runs.
+LoopSummary CloseLoop(const std::vector<Experiment>& training,
+                      const std::vector<Experiment>& holdout, const LoopOptions& options);
+
+// loop.json (schema ccsrm-loop/1).
+nlohmann::json ToJson(const LoopSummary& summary, const std::vector<Experiment>& training,
+                      const std::vector<Experiment>& holdout);
+
+// Writes the loop folder: loop.json; declared/ and final/ (fit folders of
+// the declared and the final model, WriteFitDirectory); holdout/ with, per
+// held-out experiment, <name>.angles.csv (time, measured, declared, final
+// θx and θy of every joint, deg). Returns the paths written.
+std::vector<std::string> WriteLoopDirectory(const LoopSummary& summary,
+                                            const std::vector<Experiment>& training,
+                                            const std::vector<Experiment>& holdout,
+                                            const std::string& directory);
+
+}  // namespace ccsrm::identify

@@ -1,0 +1,605 @@
+#include "ccsrm/identify/loop.h"
+
+#include <gsl/gsl_cdf.h>
+
+#include <Eigen/QR>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <sstream>
+
+#include "ccsrm/common/error.h"
+#include "ccsrm/sim/effects.h"
+
+namespace ccsrm::identify {
+namespace {
+
+constexpr double kDeg = 180.0 / M_PI;
+
+std::string Format(const char* format, double value) {
+  char text[96];
+  std::snprintf(text, sizeof(text), format, value);
+  return text;
+}
+
+// An effect's size parameters: those whose default while on is the neutral
+// value and differs from the realistic magnitude (friction, tilt, delay, a
+// dead band, a creep fraction, drag, offsets). Shape parameters (a smoothing
+// rate, a creep's time constant) default to their realistic value; they
+// stay there: at zero size they have no effect to fit.
+std::vector<std::string> SizeParameters(const std::string& effect) {
+  std::vector<std::string> out;
+  for (const std::string& name : sim::FindEffect(effect, "--candidates").parameters) {
+    const sim::ParameterInfo& info = sim::FindParameter(name, "--candidates");
+    const bool shape = info.absent_value != 0.0 && info.absent_value == info.realistic;
+    if (!shape) out.push_back(name);
+  }
+  return out;
+}
+
+// The secant step of a size parameter in the score test: its realistic
+// magnitude, which is inside its bounds and large enough to rise above the
+// solver's own noise.
+double ScoreStep(const std::string& name) {
+  const sim::ParameterInfo& info = sim::FindParameter(name, "--candidates");
+  const double step = std::abs(info.realistic);
+  return step > 0.0 ? step : 0.01 * (info.upper - info.lower);
+}
+
+// Weighted residual layout of FitProblem: experiment, frame, column, measured
+// entries only; (angles - measured) / noise.
+Eigen::VectorXd Weighted(const std::vector<Experiment>& experiments,
+                         const std::vector<const Eigen::MatrixXd*>& angles, bool difference_only,
+                         const std::vector<const Eigen::MatrixXd*>& base = {}) {
+  std::vector<double> out;
+  for (std::size_t e = 0; e < experiments.size(); ++e) {
+    const Experiment& x = experiments[e];
+    for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
+      for (Eigen::Index c = 0; c < x.measured_rad.cols(); ++c) {
+        if (!std::isfinite(x.measured_rad(f, c))) continue;
+        const double reference = difference_only ? (*base[e])(f, c) : x.measured_rad(f, c);
+        double v =
+            ((*angles[e])(f, c) - reference) * kDeg / x.noise_deg[static_cast<std::size_t>(c / 2)];
+        if (!std::isfinite(v)) v = 0.0;
+        out.push_back(v);
+      }
+    }
+  }
+  return Eigen::Map<Eigen::VectorXd>(out.data(), static_cast<Eigen::Index>(out.size()));
+}
+
+// How much of r a least-squares fit of columns A removes: ||r||² - min ||r + A x||².
+double Reduction(const Eigen::VectorXd& r, const Eigen::MatrixXd& a, Eigen::VectorXd* x) {
+  if (a.cols() == 0) {
+    if (x != nullptr) x->resize(0);
+    return 0.0;
+  }
+  // Columns scaled to unit norm: the fitted Jacobian's and the candidates'
+  // differ by orders of magnitude.
+  Eigen::VectorXd norms = a.colwise().norm().transpose();
+  for (Eigen::Index k = 0; k < norms.size(); ++k) {
+    if (!(norms[k] > 0.0)) norms[k] = 1.0;
+  }
+  const Eigen::MatrixXd scaled = a * norms.cwiseInverse().asDiagonal();
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(scaled);
+  const Eigen::VectorXd y = qr.solve(-r);
+  if (x != nullptr) *x = y.cwiseQuotient(norms);
+  return r.squaredNorm() - (r + scaled * y).squaredNorm();
+}
+
+// The parameters of an experiment at values (over its nominal configuration).
+sim::ArmParameters ParametersFor(const Experiment& e, const std::map<std::string, double>& values) {
+  sim::ArmParameters p = e.config.parameters;
+  for (const auto& [name, value] : values) sim::SetParameter(name, value, "loop", &p);
+  return p;
+}
+
+// Every value a fit leaves: the options' values, then the free estimates.
+std::map<std::string, double> ValuesOf(const IdentificationSummary& fit,
+                                       const std::map<std::string, double>& fixed) {
+  std::map<std::string, double> values = fixed;
+  for (const ParameterEstimate& p : fit.parameters) {
+    if (p.free) values[p.name] = p.value;
+  }
+  return values;
+}
+
+struct HoldoutResult {
+  std::vector<Eigen::MatrixXd> angles_rad;
+  double rms_deg = 0.0;
+  double mean_square = 0.0;  // weighted, per sample
+  double effective_samples = 0.0;
+  ChannelErrors errors;
+  bool ok = true;
+};
+
+}  // namespace
+
+std::vector<std::string> LoopDeclaredParameterNames() { return {"mu", "mu_c", "T_p"}; }
+
+bool LoopOptions::IsValid(std::string* error) const {
+  const auto fail = [&](const std::string& message) {
+    if (error != nullptr) *error = message;
+    return false;
+  };
+  std::string inner;
+  if (!fit.IsValid(&inner)) return fail(inner);
+  std::set<std::string> seen;
+  for (const std::string& c : candidates) {
+    bool known = false;
+    for (const sim::EffectInfo& e : sim::Effects()) known = known || e.name == c;
+    if (!known) {
+      std::string names;
+      for (const sim::EffectInfo& e : sim::Effects()) names += (names.empty() ? "" : ", ") + e.name;
+      return fail("candidates: unknown effect '" + c + "' (known: " + names + ")");
+    }
+    if (!seen.insert(c).second) return fail("candidates: '" + c + "' is given twice");
+    for (const std::string& name : fit.free_parameters) {
+      if (name.rfind(c + ".", 0) == 0) {
+        return fail("candidates: '" + c + "' already has a free parameter (" + name + ")");
+      }
+    }
+  }
+  if (max_rounds < 0) return fail("max_rounds must be >= 0");
+  if (refits_per_round < 1) return fail("refits_per_round must be >= 1");
+  if (!(score_significance > 0.0 && score_significance < 1.0)) {
+    return fail("score_significance must be in (0, 1)");
+  }
+  if (!(min_delta_bic >= 0.0)) return fail("min_delta_bic must be >= 0");
+  if (!(holdout_z >= 0.0)) return fail("holdout_z must be >= 0");
+  if (!(tie_delta_bic >= 0.0)) return fail("tie_delta_bic must be >= 0");
+  if (!(unexplained_noise_ratio > 0.0)) return fail("unexplained_noise_ratio must be > 0");
+  return true;
+}
+
+LoopSummary CloseLoop(const std::vector<Experiment>& training,
+                      const std::vector<Experiment>& holdout, const LoopOptions& options) {
+  const auto clock_start = std::chrono::steady_clock::now();
+  std::string error;
+  if (!options.IsValid(&error)) ThrowInputError("loop", "options", error);
+  if (training.empty()) ThrowInputError("loop", "--data", "no training experiment");
+  for (const Experiment& h : holdout) {
+    if (h.joints != training.front().joints) {
+      ThrowInputError(h.path, "joints", "the held-out arm differs from the training experiments'");
+    }
+  }
+  const auto progress = [&](int round, const std::string& stage, const std::string& candidate,
+                            const std::string& message) {
+    if (options.on_progress) options.on_progress({round, stage, candidate, message});
+  };
+
+  // The candidates: those given, else every effect the declared model has off.
+  std::vector<std::string> candidates = options.candidates;
+  if (candidates.empty()) {
+    for (const sim::EffectInfo& e : sim::Effects()) {
+      if (!training.front().config.parameters.EffectOn(e.name)) candidates.push_back(e.name);
+    }
+  }
+
+  LoopSummary summary;
+  std::unique_ptr<SimulationBackend> training_backend =
+      MakeThreadBackend(&training, options.fit.threads);
+  std::unique_ptr<SimulationBackend> holdout_backend =
+      MakeThreadBackend(&holdout, options.fit.threads);
+  summary.threads = training_backend->parallelism();
+  std::int64_t simulations = 0;
+
+  // The held-out experiments at a fit's values.
+  const auto run_holdout = [&](const std::map<std::string, double>& values) {
+    HoldoutResult h;
+    if (holdout.empty()) return h;
+    std::vector<RunRequest> requests;
+    for (std::size_t e = 0; e < holdout.size(); ++e) {
+      requests.push_back({e, ParametersFor(holdout[e], values), false, {}});
+    }
+    std::vector<RunResult> results = holdout_backend->RunBatch(requests, nullptr);
+    simulations += static_cast<std::int64_t>(requests.size());
+    std::vector<const Experiment*> xs;
+    std::vector<const Eigen::MatrixXd*> as;
+    for (std::size_t e = 0; e < holdout.size(); ++e) {
+      h.ok = h.ok && results[e].summary.completed();
+      h.angles_rad.push_back(std::move(results[e].angles_rad));
+    }
+    std::vector<const Eigen::MatrixXd*> angles;
+    for (std::size_t e = 0; e < holdout.size(); ++e) {
+      xs.push_back(&holdout[e]);
+      angles.push_back(&h.angles_rad[e]);
+    }
+    h.errors = AngleErrors(xs, angles);
+    h.rms_deg = h.errors.rms_deg_overall;
+    const Eigen::VectorXd r = Weighted(holdout, angles, false);
+    h.mean_square = r.size() > 0 ? r.squaredNorm() / static_cast<double>(r.size()) : 0.0;
+    const ResidualDiagnostics d = DiagnoseResidual(holdout, h.angles_rad);
+    h.effective_samples = d.effective_samples;
+    return h;
+  };
+
+  // The declared model.
+  progress(0, "declared fit", "", "fitting the declared model");
+  IdentificationOptions fit_options = options.fit;
+  summary.declared = Identify(training, fit_options);
+  simulations += summary.declared.simulations;
+  IdentificationSummary current = summary.declared;
+  std::vector<std::string> free = fit_options.free_parameters;
+  std::map<std::string, double> fixed = fit_options.values;
+  for (const std::string& name : free) fixed.erase(name);
+  HoldoutResult current_holdout = run_holdout(ValuesOf(current, fixed));
+  summary.holdout_declared_rad = current_holdout.angles_rad;
+  summary.before = summary.declared.errors;
+  summary.rms_before_deg = summary.declared.errors.rms_deg_overall;
+  if (!holdout.empty()) {
+    summary.holdout_rms_before_deg = current_holdout.rms_deg;
+    summary.holdout_before = current_holdout.errors;
+  }
+  progress(
+      0, "declared fit", "",
+      "declared model: RMS " + Format("%.4f", summary.rms_before_deg) + " deg (" +
+          TerminationName(summary.declared.termination) + ")" +
+          (holdout.empty() ? std::string()
+                           : ", held out " + Format("%.4f", current_holdout.rms_deg) + " deg"));
+
+  std::vector<std::string> effects_on;
+  const bool declared_ok = summary.declared.termination != IdentificationTermination::kFailed &&
+                           summary.declared.jacobian.size() > 0;
+  for (int round = 1; declared_ok && round <= options.max_rounds; ++round) {
+    LoopRound lr;
+    lr.index = round;
+    lr.effects_on = effects_on;
+    lr.rms_deg = current.errors.rms_deg_overall;
+    if (!holdout.empty()) lr.holdout_rms_deg = current_holdout.rms_deg;
+    std::vector<Eigen::MatrixXd> fitted;
+    for (const ExperimentFit& f : current.experiments) fitted.push_back(f.simulated_rad);
+    lr.evidence = DiagnoseResidual(training, fitted);
+
+    std::vector<std::string> remaining;
+    for (const std::string& c : candidates) {
+      if (std::find(effects_on.begin(), effects_on.end(), c) == effects_on.end()) {
+        remaining.push_back(c);
+      }
+    }
+    if (remaining.empty()) {
+      lr.decision = "every candidate is already in the model.";
+      summary.rounds.push_back(std::move(lr));
+      break;
+    }
+
+    // Score test: sensitivity columns of every candidate's size parameters.
+    progress(round, "scoring", "",
+             "round " + std::to_string(round) + ": scoring " + std::to_string(remaining.size()) +
+                 " candidates");
+    struct Column {
+      std::size_t candidate;
+      std::string parameter;
+      double step;
+      std::vector<Eigen::MatrixXd> angles;  // per experiment
+    };
+    std::vector<Column> columns;
+    std::vector<RunRequest> requests;
+    std::vector<std::size_t> request_column;
+    for (std::size_t c = 0; c < remaining.size(); ++c) {
+      const bool measurement = sim::FindEffect(remaining[c], "--candidates").measurement;
+      for (const std::string& q : SizeParameters(remaining[c])) {
+        Column col{c, q, ScoreStep(q), {}};
+        for (std::size_t e = 0; e < training.size(); ++e) {
+          sim::ArmParameters p = current.experiments[e].parameters;
+          sim::SetParameter(q, col.step, "loop", &p);
+          if (measurement) {
+            // Recorded from the fitted run: no simulation.
+            const ExperimentFit& f = current.experiments[e];
+            Eigen::MatrixXd a =
+                Eigen::MatrixXd::Constant(f.simulated_rad.rows(), f.simulated_rad.cols(),
+                                          std::numeric_limits<double>::quiet_NaN());
+            for (std::size_t k = 0;
+                 k < f.run.trajectory.size() && static_cast<Eigen::Index>(k) < a.rows(); ++k) {
+              const std::vector<Eigen::Vector2d> rec =
+                  sim::RecordedJointAngles(p, f.run.trajectory.frames[k]);
+              for (std::size_t j = 0; j < rec.size(); ++j) {
+                a(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(2 * j)) = rec[j].x();
+                a(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(2 * j + 1)) = rec[j].y();
+              }
+            }
+            training[e].AsMeasured(&a);
+            col.angles.push_back(std::move(a));
+          } else {
+            col.angles.emplace_back();
+            requests.push_back({e, p, false, {}});
+            request_column.push_back(columns.size());
+          }
+        }
+        columns.push_back(std::move(col));
+      }
+    }
+    {
+      std::size_t done_columns = 0;
+      std::vector<RunResult> results = training_backend->RunBatch(
+          requests, [&](std::size_t finished, std::size_t total, const RunResult&) {
+            if (finished == total || finished % 4 == 0) {
+              progress(
+                  round, "scoring", "",
+                  "  sensitivity runs " + std::to_string(finished) + "/" + std::to_string(total));
+            }
+          });
+      (void)done_columns;
+      simulations += static_cast<std::int64_t>(requests.size());
+      for (std::size_t k = 0; k < results.size(); ++k) {
+        columns[request_column[k]].angles[requests[k].experiment] =
+            std::move(results[k].angles_rad);
+      }
+    }
+    std::vector<const Eigen::MatrixXd*> base_angles;
+    for (const Eigen::MatrixXd& a : fitted) base_angles.push_back(&a);
+    const Eigen::VectorXd r = current.weighted_residuals;
+    const Eigen::MatrixXd& jb = current.jacobian;
+    const double n = static_cast<double>(r.size());
+    const double neff_ratio =
+        n > 0.0 && current.effective_samples > 0.0 ? current.effective_samples / n : 1.0;
+    const double base_reduction = Reduction(r, jb, nullptr);
+    for (std::size_t c = 0; c < remaining.size(); ++c) {
+      CandidateResult cand;
+      cand.name = remaining[c];
+      std::vector<const Column*> cols;
+      for (const Column& col : columns) {
+        if (col.candidate == c) cols.push_back(&col), cand.parameters.push_back(col.parameter);
+      }
+      // Active set: a size parameter whose linear estimate leaves its bounds
+      // (a negative friction) is dropped and the rest refitted.
+      std::vector<bool> active(cols.size(), true);
+      Eigen::VectorXd x;
+      double reduction = 0.0;
+      for (std::size_t pass = 0; pass <= cols.size(); ++pass) {
+        std::vector<std::size_t> idx;
+        for (std::size_t k = 0; k < cols.size(); ++k) {
+          if (active[k]) idx.push_back(k);
+        }
+        Eigen::MatrixXd a(r.size(), jb.cols() + static_cast<Eigen::Index>(idx.size()));
+        a.leftCols(jb.cols()) = jb;
+        for (std::size_t k = 0; k < idx.size(); ++k) {
+          std::vector<const Eigen::MatrixXd*> ca;
+          for (const Eigen::MatrixXd& m : cols[idx[k]]->angles) ca.push_back(&m);
+          a.col(jb.cols() + static_cast<Eigen::Index>(k)) =
+              Weighted(training, ca, true, base_angles) / cols[idx[k]]->step;
+        }
+        reduction = Reduction(r, a, &x) - base_reduction;
+        bool changed = false;
+        for (std::size_t k = 0; k < idx.size(); ++k) {
+          const sim::ParameterInfo& info = sim::FindParameter(cols[idx[k]]->parameter, "loop");
+          const double value = x[jb.cols() + static_cast<Eigen::Index>(k)];
+          if (value < info.lower || value > info.upper) {
+            active[idx[k]] = false;
+            changed = true;
+          } else {
+            cand.linearised[cols[idx[k]]->parameter] = value;
+          }
+        }
+        if (!changed) break;
+        cand.linearised.clear();
+      }
+      cand.score = std::max(reduction, 0.0) * neff_ratio;
+      const double dof = static_cast<double>(cols.size());
+      cand.p_value = dof > 0 ? gsl_cdf_chisq_Q(cand.score, dof) : 1.0;
+      cand.significant =
+          cand.p_value < options.score_significance / static_cast<double>(remaining.size());
+      for (const std::string& signal : sim::FindEffect(cand.name, "loop").fingerprint) {
+        if (const SignalEvidence* ev = lr.evidence.Pooled(signal)) cand.evidence.push_back(*ev);
+      }
+      lr.candidates.push_back(std::move(cand));
+    }
+    std::stable_sort(
+        lr.candidates.begin(), lr.candidates.end(),
+        [](const CandidateResult& a, const CandidateResult& b) { return a.score > b.score; });
+    for (const CandidateResult& c : lr.candidates) {
+      progress(round, "scoring", c.name,
+               "  " + c.name + ": score " + Format("%.1f", c.score) + ", p " +
+                   Format("%.2g", c.p_value) + (c.significant ? " (significant)" : ""));
+    }
+
+    // Refit the best significant few.
+    int refits = 0;
+    std::map<std::string, IdentificationSummary> refit_fits;
+    std::map<std::string, HoldoutResult> refit_holdouts;
+    for (CandidateResult& cand : lr.candidates) {
+      if (!cand.significant) {
+        cand.reason = "score test not significant (p " + Format("%.2g", cand.p_value) + ")";
+        continue;
+      }
+      if (refits >= options.refits_per_round) {
+        cand.reason = "significant, but not among the best " +
+                      std::to_string(options.refits_per_round) + " scores of the round";
+        continue;
+      }
+      ++refits;
+      progress(round, "refit", cand.name, "  refitting with " + cand.name);
+      IdentificationOptions o = options.fit;
+      o.free_parameters = free;
+      o.values = ValuesOf(current, fixed);
+      o.bounds.clear();
+      for (const auto& [name, range] : options.fit.bounds) o.bounds[name] = range;
+      for (const std::string& q : cand.parameters) {
+        const sim::ParameterInfo& info = sim::FindParameter(q, "loop");
+        const double scale = ScoreStep(q);
+        double start = cand.linearised.count(q) ? cand.linearised[q] : 0.0;
+        // Start inside the bounds with room for a difference step.
+        start = std::clamp(start, info.lower, info.upper);
+        o.free_parameters.push_back(q);
+        o.values[q] = start;
+        o.scales[q] = scale;
+      }
+      IdentificationSummary refit = Identify(training, o);
+      simulations += refit.simulations;
+      cand.refitted = true;
+      cand.simulations = refit.simulations;
+      cand.termination = TerminationName(refit.termination);
+      cand.rms_deg = refit.errors.rms_deg_overall;
+      if (refit.termination == IdentificationTermination::kFailed) {
+        cand.reason = "refit failed: " + refit.message;
+        continue;
+      }
+      const double neff = std::min(current.effective_samples, refit.effective_samples);
+      const double nres = static_cast<double>(refit.residuals);
+      const double dchi2 = 2.0 * (current.final_cost - refit.final_cost) * neff / nres;
+      cand.delta_bic = dchi2 - static_cast<double>(cand.parameters.size()) * std::log(neff);
+      for (const std::string& q : cand.parameters) {
+        if (const ParameterEstimate* est = refit.Find(q)) {
+          cand.estimates[q] = *est;
+          if (est->identifiable && (est->ci95_lower > 0.0 || est->ci95_upper < 0.0)) {
+            cand.size_significant = true;
+          }
+        }
+      }
+      HoldoutResult h = run_holdout(ValuesOf(refit, fixed));
+      if (!holdout.empty()) {
+        cand.holdout_rms_deg = h.rms_deg;
+        const double needed =
+            options.holdout_z * h.mean_square * std::sqrt(2.0 / std::max(h.effective_samples, 1.0));
+        cand.holdout_improved = h.ok && current_holdout.mean_square - h.mean_square > needed;
+      } else {
+        cand.holdout_improved = true;  // nothing held out: the criterion alone decides
+      }
+      const bool bic_ok = cand.delta_bic > options.min_delta_bic;
+      cand.accepted = bic_ok && cand.holdout_improved && cand.size_significant;
+      std::string why;
+      why += "ΔBIC " + Format("%.1f", cand.delta_bic) + (bic_ok ? " > " : " <= ") +
+             Format("%g", options.min_delta_bic);
+      if (!holdout.empty()) {
+        why += "; held-out RMS " + Format("%.4f", current_holdout.rms_deg) + " -> " +
+               Format("%.4f", h.rms_deg) + " deg" +
+               (cand.holdout_improved ? " (a real gain)" : " (no gain beyond chance)");
+      }
+      why += cand.size_significant ? "; its size is distinguishable from 0"
+                                   : "; its size is indistinguishable from 0";
+      cand.reason = why;
+      progress(round, "refit", cand.name,
+               "  " + cand.name + ": RMS " + Format("%.4f", cand.rms_deg) + " deg, " + why +
+                   (cand.accepted ? " -> passes" : " -> fails"));
+      refit_fits.emplace(cand.name, std::move(refit));
+      refit_holdouts.emplace(cand.name, std::move(h));
+    }
+
+    // The winner: the largest ΔBIC among those that pass; ties go to the simpler.
+    const CandidateResult* best = nullptr;
+    for (const CandidateResult& c : lr.candidates) {
+      if (c.accepted && (best == nullptr || c.delta_bic > best->delta_bic)) best = &c;
+    }
+    if (best == nullptr) {
+      bool any_significant = false;
+      for (const CandidateResult& c : lr.candidates) any_significant |= c.significant;
+      lr.decision = any_significant
+                        ? "no candidate earns its place: the refitted ones fail a criterion."
+                        : "no candidate earns its place: none explains a significant part of "
+                          "the residual (score test).";
+      for (CandidateResult& c : lr.candidates) c.accepted = false;
+      summary.rounds.push_back(std::move(lr));
+      progress(round, "done", "",
+               "round " + std::to_string(round) + ": " + summary.rounds.back().decision);
+      break;
+    }
+    const CandidateResult* winner = best;
+    for (const CandidateResult& c : lr.candidates) {
+      if (&c == best || !c.accepted) continue;
+      if (best->delta_bic - c.delta_bic < options.tie_delta_bic) {
+        lr.tie.push_back(c.name);
+        if (c.parameters.size() < winner->parameters.size()) winner = &c;
+      }
+    }
+    if (!lr.tie.empty()) lr.tie.push_back(best->name);
+    lr.winner = winner->name;
+    for (CandidateResult& c : lr.candidates) {
+      if (c.accepted && c.name != lr.winner) {
+        c.accepted = false;
+        c.reason += "; passes, but " + lr.winner + " explains more";
+      }
+    }
+    lr.decision =
+        "added " + lr.winner + ": ΔBIC " + Format("%.1f", winner->delta_bic) + ", training RMS " +
+        Format("%.4f", lr.rms_deg) + " -> " + Format("%.4f", winner->rms_deg) + " deg" +
+        (winner->holdout_rms_deg ? ", held-out " + Format("%.4f", *lr.holdout_rms_deg) + " -> " +
+                                       Format("%.4f", *winner->holdout_rms_deg) + " deg"
+                                 : std::string()) +
+        ".";
+    if (!lr.tie.empty()) {
+      std::string names;
+      for (const std::string& t : lr.tie) names += (names.empty() ? "" : ", ") + t;
+      lr.decision += " Tie (ΔBIC within " + Format("%g", options.tie_delta_bic) + "): " + names +
+                     "; the one with the fewest parameters is kept.";
+    }
+    progress(round, "done", lr.winner, "round " + std::to_string(round) + ": " + lr.decision);
+    for (const std::string& q : winner->parameters) free.push_back(q);
+    effects_on.push_back(lr.winner);
+    current = std::move(refit_fits.at(lr.winner));
+    current_holdout = std::move(refit_holdouts.at(lr.winner));
+    summary.rounds.push_back(std::move(lr));
+  }
+
+  summary.added_effects = effects_on;
+  summary.final_fit = current;
+  summary.after = current.errors;
+  summary.rms_after_deg = current.errors.rms_deg_overall;
+  summary.holdout_final_rad = current_holdout.angles_rad;
+  if (!holdout.empty()) {
+    summary.holdout_rms_after_deg = current_holdout.rms_deg;
+    summary.holdout_after = current_holdout.errors;
+  }
+  {
+    std::vector<Eigen::MatrixXd> fitted;
+    for (const ExperimentFit& f : current.experiments) fitted.push_back(f.simulated_rad);
+    if (!fitted.empty()) summary.final_evidence = DiagnoseResidual(training, fitted);
+  }
+  // Where the residual remains.
+  for (const ChannelDiagnostics& ch : summary.final_evidence.channels) {
+    if (!(ch.rms_deg > options.unexplained_noise_ratio * ch.noise_deg)) continue;
+    UnexplainedChannel u;
+    const ExperimentDiagnostics& ed = summary.final_evidence.experiments[ch.experiment];
+    u.experiment = ed.name;
+    u.joint = ch.joint;
+    u.axis = ch.axis;
+    u.rms_deg = ch.rms_deg;
+    u.noise_deg = ch.noise_deg;
+    for (std::size_t p = 0; p < ch.phase_rms_deg.size() && p < ed.phases.size(); ++p) {
+      if (std::isfinite(ch.phase_rms_deg[p]) && ch.phase_rms_deg[p] > u.worst_phase_rms_deg) {
+        u.worst_phase_rms_deg = ch.phase_rms_deg[p];
+        u.worst_phase = ed.phases[p].name;
+      }
+    }
+    summary.unexplained.push_back(u);
+  }
+  std::sort(summary.unexplained.begin(), summary.unexplained.end(),
+            [](const UnexplainedChannel& a, const UnexplainedChannel& b) {
+              return a.rms_deg / a.noise_deg > b.rms_deg / b.noise_deg;
+            });
+  std::ostringstream conclusion;
+  if (!declared_ok) {
+    conclusion << "the declared model's fit failed (" << summary.declared.message
+               << "); no candidate was tried.";
+  } else if (summary.added_effects.empty()) {
+    conclusion << "no effect added.";
+  } else {
+    conclusion << "added ";
+    for (std::size_t k = 0; k < summary.added_effects.size(); ++k) {
+      conclusion << (k ? ", " : "") << summary.added_effects[k];
+    }
+    conclusion << ".";
+  }
+  if (declared_ok) {
+    if (summary.unexplained.empty()) {
+      conclusion << " The residual is at the noise floor: every joint and axis within "
+                 << Format("%g", options.unexplained_noise_ratio) << "x its noise.";
+    } else {
+      const UnexplainedChannel& u = summary.unexplained.front();
+      conclusion << " Unexplained residual remains in " << summary.unexplained.size()
+                 << " joint axes (above " << Format("%g", options.unexplained_noise_ratio)
+                 << "x their noise); the largest: " << u.experiment << " joint " << u.joint
+                 << (u.axis == 0 ? " θx " : " θy ") << Format("%.4f", u.rms_deg) << " deg against "
+                 << Format("%.4f", u.noise_deg) << ", worst in " << u.worst_phase << ".";
+    }
+  }
+  summary.conclusion = conclusion.str();
+  summary.simulations = simulations;
+  summary.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+  progress(static_cast<int>(summary.rounds.size()), "done", "", summary.conclusion);
+  return summary;
+}
+
+}  // namespace ccsrm::identify

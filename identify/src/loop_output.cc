@@ -1,0 +1,278 @@
+// The loop's summary as text, JSON (ccsrm-loop/1) and a loop folder.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/identify/loop.h"
+
+namespace ccsrm::identify {
+namespace {
+
+constexpr double kDeg = 180.0 / M_PI;
+
+nlohmann::json Number(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
+}
+
+nlohmann::json Optional(const std::optional<double>& value) {
+  return value ? Number(*value) : nlohmann::json(nullptr);
+}
+
+std::string Format(const char* format, double value) {
+  if (!std::isfinite(value)) return "-";
+  char text[96];
+  std::snprintf(text, sizeof(text), format, value);
+  return text;
+}
+
+nlohmann::json PerJoint(const ChannelErrors& e) {
+  nlohmann::json joints = nlohmann::json::array();
+  for (std::size_t j = 0; j < e.rms_deg.size(); ++j) {
+    joints.push_back(
+        {{"joint", j + 1}, {"rms_deg", {Number(e.rms_deg[j][0]), Number(e.rms_deg[j][1])}}});
+  }
+  return {{"rms_deg", Number(e.rms_deg_overall)}, {"joints", joints}};
+}
+
+nlohmann::json Estimate(const ParameterEstimate& p) {
+  return {{"value", Number(p.value)},
+          {"std_error", Number(p.std_error)},
+          {"ci95", {Number(p.ci95_lower), Number(p.ci95_upper)}},
+          {"identifiable", p.identifiable},
+          {"free", p.free},
+          {"units", p.units}};
+}
+
+nlohmann::json Evidence(const std::vector<SignalEvidence>& evidence) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const SignalEvidence& s : evidence) {
+    out.push_back({{"signal", s.signal},
+                   {"value", Number(s.value)},
+                   {"band", Number(s.band)},
+                   {"significant", s.significant()}});
+  }
+  return out;
+}
+
+}  // namespace
+
+nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& training,
+                      const std::vector<Experiment>& holdout) {
+  using nlohmann::json;
+  json j;
+  j["schema"] = "ccsrm-loop/1";
+  json data = json::array();
+  for (const Experiment& e : training) {
+    data.push_back({{"name", e.name}, {"path", e.path}, {"role", "training"}});
+  }
+  for (const Experiment& e : holdout) {
+    data.push_back({{"name", e.name}, {"path", e.path}, {"role", "holdout"}});
+  }
+  j["data"] = data;
+  j["declared_free"] = s.declared.free_names;
+  json rounds = json::array();
+  for (const LoopRound& r : s.rounds) {
+    json cands = json::array();
+    for (const CandidateResult& c : r.candidates) {
+      json est = json::object();
+      for (const auto& [name, e] : c.estimates) est[name] = Estimate(e);
+      cands.push_back({{"name", c.name},
+                       {"score", Number(c.score)},
+                       {"p_value", Number(c.p_value)},
+                       {"significant", c.significant},
+                       {"parameters", c.parameters},
+                       {"linearised", c.linearised},
+                       {"evidence", Evidence(c.evidence)},
+                       {"refitted", c.refitted},
+                       {"delta_bic", c.refitted ? Number(c.delta_bic) : json(nullptr)},
+                       {"rms_deg", c.refitted ? Number(c.rms_deg) : json(nullptr)},
+                       {"holdout_rms_deg", Optional(c.holdout_rms_deg)},
+                       {"holdout_improved", c.holdout_improved},
+                       {"size_significant", c.size_significant},
+                       {"termination", c.termination},
+                       {"estimates", est},
+                       {"simulations", c.simulations},
+                       {"accepted", c.accepted},
+                       {"reason", c.reason}});
+    }
+    rounds.push_back({{"round", r.index},
+                      {"effects_on", r.effects_on},
+                      {"rms_deg", Number(r.rms_deg)},
+                      {"holdout_rms_deg", Optional(r.holdout_rms_deg)},
+                      {"evidence", ToJson(r.evidence)},
+                      {"candidates", cands},
+                      {"winner", r.winner.empty() ? json(nullptr) : json(r.winner)},
+                      {"tie", r.tie},
+                      {"decision", r.decision}});
+  }
+  j["rounds"] = rounds;
+  j["added_effects"] = s.added_effects;
+  json params = json::object();
+  for (const ParameterEstimate& p : s.final_fit.parameters) {
+    if (p.free) params[p.name] = Estimate(p);
+  }
+  j["parameters"] = params;
+  j["rms_before_deg"] = Number(s.rms_before_deg);
+  j["rms_after_deg"] = Number(s.rms_after_deg);
+  j["holdout_rms_before_deg"] = Optional(s.holdout_rms_before_deg);
+  j["holdout_rms_after_deg"] = Optional(s.holdout_rms_after_deg);
+  j["before"] = PerJoint(s.before);
+  j["after"] = PerJoint(s.after);
+  j["holdout_before"] = s.holdout_before ? PerJoint(*s.holdout_before) : json(nullptr);
+  j["holdout_after"] = s.holdout_after ? PerJoint(*s.holdout_after) : json(nullptr);
+  double floor = 0.0;
+  std::size_t count = 0;
+  for (const Experiment& e : training) {
+    for (double v : e.noise_deg) floor += v * v, ++count;
+  }
+  j["noise_floor_deg"] =
+      count ? Number(std::sqrt(floor / static_cast<double>(count))) : json(nullptr);
+  json unexplained = json::array();
+  for (const UnexplainedChannel& u : s.unexplained) {
+    unexplained.push_back({{"experiment", u.experiment},
+                           {"joint", u.joint},
+                           {"axis", u.axis == 0 ? "x" : "y"},
+                           {"rms_deg", Number(u.rms_deg)},
+                           {"noise_deg", Number(u.noise_deg)},
+                           {"worst_phase", u.worst_phase},
+                           {"worst_phase_rms_deg", Number(u.worst_phase_rms_deg)}});
+  }
+  j["unexplained"] = unexplained;
+  j["final_evidence"] = ToJson(s.final_evidence);
+  j["conclusion"] = s.conclusion;
+  j["simulations"] = s.simulations;
+  j["wall_time_s"] = Number(s.wall_time_s);
+  j["threads"] = s.threads;
+  j["declared_fit"] = {{"termination", TerminationName(s.declared.termination)},
+                       {"iterations", s.declared.iterations},
+                       {"simulations", s.declared.simulations}};
+  j["final_fit"] = {{"termination", TerminationName(s.final_fit.termination)},
+                    {"iterations", s.final_fit.iterations},
+                    {"simulations", s.final_fit.simulations}};
+  return j;
+}
+
+std::string LoopSummary::FullReport() const {
+  std::ostringstream out;
+  out << "Declared model: training RMS " << Format("%.4f", rms_before_deg) << " deg";
+  if (holdout_rms_before_deg) out << ", held out " << Format("%.4f", *holdout_rms_before_deg);
+  out << "\n";
+  for (const LoopRound& r : rounds) {
+    out << "\nRound " << r.index << " (training RMS " << Format("%.4f", r.rms_deg) << " deg)\n";
+    out << "  candidate           score     p        refit  dBIC     RMS      held-out  accepted\n";
+    for (const CandidateResult& c : r.candidates) {
+      char line[256];
+      std::snprintf(line, sizeof(line), "  %-18s %9s %8s  %-5s %8s %8s %9s  %s\n", c.name.c_str(),
+                    Format("%.1f", c.score).c_str(), Format("%.2g", c.p_value).c_str(),
+                    c.refitted ? "yes" : "no",
+                    c.refitted ? Format("%.1f", c.delta_bic).c_str() : "-",
+                    c.refitted ? Format("%.4f", c.rms_deg).c_str() : "-",
+                    c.holdout_rms_deg ? Format("%.4f", *c.holdout_rms_deg).c_str() : "-",
+                    c.accepted ? "yes" : "no");
+      out << line;
+    }
+    out << "  decision: " << r.decision << "\n";
+  }
+  out << "\nParameters of the final model:\n";
+  for (const ParameterEstimate& p : final_fit.parameters) {
+    if (!p.free) continue;
+    out << "  " << p.name << " = " << Format("%.6g", p.value);
+    if (p.identifiable) {
+      out << " ± " << Format("%.2g", p.std_error) << " " << p.units << "  (95 % ["
+          << Format("%.6g", p.ci95_lower) << ", " << Format("%.6g", p.ci95_upper) << "])";
+    } else {
+      out << " " << p.units << "  (not identifiable)";
+    }
+    out << "\n";
+  }
+  out << "\nRMS error [deg]      before    after\n";
+  out << "  training          " << Format("%.4f", rms_before_deg) << "   "
+      << Format("%.4f", rms_after_deg) << "\n";
+  if (holdout_rms_before_deg && holdout_rms_after_deg) {
+    out << "  held out          " << Format("%.4f", *holdout_rms_before_deg) << "   "
+        << Format("%.4f", *holdout_rms_after_deg) << "\n";
+  }
+  if (!unexplained.empty()) {
+    out << "\nUnexplained (RMS above the noise):\n";
+    for (std::size_t k = 0; k < unexplained.size() && k < 12; ++k) {
+      const UnexplainedChannel& u = unexplained[k];
+      out << "  " << u.experiment << " joint " << u.joint << (u.axis == 0 ? " θx " : " θy ")
+          << Format("%.4f", u.rms_deg) << " deg (noise " << Format("%.4f", u.noise_deg)
+          << "), worst in " << u.worst_phase << "\n";
+    }
+    if (unexplained.size() > 12) out << "  ... and " << unexplained.size() - 12 << " more\n";
+  }
+  out << "\n" << conclusion << "\n";
+  out << simulations << " simulations, " << Format("%.0f", wall_time_s) << " s wall on " << threads
+      << " threads\n";
+  return out.str();
+}
+
+std::vector<std::string> WriteLoopDirectory(const LoopSummary& summary,
+                                            const std::vector<Experiment>& training,
+                                            const std::vector<Experiment>& holdout,
+                                            const std::string& directory) {
+  namespace fs = std::filesystem;
+  AtomicOutputDirectory out(directory);
+  const fs::path tmp(out.temp_path());
+  std::vector<std::string> written = {(fs::path(directory) / "loop.json").string()};
+  const auto relocate = [&](const std::vector<std::string>& paths) {
+    for (const std::string& p : paths) {
+      written.push_back((fs::path(directory) / fs::relative(p, tmp)).string());
+    }
+  };
+  if (!summary.declared.experiments.empty()) {
+    relocate(WriteFitDirectory(summary.declared, training, (tmp / "declared").string()));
+  }
+  if (!summary.final_fit.experiments.empty()) {
+    relocate(WriteFitDirectory(summary.final_fit, training, (tmp / "final").string()));
+  }
+  if (!holdout.empty() && summary.holdout_declared_rad.size() == holdout.size() &&
+      summary.holdout_final_rad.size() == holdout.size()) {
+    fs::create_directory(tmp / "holdout");
+    for (std::size_t e = 0; e < holdout.size(); ++e) {
+      const Experiment& x = holdout[e];
+      std::ostringstream csv;
+      csv << "# " << x.name
+          << ": held-out joint angles [deg]: measured, the declared model's and the final "
+             "model's; empty where not measured\n";
+      csv << "time_s";
+      for (int j = 1; j <= x.joints; ++j) {
+        for (const char* axis : {"x", "y"}) {
+          csv << ",measured_theta" << axis << j << "_deg,declared_theta" << axis << j
+              << "_deg,final_theta" << axis << j << "_deg";
+        }
+      }
+      csv << "\n";
+      char value[64];
+      for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
+        std::snprintf(value, sizeof(value), "%.6f", x.frame_time_s[static_cast<std::size_t>(f)]);
+        csv << value;
+        for (Eigen::Index c = 0; c < x.measured_rad.cols(); ++c) {
+          for (const Eigen::MatrixXd* m :
+               {&x.measured_rad, &summary.holdout_declared_rad[e], &summary.holdout_final_rad[e]}) {
+            const double v = f < m->rows() ? (*m)(f, c) * kDeg : NAN;
+            if (std::isfinite(v)) {
+              std::snprintf(value, sizeof(value), ",%.6f", v);
+              csv << value;
+            } else {
+              csv << ",";
+            }
+          }
+        }
+        csv << "\n";
+      }
+      const std::string name = x.name.empty() ? "holdout" + std::to_string(e + 1) : x.name;
+      WriteTextFileAtomically((tmp / "holdout" / (name + ".angles.csv")).string(), csv.str());
+      written.push_back((fs::path(directory) / "holdout" / (name + ".angles.csv")).string());
+    }
+  }
+  WriteTextFileAtomically((tmp / "loop.json").string(),
+                          ToJson(summary, training, holdout).dump(2) + "\n");
+  out.Commit();
+  return written;
+}
+
+}  // namespace ccsrm::identify
