@@ -37,6 +37,7 @@ namespace fs = std::filesystem;
 struct GenerateArgs {
   sim::PaperRunOptions run;  // its named parameters are the truth
   double noise_mm = 0.2;
+  double resolution_mm = 0.0;
   std::uint64_t seed = 1;
   bool no_occlusions = false;
   std::string out;
@@ -210,6 +211,7 @@ int RunGenerate(const GenerateArgs& a) {
     if (changed) options.nominal_config_yaml = sim::ToYaml(nominal);
   }
   options.recording.noise_sigma_m = a.noise_mm * 1e-3;
+  options.recording.resolution_m = a.resolution_mm * 1e-3;
   options.recording.seed = a.seed;
   options.recording.occlusions.enabled = !a.no_occlusions;
   std::string error;
@@ -304,6 +306,11 @@ void AddGenerateCommand(CLI::App& root) {
   AddParameterOptions(cmd, &a->run);
   cmd->add_option("--noise-mm", a->noise_mm, "Marker noise, standard deviation [mm]")
       ->capture_default_str();
+  cmd->add_option("--resolution-mm", a->resolution_mm,
+                  "Round every marker coordinate to this resolution [mm] (the largest power of "
+                  "two in m not above it), as a C3D file's integer storage does; shrinks the "
+                  "file about four times (default 0: full precision)")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--seed", a->seed, "Seed of the noise and occlusion generator")
       ->capture_default_str();
   cmd->add_flag("--no-occlusions", a->no_occlusions, "Every marker seen in every frame");

@@ -446,7 +446,14 @@ class IterationReporter final : public ceres::IterationCallback {
     if (!residuals) return false;
     const double n = static_cast<double>(problem_->num_residuals());
     const double n_eff = problem_->EffectiveSamples(*residuals);
-    return 2.0 * (previous_cost_ - cost) * (n_eff / n) < options_.min_effective_chi2_decrease;
+    // In units of the residual variance 2 cost / (N - p), as the standard
+    // errors are: where the model cannot reach the noise (a missing effect)
+    // every residual is that much larger than the noise, and so are the
+    // cost differences chance makes.
+    const double p = static_cast<double>(problem_->num_free());
+    const double variance = n > p ? std::max(2.0 * cost / (n - p), 1.0) : 1.0;
+    return 2.0 * (previous_cost_ - cost) * (n_eff / n) / variance <
+           options_.min_effective_chi2_decrease;
   }
 
   void Report(const ceres::IterationSummary& s) {

@@ -436,9 +436,37 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
         cand.reason = "refit failed: " + refit.message;
         continue;
       }
+      // The candidate's own share of the gain: the refit's point with the
+      // candidate's size parameters at 0. A refit also moves the declared
+      // parameters; where the current fit stopped short of its optimum (a
+      // rough cost), that move alone lowers the cost, and must not be
+      // credited to the candidate. So the gain is counted from the worse of
+      // the current fit and the refit without the candidate.
+      std::map<std::string, double> without = ValuesOf(refit, fixed);
+      for (const std::string& q : cand.parameters) without[q] = 0.0;
+      double cost_without = current.final_cost;
+      {
+        std::vector<RunRequest> runs;
+        for (std::size_t e = 0; e < training.size(); ++e) {
+          runs.push_back({e, ParametersFor(training[e], without), false, {}});
+        }
+        std::vector<RunResult> results = training_backend->RunBatch(runs, nullptr);
+        simulations += static_cast<std::int64_t>(runs.size());
+        std::vector<const Eigen::MatrixXd*> angles;
+        bool ok = true;
+        for (const RunResult& run : results) {
+          ok = ok && run.summary.completed();
+          angles.push_back(&run.angles_rad);
+        }
+        if (ok) {
+          cost_without =
+              std::max(cost_without, 0.5 * Weighted(training, angles, false).squaredNorm());
+        }
+      }
+      cand.cost_without = cost_without;
       const double neff = std::min(current.effective_samples, refit.effective_samples);
       const double nres = static_cast<double>(refit.residuals);
-      const double dchi2 = 2.0 * (current.final_cost - refit.final_cost) * neff / nres;
+      const double dchi2 = 2.0 * (cost_without - refit.final_cost) * neff / nres;
       cand.delta_bic = dchi2 - static_cast<double>(cand.parameters.size()) * std::log(neff);
       for (const std::string& q : cand.parameters) {
         if (const ParameterEstimate* est = refit.Find(q)) {
@@ -450,10 +478,17 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       }
       HoldoutResult h = run_holdout(ValuesOf(refit, fixed));
       if (!holdout.empty()) {
+        // Held out likewise: from the worse of the current model and the
+        // refit without the candidate.
+        const HoldoutResult h_without = run_holdout(without);
+        const double before = h_without.ok
+                                  ? std::max(current_holdout.mean_square, h_without.mean_square)
+                                  : current_holdout.mean_square;
         cand.holdout_rms_deg = h.rms_deg;
+        cand.holdout_rms_without_deg = h_without.rms_deg;
         const double needed =
             options.holdout_z * h.mean_square * std::sqrt(2.0 / std::max(h.effective_samples, 1.0));
-        cand.holdout_improved = h.ok && current_holdout.mean_square - h.mean_square > needed;
+        cand.holdout_improved = h.ok && before - h.mean_square > needed;
       } else {
         cand.holdout_improved = true;  // nothing held out: the criterion alone decides
       }

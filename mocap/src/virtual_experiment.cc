@@ -55,6 +55,10 @@ bool VirtualRecordingOptions::IsValid(std::string* error) const {
     if (error != nullptr) *error = "noise_sigma_m must be >= 0";
     return false;
   }
+  if (!(resolution_m >= 0.0 && resolution_m <= 1e-3)) {
+    if (error != nullptr) *error = "resolution_m must be in [0, 1e-3] m";
+    return false;
+  }
   return occlusions.IsValid(error);
 }
 
@@ -98,6 +102,12 @@ datasets::Array RecordMarkers(const datasets::Array& clean, const MarkerLayout& 
   // does not depend on the occlusion settings.
   std::normal_distribution<double> noise(0.0, 1.0);
   for (double& value : recorded.values) value += options.noise_sigma_m * noise(rng);
+  if (options.resolution_m > 0.0) {
+    const int exponent = static_cast<int>(std::floor(std::log2(options.resolution_m)));
+    for (double& value : recorded.values) {
+      value = std::ldexp(std::nearbyint(std::ldexp(value, -exponent)), exponent);
+    }
+  }
 
   VirtualRecordingSummary s;
   const OcclusionOptions& o = options.occlusions;

@@ -123,8 +123,11 @@ struct IdentificationOptions {
   // (and each costs a Jacobian). Default 0.1. 0 turns the rule off.
   double converged_step_fraction = 0.1;
   // And once an accepted step lowered the effective chi-square,
-  // 2 cost N_eff / N, by less than this: a difference the data cannot tell
-  // apart. Default 1. 0 turns the rule off.
+  // 2 cost N_eff / N, by less than this many times the residual variance
+  // 2 cost / (N - p) (at least 1): a difference the data cannot tell apart.
+  // At the noise floor the variance is 1; where the model misses something
+  // the residuals, and the chance differences of the cost, are that much
+  // larger. Default 1. 0 turns the rule off.
   double min_effective_chi2_decrease = 1.0;
   // A parameter whose standard error exceeds this fraction of its scale is
   // reported as not identifiable. Default 0.25: its 95 % interval would

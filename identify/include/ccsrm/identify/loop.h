@@ -25,11 +25,16 @@
 //       (10: "very strong" evidence on Kass & Raftery's scale), with
 //       Δχ²_eff = 2 (cost before - cost after) N_eff / N and N_eff the
 //       smaller of the two fits' (the more autocorrelated residual: the
-//       conservative count);
+//       conservative count). "Before" is the larger of the current fit's
+//       cost and the cost at the refit's point with the candidate's size
+//       parameters at 0: a refit also moves the declared parameters, and
+//       where the current fit stopped short of its optimum that move alone
+//       lowers the cost; it is not the candidate's gain;
 //     - held-out error (when held-out experiments are given): their mean
-//       square error falls by more than holdout_z standard errors of a mean
-//       square of N_eff,holdout independent samples, MS_after · sqrt(2 /
-//       N_eff) (2: chance alone gives such a gain about 2 % of the time);
+//       square error falls, from the same "before", by more than holdout_z
+//       standard errors of a mean square of N_eff,holdout independent
+//       samples, MS_after · sqrt(2 / N_eff) (2: chance alone gives such a
+//       gain about 2 % of the time);
 //     - size: at least one of its size parameters is identifiable with a
 //       95 % interval that excludes 0 (an effect indistinguishable from
 //       absent is not added).
@@ -113,9 +118,13 @@ struct CandidateResult {
   std::vector<SignalEvidence> evidence;
   // Refit (when refitted).
   bool refitted = false;
+  // The cost (1/2 Σ r²) its gain is counted from: the larger of the current
+  // fit's and the refit's with the candidate's size parameters at 0.
+  double cost_without = 0.0;
   double delta_bic = 0.0;
   double rms_deg = 0.0;  // training, after its refit
   std::optional<double> holdout_rms_deg;
+  std::optional<double> holdout_rms_without_deg;  // the refit without the candidate, held out
   bool holdout_improved = false;
   bool size_significant = false;
   std::string termination;

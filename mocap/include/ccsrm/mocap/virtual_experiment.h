@@ -37,6 +37,13 @@ struct OcclusionOptions {
 struct VirtualRecordingOptions {
   // Standard deviation of the isotropic Gaussian noise on every coordinate [m].
   double noise_sigma_m = 0.2e-3;
+  // Resolution of the recorded coordinates [m]: after the noise, every
+  // coordinate is rounded to a multiple of the largest power of two (in m)
+  // not above it, as a C3D file's integer storage with its POINT:SCALE
+  // rounds (0.1 mm: 2^-14 m = 0.061 mm). A power of two leaves the low
+  // mantissa bits zero, so the HDF5 file's shuffle and deflate shrink it
+  // about four times. Default 0: full double precision.
+  double resolution_m = 0.0;
   OcclusionOptions occlusions;
   // Seed of the std::mt19937_64 generator.
   std::uint64_t seed = 1;
