@@ -194,11 +194,11 @@ Section ErrorSection(const LoopFolder& loop) {
   overall.columns = {{"data", "data", "", kRms},
                      {"before_deg", "declared model", "deg", kRms},
                      {"after_deg", "final model", "deg", kRms}};
-  overall.AddRow({Cell::Text("training"), Cell::Number(loop.before.rms_deg),
-                  Cell::Number(loop.after.rms_deg)});
-  if (held) {
-    overall.AddRow({Cell::Text("held out"), Cell::Number(loop.holdout_before->rms_deg),
-                    Cell::Number(loop.holdout_after->rms_deg)});
+  overall.AddRow({Cell::Text("training"), Cell::Number(loop.rms_before_deg),
+                  Cell::Number(loop.rms_after_deg)});
+  if (std::isfinite(loop.holdout_rms_before_deg) || std::isfinite(loop.holdout_rms_after_deg)) {
+    overall.AddRow({Cell::Text("held out"), Cell::Number(loop.holdout_rms_before_deg),
+                    Cell::Number(loop.holdout_rms_after_deg)});
   }
   Table per_joint;
   per_joint.id = "errors_per_joint";

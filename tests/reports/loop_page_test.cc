@@ -581,7 +581,9 @@ TEST(LoopPage, AFailedDeclaredFitGivesAPageThatSaysSo) {
   loop["added_effects"] = json::array();
   loop["parameters"] = json::object();
   loop["unexplained"] = json::array();
+  loop["holdout_rms_before_deg"] = nullptr;
   loop["holdout_rms_after_deg"] = nullptr;
+  loop["holdout_before"] = nullptr;
   loop["holdout_after"] = nullptr;
   loop["declared_fit"]["termination"] = "failed";
   loop["final_evidence"] = {{"rms_deg", 0.0},
