@@ -680,9 +680,10 @@ Table UnexplainedTable(const LoopFolder& loop) {
   table.id = "unexplained";
   table.title = "Joint axes the final model does not explain";
   table.caption =
-      "loop.json 'unexplained': every experiment, joint and axis whose RMS residual exceeds 1.5 "
-      "times its measurement noise, largest ratio first, with the phase of the protocol where "
-      "it is largest.";
+      "loop.json 'unexplained': every experiment, joint and axis whose RMS residual exceeds its "
+      "measurement noise by more than the loop's ratio (LoopOptions::unexplained_noise_ratio, "
+      "1.5 by default), largest ratio first, with the phase of the protocol where it is "
+      "largest.";
   table.columns = {{"experiment", "experiment", "", kRms},
                    {"joint", "joint", "", kCount},
                    {"axis", "axis", "", kRms},
@@ -754,13 +755,14 @@ Table PhaseTable(const LoopDiagnostics& d) {
 
 Section UnexplainedSection(const LoopFolder& loop) {
   Section section{"unexplained", "What remains unexplained", {}};
+  const std::size_t n = loop.unexplained.size();
   section.blocks.push_back(Paragraph{
-      loop.conclusion + " " +
-          (loop.unexplained.empty()
-               ? std::string("No joint axis has a residual above 1.5 times its noise.")
-               : Plural(static_cast<double>(loop.unexplained.size()), "joint axis") +
-                     " keep a residual above 1.5 times their noise (table below); the signals "
-                     "it still follows point to what the effect library lacks."),
+      "Conclusion: " + loop.conclusion + " " +
+          (n == 0 ? std::string("No joint axis keeps a residual above its noise threshold.")
+                  : Show(static_cast<double>(n), kCount) +
+                        (n == 1 ? " joint axis keeps" : " joint axes keep") +
+                        " a residual above its noise threshold (table below); the signals the "
+                        "residual still follows point to what the effect library lacks."),
       false});
   section.blocks.push_back(UnexplainedTable(loop));
   section.blocks.push_back(PhaseTable(loop.final_evidence));

@@ -420,6 +420,8 @@ TEST(LoopPage, KnownLoopShowsItsNumbers) {
   EXPECT_THAT(headline.text, HasSubstr("the held-out error from 0.1212 to 0.0523 deg"));
   const Paragraph& conclusion = std::get<Paragraph>(document.sections[0].blocks[1]);
   EXPECT_THAT(conclusion.text, HasSubstr("worst in motion 2"));
+  const Paragraph& remains = std::get<Paragraph>(document.sections.back().blocks[0]);
+  EXPECT_THAT(remains.text, HasSubstr("2 joint axes keep a residual above its noise threshold"));
   const json round2 = summary["sections"][5];
   EXPECT_EQ(round2["id"], "round-2");
 
