@@ -7,7 +7,7 @@
 // final/ and holdout/.
 #include <algorithm>
 #include <cmath>
-#include <set>
+#include <filesystem>
 #include <string>
 
 #include "ccsrm/common/error.h"
@@ -123,7 +123,7 @@ Section SummarySection(const LoopFolder& loop) {
   }
   section.blocks.push_back(Paragraph{
       "The fits of the declared and the final model have pages of their own: ccsrm report --in " +
-          loop.folder + "/declared (or /final).",
+          (std::filesystem::path(loop.folder) / "declared").string() + " (or final).",
       false});
   section.blocks.push_back(LoopTable(loop));
   section.blocks.push_back(DataTable(loop));
@@ -330,10 +330,11 @@ Section TrainingResidualSection(const LoopFolder& loop) {
     for (const internal::FitExperiment& x : loop.final_model->experiments) {
       if (x.name == before.name) after = &x;
     }
-    if (after == nullptr) {
-      section.blocks.push_back(Paragraph{
-          "final/fit.json has no experiment " + before.name + ": its residuals are not shown.",
-          true});
+    if (after == nullptr || after->residual_deg.shape[1] != before.residual_deg.shape[1]) {
+      section.blocks.push_back(
+          Paragraph{"final/ has no experiment " + before.name +
+                        " with the joints of declared/: its residuals are not shown.",
+                    true});
       continue;
     }
     const std::string stem =

@@ -575,6 +575,33 @@ TEST(LoopPage, MissingFitFoldersAndHeldOutFilesAreNotices) {
   }
 }
 
+TEST(LoopPage, AFinalFitOfAnotherArmIsANoticeNotACrash) {
+  const fs::path dir = WriteLoopFolder("other_arm", KnownLoopJson());
+  // final/ with the angles of 11 joints: nothing to put beside declared/.
+  std::string csv = testing::KnownAnglesCsv(1.0);
+  std::string cut;
+  std::size_t start = 0;
+  while (start < csv.size()) {
+    const std::size_t end = csv.find('\n', start);
+    std::string line = csv.substr(start, end - start);
+    if (line[0] != '#') {
+      // Drop the last joint's 6 columns.
+      for (int k = 0; k < 6; ++k) line.erase(line.rfind(','));
+    }
+    cut += line + "\n";
+    start = end + 1;
+  }
+  WriteTextFileAtomically((dir / "final" / "g4.angles.csv").string(), cut);
+  json fit = testing::KnownFitJson();
+  fit["experiments"][0]["noise_deg"].erase(11);
+  fit["experiments"][0]["start"]["per_joint"].erase(11);
+  fit["experiments"][0]["fitted"]["per_joint"].erase(11);
+  WriteTextFileAtomically((dir / "final" / "fit.json").string(), fit.dump());
+  const Document document = BuildLoopDocument(dir.string(), ReportOptions());
+  ASSERT_FALSE(document.notices().empty());
+  EXPECT_THAT(document.notices()[0], HasSubstr("with the joints of declared/"));
+}
+
 TEST(LoopPage, AFailedDeclaredFitGivesAPageThatSaysSo) {
   // What ccsrm loop writes when the declared model's fit fails: no rounds,
   // empty diagnostics, no fit folders, no held-out errors.
