@@ -1,5 +1,6 @@
-// ccsrm report --in run.h5|exp.h5|fit/ --out report/: an HTML page with
-// gnuplot figures and a JSON summary of a run, an experiment or a fit.
+// ccsrm report --in run.h5|exp.h5|fit/|loop/ --out report/: an HTML page
+// with gnuplot figures and a JSON summary of a run, an experiment, a fit or
+// a loop.
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -14,7 +15,7 @@ void AddReportCommand(CLI::App& root) {
   CLI::App* cmd = root.add_subcommand(
       "report",
       "Write an HTML report (index.html, figures/, summary.json) of a ccsrm-run/1 or "
-      "ccsrm-dataset/1 file, or of a fit folder (ccsrm identify)");
+      "ccsrm-dataset/1 file, or of a fit folder (ccsrm identify) or a loop folder (ccsrm loop)");
   struct Args {
     std::string in;
     std::string out;
@@ -23,8 +24,8 @@ void AddReportCommand(CLI::App& root) {
   };
   auto a = std::make_shared<Args>();
   cmd->add_option("--in", a->in,
-                  "Run (ccsrm simulate), experiment (ccsrm generate, mocap process) or fit "
-                  "folder (ccsrm identify)")
+                  "Run (ccsrm simulate), experiment (ccsrm generate, mocap process), fit "
+                  "folder (ccsrm identify) or loop folder (ccsrm loop)")
       ->required();
   cmd->add_option("--out", a->out,
                   "Report folder; an existing one is replaced only if it holds an earlier report")

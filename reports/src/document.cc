@@ -62,6 +62,7 @@ th, td { padding: 3px 10px; border-bottom: 1px solid #e6e6ea; text-align: left; 
 td { white-space: nowrap; }
 th { background: #eef0f4; font-weight: 600; vertical-align: bottom; min-width: 4.5em; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; }
+td.wrap { white-space: normal; min-width: 14em; max-width: 36em; }
 tbody tr:nth-child(even) { background: #fafafc; }
 .caption { color: #555; font-size: 13px; margin: 2px 0 14px; }
 figure { margin: 10px 0 18px; }
@@ -79,7 +80,9 @@ void WriteTable(const Table& table, std::ostream& out) {
     out << "<tr>";
     for (std::size_t i = 0; i < row.size(); ++i) {
       const bool number = row[i].kind != Cell::Kind::kText;
-      out << (number ? "<td class=\"num\">" : "<td>")
+      out << (number                  ? "<td class=\"num\">"
+              : table.columns[i].wrap ? "<td class=\"wrap\">"
+                                      : "<td>")
           << Escape(FormatCell(row[i], table.columns[i])) << "</td>";
     }
     out << "</tr>\n";

@@ -1,14 +1,11 @@
 #include "fit_folder.h"
 
-#include <cerrno>
-#include <cstdlib>
 #include <exception>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "angles_csv.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/datasets/run_file.h"
 
@@ -18,73 +15,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// Reads values out of fit.json; every error names the file and the key's
-// path ("parameters.T_p.value").
-class FitJson {
- public:
-  explicit FitJson(std::string file) : file_(std::move(file)) {}
-
-  [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
-    ThrowInputError(file_, "key '" + key + "'", what);
-  }
-
-  const json& At(const json& object, const std::string& parent, const std::string& key) const {
-    const std::string path = parent.empty() ? key : parent + "." + key;
-    if (!object.is_object()) Fail(parent, "expected an object");
-    const auto it = object.find(key);
-    if (it == object.end()) Fail(path, "missing");
-    return *it;
-  }
-
-  // A number; null is NaN where `nullable` (JSON has no NaN or infinity).
-  double Number(const json& value, const std::string& key, bool nullable = false) const {
-    if (value.is_null() && nullable) return kUnknown;
-    if (!value.is_number()) Fail(key, nullable ? "expected a number or null" : "expected a number");
-    return value.get<double>();
-  }
-  double NumberAt(const json& object, const std::string& parent, const std::string& key,
-                  bool nullable = false) const {
-    return Number(At(object, parent, key), Join(parent, key), nullable);
-  }
-  std::string Text(const json& object, const std::string& parent, const std::string& key) const {
-    const json& value = At(object, parent, key);
-    if (!value.is_string()) Fail(Join(parent, key), "expected a string");
-    return value.get<std::string>();
-  }
-  bool Flag(const json& object, const std::string& parent, const std::string& key) const {
-    const json& value = At(object, parent, key);
-    if (!value.is_boolean()) Fail(Join(parent, key), "expected true or false");
-    return value.get<bool>();
-  }
-  const json& List(const json& object, const std::string& parent, const std::string& key) const {
-    const json& value = At(object, parent, key);
-    if (!value.is_array()) Fail(Join(parent, key), "expected a list");
-    return value;
-  }
-  std::vector<double> Numbers(const json& object, const std::string& parent, const std::string& key,
-                              bool nullable = false) const {
-    const json& list = List(object, parent, key);
-    std::vector<double> out;
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      out.push_back(Number(list[i], Join(parent, key) + "[" + std::to_string(i) + "]", nullable));
-    }
-    return out;
-  }
-  // A pair [a, b] of numbers.
-  std::array<double, 2> Pair(const json& value, const std::string& key, bool nullable) const {
-    if (!value.is_array() || value.size() != 2) Fail(key, "expected a list of two numbers");
-    return {Number(value[0], key + "[0]", nullable), Number(value[1], key + "[1]", nullable)};
-  }
-
-  static std::string Join(const std::string& parent, const std::string& key) {
-    return parent.empty() ? key : parent + "." + key;
-  }
-
- private:
-  std::string file_;
-};
-
-FitErrors ReadErrors(const FitJson& in, const json& object, const std::string& key) {
+FitErrors ReadErrors(const JsonReader& in, const json& object, const std::string& key) {
   FitErrors errors;
   errors.rms_deg = in.NumberAt(object, key, "rms_deg", true);
   errors.fit_percent = in.NumberAt(object, key, "fit_percent", true);
@@ -102,7 +33,7 @@ FitErrors ReadErrors(const FitJson& in, const json& object, const std::string& k
   return errors;
 }
 
-FitParameter ReadParameter(const FitJson& in, const json& entry, const std::string& name) {
+FitParameter ReadParameter(const JsonReader& in, const json& entry, const std::string& name) {
   const std::string at = "parameters." + name;
   FitParameter p;
   p.name = name;
@@ -126,99 +57,14 @@ FitParameter ReadParameter(const FitJson& in, const json& entry, const std::stri
   return p;
 }
 
-// One row of the angles file: comma-separated cells, empty = not measured.
-std::vector<std::string> SplitCells(const std::string& line) {
-  std::vector<std::string> cells;
-  std::string cell;
-  std::istringstream stream(line);
-  while (std::getline(stream, cell, ',')) cells.push_back(cell);
-  if (!line.empty() && line.back() == ',') cells.push_back("");
-  return cells;
-}
-
-// <name>.angles.csv: a comment line, the header time_s, then for joint
-// j = 1..J and axis x, y: measured_theta<axis><j>_deg,
-// fitted_theta<axis><j>_deg, residual_theta<axis><j>_deg.
+// <name>.angles.csv: measured, fitted and residual angles of every joint.
 void ReadAnglesFile(const std::string& file, FitExperiment* e) {
-  std::ifstream in(file);
-  if (!in) ThrowInputError(file, "", "cannot be read (the angles file fit.json names)");
-  std::string line;
-  int number = 0;
-  std::vector<std::string> header;
-  while (std::getline(in, line)) {
-    ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty() || line[0] == '#') continue;
-    header = SplitCells(line);
-    break;
-  }
-  const std::string where = "line " + std::to_string(number);
-  if (header.empty() || header[0] != "time_s" || (header.size() - 1) % 6 != 0 ||
-      header.size() < 7) {
-    ThrowInputError(file, where,
-                    "expected the header time_s,measured_thetax1_deg,fitted_thetax1_deg,"
-                    "residual_thetax1_deg,... (6 columns per joint)");
-  }
-  const std::size_t joints = (header.size() - 1) / 6;
-  const char* kinds[] = {"measured", "fitted", "residual"};
-  for (std::size_t j = 0; j < joints; ++j) {
-    for (std::size_t c = 0; c < 2; ++c) {
-      for (std::size_t k = 0; k < 3; ++k) {
-        const std::string want = std::string(kinds[k]) + "_theta" + (c == 0 ? "x" : "y") +
-                                 std::to_string(j + 1) + "_deg";
-        const std::size_t column = 1 + 6 * j + 3 * c + k;
-        if (header[column] != want) {
-          ThrowInputError(file, where,
-                          "column " + std::to_string(column + 1) + " is '" + header[column] +
-                              "', expected '" + want + "'");
-        }
-      }
-    }
-  }
-  std::vector<std::vector<double>> rows;
-  while (std::getline(in, line)) {
-    ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty() || line[0] == '#') continue;
-    const std::vector<std::string> cells = SplitCells(line);
-    if (cells.size() != header.size()) {
-      ThrowInputError(
-          file, "line " + std::to_string(number),
-          std::to_string(cells.size()) + " cells, expected " + std::to_string(header.size()));
-    }
-    std::vector<double> row(cells.size(), kUnknown);
-    for (std::size_t i = 0; i < cells.size(); ++i) {
-      if (cells[i].empty() && i > 0) continue;
-      char* end = nullptr;
-      errno = 0;
-      row[i] = std::strtod(cells[i].c_str(), &end);
-      if (cells[i].empty() || *end != '\0' || errno != 0) {
-        ThrowInputError(file, "line " + std::to_string(number),
-                        "column " + std::to_string(i + 1) + " ('" + header[i] + "'): '" + cells[i] +
-                            "' is not a number");
-      }
-    }
-    if (!rows.empty() && !(row[0] > rows.back()[0])) {
-      ThrowInputError(file, "line " + std::to_string(number), "times must increase");
-    }
-    rows.push_back(std::move(row));
-  }
-  if (rows.empty()) ThrowInputError(file, "", "has no frames");
-  const std::size_t frames = rows.size();
-  e->measured_deg = datasets::Array({frames, joints, 2});
-  e->fitted_deg = datasets::Array({frames, joints, 2});
-  e->residual_deg = datasets::Array({frames, joints, 2});
-  for (std::size_t f = 0; f < frames; ++f) {
-    e->time_s.push_back(rows[f][0]);
-    for (std::size_t j = 0; j < joints; ++j) {
-      for (std::size_t c = 0; c < 2; ++c) {
-        const std::size_t column = 1 + 6 * j + 3 * c;
-        e->measured_deg.at(f, j, c) = rows[f][column];
-        e->fitted_deg.at(f, j, c) = rows[f][column + 1];
-        e->residual_deg.at(f, j, c) = rows[f][column + 2];
-      }
-    }
-  }
+  AnglesCsv angles =
+      ReadAnglesCsv(file, {"measured", "fitted", "residual"}, "the angles file fit.json names");
+  e->time_s = std::move(angles.time_s);
+  e->measured_deg = std::move(angles.series[0]);
+  e->fitted_deg = std::move(angles.series[1]);
+  e->residual_deg = std::move(angles.series[2]);
 }
 
 // The segments of the arm the experiment was fitted with, from the fitted
@@ -250,7 +96,7 @@ void ReadSegments(const std::string& run_file, FitExperiment* e) {
   }
 }
 
-FitExperiment ReadExperiment(const FitJson& in, const json& entry, std::size_t index,
+FitExperiment ReadExperiment(const JsonReader& in, const json& entry, std::size_t index,
                              const fs::path& folder) {
   const std::string at = "experiments[" + std::to_string(index) + "]";
   FitExperiment e;
@@ -302,18 +148,8 @@ FitFolder ReadFitFolder(const std::string& folder) {
   const fs::path path = fs::path(folder) / "fit.json";
   if (!fs::is_regular_file(path, ec)) ThrowInputError(folder, "", "not a fit folder (no fit.json)");
   const std::string file = path.string();
-  std::ifstream stream(path);
-  const json root = json::parse(stream, nullptr, /*allow_exceptions=*/false);
-  if (root.is_discarded()) ThrowInputError(file, "", "not valid JSON");
-  if (!root.is_object() || !root.contains("schema")) {
-    ThrowInputError(file, "", std::string("no 'schema' key; expected schema ") + kFitSchema);
-  }
-  if (root["schema"] != kFitSchema) {
-    ThrowInputError(file, "key 'schema'",
-                    "is " + root["schema"].dump() + ", expected \"" + kFitSchema +
-                        "\" (written by ccsrm identify)");
-  }
-  const FitJson in(file);
+  const json root = ReadSchemaFile(file, kFitSchema, "ccsrm identify");
+  const JsonReader in(file);
   FitFolder fit;
   fit.folder = folder;
   fit.converged = in.Flag(root, "", "converged");

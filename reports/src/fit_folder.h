@@ -6,20 +6,18 @@
 // kept as written; the page computes none of them again.
 #include <array>
 #include <cstddef>
-#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "arm_facts.h"
 #include "ccsrm/datasets/array.h"
+#include "json_reader.h"
 
 namespace ccsrm::reports::internal {
 
 // "ccsrm-fit/1": the schema of fit.json.
 inline constexpr const char* kFitSchema = "ccsrm-fit/1";
-
-inline constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
 
 // One parameter of fit.json's `parameters`. The fields after `value` are
 // written for free parameters only; a null (not identifiable) is NaN.

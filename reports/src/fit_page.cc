@@ -6,7 +6,6 @@
 // experiments with their noise. Every number is read from fit.json or the
 // angles files as ccsrm identify wrote them.
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <set>
 #include <string>
@@ -22,10 +21,17 @@ namespace {
 
 using internal::AddText;
 using internal::AddValue;
+using internal::AxisName;
+using internal::FigureStem;
 using internal::FitErrors;
 using internal::FitExperiment;
 using internal::FitFolder;
 using internal::FitParameter;
+using internal::Key;
+using internal::ListNames;
+using internal::Plural;
+using internal::Show;
+using internal::UnitSuffix;
 
 // Number formats, one per quantity, shared by tables and text.
 const NumberFormat kValue = NumberFormat::Significant(4);     // parameters
@@ -35,51 +41,6 @@ const NumberFormat kPercent = NumberFormat::Fixed(1);         // fit percent
 const NumberFormat kCorrelation = NumberFormat::Fixed(2);     // as on the heat map
 const NumberFormat kSingular = NumberFormat::Significant(4);
 const NumberFormat kCost = NumberFormat::Significant(6);
-
-// "T_p" -> "t_p", "friction.mu_v" -> "friction_mu_v": a JSON column key.
-std::string Key(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (std::isalnum(static_cast<unsigned char>(c))) {
-      out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    } else if (!out.empty() && out.back() != '_') {
-      out += '_';
-    }
-  }
-  while (!out.empty() && out.back() == '_') out.pop_back();
-  return out.empty() ? "x" : out;
-}
-
-// A file stem for an experiment's figures: letters, digits, '_' and '-'.
-std::string FigureStem(const std::string& name) {
-  std::string out;
-  for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) || c == '-' ? c : '_';
-  return out;
-}
-
-// How a number shows on the page (the text the summary quotes).
-std::string Show(double value, NumberFormat format) {
-  return FormatCell(Cell::Number(value, format), Column{});
-}
-
-// " N", or nothing for a pure number.
-std::string UnitSuffix(const std::string& units) {
-  return units.empty() || units == "1" ? "" : " " + units;
-}
-
-std::string Plural(double n, const std::string& noun) {
-  return Show(n, NumberFormat::Integer()) + " " + noun + (n == 1.0 ? "" : "s");
-}
-
-const char* AxisName(int c) { return c == 0 ? "θx" : "θy"; }
-
-std::string ListNames(const std::vector<std::string>& names) {
-  std::string out;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    out += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
-  }
-  return out;
-}
 
 // ---------------------------------------------------------------- summary
 

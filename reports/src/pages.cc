@@ -1,6 +1,7 @@
 #include "pages.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 
@@ -142,6 +143,47 @@ void AddValue(Table* table, const std::string& quantity, double value, const std
 
 void AddText(Table* table, const std::string& quantity, const std::string& text) {
   table->AddRow({Cell::Text(quantity), Cell::Text(text), Cell::Text("")});
+}
+
+std::string Show(double value, NumberFormat format) {
+  return FormatCell(Cell::Number(value, format), Column{});
+}
+
+std::string Plural(double n, const std::string& noun) {
+  return Show(n, NumberFormat::Integer()) + " " + noun + (n == 1.0 ? "" : "s");
+}
+
+std::string ListNames(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    out += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
+  }
+  return out;
+}
+
+std::string UnitSuffix(const std::string& units) {
+  return units.empty() || units == "1" ? "" : " " + units;
+}
+
+const char* AxisName(int c) { return c == 0 ? "θx" : "θy"; }
+
+std::string Key(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (std::isalnum(static_cast<unsigned char>(c))) {
+      out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    } else if (!out.empty() && out.back() != '_') {
+      out += '_';
+    }
+  }
+  while (!out.empty() && out.back() == '_') out.pop_back();
+  return out.empty() ? "x" : out;
+}
+
+std::string FigureStem(const std::string& name) {
+  std::string out;
+  for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) || c == '-' ? c : '_';
+  return out;
 }
 
 }  // namespace ccsrm::reports::internal

@@ -60,4 +60,21 @@ void AddValue(Table* table, const std::string& quantity, double value, const std
               NumberFormat format);
 void AddText(Table* table, const std::string& quantity, const std::string& text);
 
+// Text helpers of the fit and loop pages, so a sentence quotes a number as
+// its table shows it.
+// The text `value` shows as in a table cell of that format.
+std::string Show(double value, NumberFormat format);
+// "3 iterations", "1 thread".
+std::string Plural(double n, const std::string& noun);
+// "a", "a and b", "a, b and c".
+std::string ListNames(const std::vector<std::string>& names);
+// " N" after a value, or nothing for a pure number (units "" or "1").
+std::string UnitSuffix(const std::string& units);
+// "θx" (c = 0) or "θy".
+const char* AxisName(int c);
+// "T_p" -> "t_p", "friction.mu_v" -> "friction_mu_v": a JSON column key.
+std::string Key(const std::string& text);
+// A file stem for a figure: letters, digits, '_' and '-' ("g5 slow" -> "g5_slow").
+std::string FigureStem(const std::string& name);
+
 }  // namespace ccsrm::reports::internal

@@ -14,6 +14,7 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/datasets/inspect.h"
 #include "fit_folder.h"
+#include "loop_folder.h"
 
 namespace ccsrm::reports {
 namespace {
@@ -146,16 +147,21 @@ ReportSummary MakeReport(const std::string& input, const std::string& output_fol
   std::error_code ec;
   if (!fs::exists(input, ec)) ThrowInputError(input, "", "no such file");
   const bool folder = fs::is_directory(input, ec);
-  if (!folder && fs::path(input).filename() == "fit.json") {
+  const std::string name = fs::path(input).filename().string();
+  if (!folder && (name == "fit.json" || name == "loop.json")) {
     const fs::path parent = fs::path(input).parent_path();
     ThrowInputError(input, "",
-                    "a fit is reported from its folder: ccsrm report --in " +
+                    std::string(name == "fit.json" ? "a fit" : "a loop") +
+                        " is reported from its folder: ccsrm report --in " +
                         (parent.empty() ? std::string(".") : parent.string()));
   }
-  if (folder && !internal::LooksLikeFitFolder(input)) {
+  // A loop folder holds fit folders but no fit.json of its own.
+  const bool loop = folder && internal::LooksLikeLoopFolder(input);
+  if (folder && !loop && !internal::LooksLikeFitFolder(input)) {
     ThrowInputError(input, "",
-                    "not a fit folder (no fit.json); expected a ccsrm-run/1 or ccsrm-dataset/1 "
-                    "file, or a folder written by ccsrm identify");
+                    "not a fit or loop folder (no fit.json or loop.json); expected a ccsrm-run/1 "
+                    "or ccsrm-dataset/1 file, or a folder written by ccsrm identify or ccsrm "
+                    "loop");
   }
   if (IsInside(input, output_folder)) {
     ThrowInputError(output_folder, "",
@@ -166,7 +172,7 @@ ReportSummary MakeReport(const std::string& input, const std::string& output_fol
   Document document;
   if (folder) {
     FindGnuplot(options.plot);
-    document = BuildFitDocument(input, options);
+    document = loop ? BuildLoopDocument(input, options) : BuildFitDocument(input, options);
   } else {
     const datasets::AnyFile file = datasets::ReadAnyFile(input);
     FindGnuplot(options.plot);

@@ -1,5 +1,6 @@
 // `ccsrm report` as a user runs it, on a short paper case-2 run and a
-// generated, processed experiment that the program itself makes: the page
+// generated, processed experiment that the program itself makes (and, for
+// bad input, a fit and a loop folder with a broken JSON file): the page
 // references only files that exist, its tables equal summary.json, the run's
 // stored numbers come through unchanged, bad input gets one line and exit 2,
 // and an existing report is replaced whole or not at all.
@@ -224,9 +225,10 @@ TEST(ReportCli, BadInputGetsOneLineAndExitStatus2) {
   const std::string out = (dir / "report").string();
   ExpectOneLineError(RunCcsrm("report --in " + (dir / "missing.h5").string() + " --out " + out),
                      "missing.h5: no such file");
-  ExpectOneLineError(RunCcsrm("report --in " + dir.string() + " --out " + out),
-                     "not a fit folder (no fit.json); expected a ccsrm-run/1 or ccsrm-dataset/1 "
-                     "file, or a folder written by ccsrm identify");
+  ExpectOneLineError(
+      RunCcsrm("report --in " + dir.string() + " --out " + out),
+      "not a fit or loop folder (no fit.json or loop.json); expected a ccsrm-run/1 "
+      "or ccsrm-dataset/1 file, or a folder written by ccsrm identify or ccsrm loop");
   fs::create_directories(dir / "fit");
   ccsrm::WriteTextFileAtomically((dir / "fit" / "fit.json").string(),
                                  "{\"schema\": \"ccsrm-run/1\"}");
@@ -235,6 +237,16 @@ TEST(ReportCli, BadInputGetsOneLineAndExitStatus2) {
       "fit.json: a fit is reported from its folder: ccsrm report --in " + (dir / "fit").string());
   ExpectOneLineError(RunCcsrm("report --in " + (dir / "fit").string() + " --out " + out),
                      "fit.json: key 'schema': is \"ccsrm-run/1\", expected \"ccsrm-fit/1\"");
+  // A loop folder whose loop.json lacks a key: named with the file.
+  fs::create_directories(dir / "loop");
+  ccsrm::WriteTextFileAtomically((dir / "loop" / "loop.json").string(),
+                                 "{\"schema\": \"ccsrm-loop/1\", \"data\": []}");
+  ExpectOneLineError(
+      RunCcsrm("report --in " + (dir / "loop" / "loop.json").string() + " --out " + out),
+      "loop.json: a loop is reported from its folder: ccsrm report --in " +
+          (dir / "loop").string());
+  ExpectOneLineError(RunCcsrm("report --in " + (dir / "loop").string() + " --out " + out),
+                     (dir / "loop" / "loop.json").string() + ": key 'declared_free': missing");
   ExpectOneLineError(RunCcsrm("report --in " + Paper() + " --out " + out), "paper.yaml: ");
   EXPECT_FALSE(fs::exists(out));
   // Output: inside a missing folder, onto a file, onto a folder of other

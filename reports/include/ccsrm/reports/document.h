@@ -53,6 +53,9 @@ struct Column {
   std::string header;   // shown on the page
   std::string unit;     // shown as "[unit]" after the header; empty for none
   NumberFormat format;  // default for the column's numbers
+  // Long text (a reason, a decision): the cell wraps at a readable width
+  // instead of widening the table.
+  bool wrap = false;
 };
 
 struct Table {
@@ -91,7 +94,7 @@ struct Section {
 };
 
 struct Document {
-  std::string kind;           // "run", "experiment" or "fit"
+  std::string kind;           // "run", "experiment", "fit" or "loop"
   std::string title;          // e.g. "Simulation run — paper case 2"
   std::string source;         // the input file as given on the command line
   std::string created;        // ISO 8601 UTC time the report was made

@@ -38,7 +38,7 @@ struct ReportOptions {
 struct ReportSummary {
   std::string input;   // the file reported on
   std::string output;  // the report folder
-  std::string kind;    // "run", "experiment" or "fit"
+  std::string kind;    // "run", "experiment", "fit" or "loop"
   std::string title;
   int figures = 0;
   int tables = 0;
@@ -76,6 +76,20 @@ Document BuildExperimentDocument(const datasets::ExperimentFile& experiment,
 // file (naming the file and the key or line).
 Document BuildFitDocument(const std::string& folder, const ReportOptions& options);
 
+// The page of a loop folder written by `ccsrm loop` (loop.json of schema
+// ccsrm-loop/1; declared/ and final/, the fit folders of the declared and
+// the final model; holdout/<name>.angles.csv per held-out experiment): the
+// error before and after on training and held-out data, overall and per
+// joint; the residuals of both models; per round, the residual's
+// cross-correlation with each signal, the candidates' evidence, scores,
+// refits and the decision; the final parameters with their intervals; what
+// remains unexplained. Every number in a table as loop.json gives it.
+// Throws InputError for invalid options, "<folder>: not a loop folder (no
+// loop.json)", a loop.json of another schema, a missing key or a value of
+// the wrong type (naming loop.json and the key), or a broken fit folder or
+// angles file. A missing declared/, final/ or held-out file is a notice.
+Document BuildLoopDocument(const std::string& folder, const ReportOptions& options);
+
 // Renders every figure of `document` with gnuplot into <folder>/figures,
 // then writes <folder>/index.html and <folder>/summary.json, all inside a
 // temporary folder beside the target that replaces it only when complete
@@ -89,9 +103,10 @@ void WriteReport(Document* document, const std::string& folder, const ReportOpti
 // What `ccsrm report` does: checks the options, that gnuplot is there and
 // that the output may be written (as WriteReport; and the input must not lie
 // inside it), reads `input` once (a ccsrm-run/1 or ccsrm-dataset/1 file,
-// or a fit folder), builds its page and writes it. Throws InputError naming
-// the path for a missing input, a folder without fit.json, or a file of
-// another kind; PlotError as WriteReport.
+// a fit folder or a loop folder), builds its page and writes it. Throws
+// InputError naming the path for a missing input, a folder with neither
+// fit.json nor loop.json, or a file of another kind; PlotError as
+// WriteReport.
 ReportSummary MakeReport(const std::string& input, const std::string& output_folder,
                          const ReportOptions& options);
 

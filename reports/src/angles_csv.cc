@@ -1,0 +1,114 @@
+#include "angles_csv.h"
+
+#include <cerrno>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "ccsrm/common/error.h"
+
+namespace ccsrm::reports::internal {
+namespace {
+
+// One row: comma-separated cells, empty = not measured.
+std::vector<std::string> SplitCells(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string cell;
+  std::istringstream stream(line);
+  while (std::getline(stream, cell, ',')) cells.push_back(cell);
+  if (!line.empty() && line.back() == ',') cells.push_back("");
+  return cells;
+}
+
+// The next line that is neither empty nor a comment; false at the end.
+bool NextRow(std::istream& in, std::string* line, int* number) {
+  while (std::getline(in, *line)) {
+    ++*number;
+    if (!line->empty() && line->back() == '\r') line->pop_back();
+    if (!line->empty() && (*line)[0] != '#') return true;
+  }
+  return false;
+}
+
+std::string ColumnName(const std::string& kind, std::size_t axis, std::size_t joint) {
+  return kind + "_theta" + (axis == 0 ? "x" : "y") + std::to_string(joint + 1) + "_deg";
+}
+
+}  // namespace
+
+AnglesCsv ReadAnglesCsv(const std::string& file, const std::vector<std::string>& kinds,
+                        const std::string& named_by) {
+  std::ifstream in(file);
+  if (!in) ThrowInputError(file, "", "cannot be read (" + named_by + ")");
+  std::string line;
+  int number = 0;
+  std::vector<std::string> header;
+  if (NextRow(in, &line, &number)) header = SplitCells(line);
+  const std::size_t per_joint = 2 * kinds.size();
+  const std::string where = "line " + std::to_string(number);
+  if (header.empty() || header[0] != "time_s" || header.size() < 1 + per_joint ||
+      (header.size() - 1) % per_joint != 0) {
+    std::string expected = "time_s";
+    for (const std::string& kind : kinds) expected += "," + ColumnName(kind, 0, 0);
+    ThrowInputError(file, where,
+                    "expected the header " + expected + ",... (" + std::to_string(per_joint) +
+                        " columns per joint)");
+  }
+  const std::size_t joints = (header.size() - 1) / per_joint;
+  for (std::size_t j = 0; j < joints; ++j) {
+    for (std::size_t c = 0; c < 2; ++c) {
+      for (std::size_t k = 0; k < kinds.size(); ++k) {
+        const std::string want = ColumnName(kinds[k], c, j);
+        const std::size_t column = 1 + per_joint * j + kinds.size() * c + k;
+        if (header[column] != want) {
+          ThrowInputError(file, where,
+                          "column " + std::to_string(column + 1) + " is '" + header[column] +
+                              "', expected '" + want + "'");
+        }
+      }
+    }
+  }
+  std::vector<std::vector<double>> rows;
+  while (NextRow(in, &line, &number)) {
+    const std::string at = "line " + std::to_string(number);
+    const std::vector<std::string> cells = SplitCells(line);
+    if (cells.size() != header.size()) {
+      ThrowInputError(
+          file, at,
+          std::to_string(cells.size()) + " cells, expected " + std::to_string(header.size()));
+    }
+    std::vector<double> row(cells.size(), std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      if (cells[i].empty() && i > 0) continue;
+      char* end = nullptr;
+      errno = 0;
+      row[i] = std::strtod(cells[i].c_str(), &end);
+      if (cells[i].empty() || *end != '\0' || errno != 0) {
+        ThrowInputError(file, at,
+                        "column " + std::to_string(i + 1) + " ('" + header[i] + "'): '" + cells[i] +
+                            "' is not a number");
+      }
+    }
+    if (!rows.empty() && !(row[0] > rows.back()[0]))
+      ThrowInputError(file, at, "times must increase");
+    rows.push_back(std::move(row));
+  }
+  if (rows.empty()) ThrowInputError(file, "", "has no frames");
+  AnglesCsv out;
+  const std::size_t frames = rows.size();
+  out.series.assign(kinds.size(), datasets::Array({frames, joints, 2}));
+  for (std::size_t f = 0; f < frames; ++f) {
+    out.time_s.push_back(rows[f][0]);
+    for (std::size_t j = 0; j < joints; ++j) {
+      for (std::size_t c = 0; c < 2; ++c) {
+        for (std::size_t k = 0; k < kinds.size(); ++k) {
+          out.series[k].at(f, j, c) = rows[f][1 + per_joint * j + kinds.size() * c + k];
+        }
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace ccsrm::reports::internal
