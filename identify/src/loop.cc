@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -179,6 +180,7 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
   }
 
   LoopSummary summary;
+  summary.options = options;
   std::unique_ptr<SimulationBackend> training_backend =
       MakeThreadBackend(&training, options.fit.threads);
   std::unique_ptr<SimulationBackend> holdout_backend =
@@ -445,6 +447,7 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       std::map<std::string, double> without = ValuesOf(refit, fixed);
       for (const std::string& q : cand.parameters) without[q] = 0.0;
       double cost_without = current.final_cost;
+      double cost_zeroed = std::numeric_limits<double>::quiet_NaN();
       {
         std::vector<RunRequest> runs;
         for (std::size_t e = 0; e < training.size(); ++e) {
@@ -459,8 +462,8 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
           angles.push_back(&run.angles_rad);
         }
         if (ok) {
-          cost_without =
-              std::max(cost_without, 0.5 * Weighted(training, angles, false).squaredNorm());
+          cost_zeroed = 0.5 * Weighted(training, angles, false).squaredNorm();
+          cost_without = std::max(cost_without, cost_zeroed);
         }
       }
       cand.cost_without = cost_without;
@@ -468,6 +471,19 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       const double nres = static_cast<double>(refit.residuals);
       const double dchi2 = 2.0 * (cost_without - refit.final_cost) * neff / nres;
       cand.delta_bic = dchi2 - static_cast<double>(cand.parameters.size()) * std::log(neff);
+      // Its size is distinguishable from 0 when one of its parameters'
+      // interval excludes 0, or when its parameters together do: removing
+      // it at the refit's point raises the effective chi-square beyond the
+      // 95 % quantile of a chi-square with as many degrees of freedom (the
+      // 95 % confidence region of its size excludes 0). The second serves
+      // an effect whose parameters the data determine only in combination
+      // (a delay's time constant and dead time both lag the motion, by
+      // their sum).
+      const double k = static_cast<double>(cand.parameters.size());
+      if (std::isfinite(cost_zeroed) &&
+          2.0 * (cost_zeroed - refit.final_cost) * neff / nres > gsl_cdf_chisq_Pinv(0.95, k)) {
+        cand.size_significant = true;
+      }
       for (const std::string& q : cand.parameters) {
         if (const ParameterEstimate* est = refit.Find(q)) {
           cand.estimates[q] = *est;

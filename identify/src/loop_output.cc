@@ -72,6 +72,14 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
   }
   j["data"] = data;
   j["declared_free"] = s.declared.free_names;
+  const LoopOptions& o = s.options;
+  j["criteria"] = {{"score_significance", o.score_significance},
+                   {"refits_per_round", o.refits_per_round},
+                   {"max_rounds", o.max_rounds},
+                   {"min_delta_bic", o.min_delta_bic},
+                   {"holdout_z", o.holdout_z},
+                   {"tie_delta_bic", o.tie_delta_bic},
+                   {"unexplained_noise_ratio", o.unexplained_noise_ratio}};
   json rounds = json::array();
   for (const LoopRound& r : s.rounds) {
     json cands = json::array();

@@ -17,6 +17,8 @@
 #include "ccsrm/mocap/c3d.h"
 #include "ccsrm/mocap/marker_io.h"
 #include "ccsrm/mocap/recording.h"
+#include "ccsrm/sim/config.h"
+#include "ccsrm/sim/paper_run.h"
 #include "run_ccsrm.h"
 #include "same_experiment.h"
 
@@ -27,6 +29,14 @@ using ::testing::HasSubstr;
 using Outcome = ccsrm::testing::CommandOutcome;
 
 std::string Paper() { return std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml"; }
+
+// The nominal configuration a generated case-1 experiment states: the
+// paper's arm with case 1's friction (none), and no effects.
+std::string NominalCase1() {
+  ccsrm::sim::Config c = ccsrm::sim::LoadConfig(Paper());
+  ccsrm::sim::ApplyPaperCase(1, &c.parameters);
+  return ccsrm::sim::ToYaml(c);
+}
 
 fs::path FreshDir(const std::string& name) {
   return ccsrm::testing::ScratchDirectory("mocap_cli_" + name);
@@ -65,7 +75,7 @@ TEST(Generate, WritesTheExperimentAndBothTruthFiles) {
   const ccsrm::datasets::ExperimentFile e =
       ccsrm::datasets::ReadExperimentFile((dir / "exp.h5").string());
   EXPECT_EQ(e.source, ccsrm::datasets::ExperimentSource::kGenerated);
-  EXPECT_EQ(e.config_yaml, ccsrm::ReadTextFile(Paper()));  // the nominal text, never the truth
+  EXPECT_EQ(e.config_yaml, NominalCase1());  // the nominal arm with its case, never the truth
   EXPECT_EQ(e.mocap_time.rows(), 31u);
   EXPECT_EQ(e.input_length_change.shape, (std::vector<std::size_t>{31, 6}));
   EXPECT_EQ(e.marker_names.size(), 52u);
@@ -323,8 +333,11 @@ TEST(MocapExport, C3dOfAnExperimentProcessesToTheSameMeasurementAsTheExperiment)
   Outcome o = RunCcsrm("mocap export --in " + exp + " --out " + c3d);
   ASSERT_EQ(o.status, 0) << o.err;
   EXPECT_THAT(o.out, HasSubstr("31 frames, 52 markers at 100 Hz (C3D, Intel, float storage, mm)"));
+  // The experiment's own configuration, as a lab would keep it beside the C3D.
+  const std::string config = (dir / "nominal.yaml").string();
+  ccsrm::WriteTextFileAtomically(config, ccsrm::datasets::ReadExperimentFile(exp).config_yaml);
   const std::string via_c3d = (dir / "exp_c3d.h5").string();
-  o = RunCcsrm("mocap process --quiet --in " + c3d + " --config " + Paper() + " --inputs " + exp +
+  o = RunCcsrm("mocap process --quiet --in " + c3d + " --config " + config + " --inputs " + exp +
                " --out " + via_c3d);
   ASSERT_EQ(o.status, 0) << o.err;
   const std::string via_h5 = (dir / "exp_h5.h5").string();
@@ -418,7 +431,7 @@ TEST(Generate, EffectsGoToTheTruthOnlyAndMocapOffsetIntoTheRecordedAngles) {
   ASSERT_EQ(g.status, 0) << g.err;
   EXPECT_THAT(g.out, HasSubstr("effects on (truth only): table_tilt mocap_offset"));
   const auto e = ccsrm::datasets::ReadExperimentFile(exp);
-  EXPECT_EQ(e.config_yaml, ccsrm::ReadTextFile(Paper()));  // nominal, no effects
+  EXPECT_EQ(e.config_yaml, NominalCase1());  // nominal, no effects
   const std::string truth_yaml = ccsrm::ReadTextFile((dir / "exp.truth.yaml").string());
   EXPECT_THAT(truth_yaml, HasSubstr("table_tilt:\n    lateral_rad: 0.001"));
   EXPECT_THAT(truth_yaml, HasSubstr("joint2_x_rad: 0.01"));

@@ -36,8 +36,13 @@
 //       samples, MS_after · sqrt(2 / N_eff) (2: chance alone gives such a
 //       gain about 2 % of the time);
 //     - size: at least one of its size parameters is identifiable with a
-//       95 % interval that excludes 0 (an effect indistinguishable from
-//       absent is not added).
+//       95 % interval that excludes 0, or together they are: removing the
+//       effect at the refit's point raises the effective chi-square beyond
+//       the 95 % quantile of a chi-square of k degrees of freedom (its
+//       size's 95 % confidence region excludes 0; for an effect whose
+//       parameters the data see only in combination, like a delay's time
+//       constant and dead time). An effect indistinguishable from absent is
+//       not added.
 //  5. The winner has the largest ΔBIC. Candidates within tie_delta_bic of
 //     it (2: "not worth more than a bare mention") tie; of those the one
 //     with the fewest parameters wins, and the tie is reported.
@@ -157,6 +162,7 @@ struct UnexplainedChannel {
 };
 
 struct LoopSummary {
+  LoopOptions options;  // what the loop ran with (its thresholds go to loop.json)
   std::vector<LoopRound> rounds;
   std::vector<std::string> added_effects;
   IdentificationSummary declared;   // the declared model's fit
