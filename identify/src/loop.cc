@@ -314,7 +314,6 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       }
     }
     {
-      std::size_t done_columns = 0;
       std::vector<RunResult> results = training_backend->RunBatch(
           requests, [&](std::size_t finished, std::size_t total, const RunResult&) {
             if (finished == total || finished % 4 == 0) {
@@ -323,7 +322,6 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
                   "  sensitivity runs " + std::to_string(finished) + "/" + std::to_string(total));
             }
           });
-      (void)done_columns;
       simulations += static_cast<std::int64_t>(requests.size());
       for (std::size_t k = 0; k < results.size(); ++k) {
         columns[request_column[k]].angles[requests[k].experiment] =
