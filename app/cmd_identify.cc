@@ -33,6 +33,7 @@ struct IdentifyArgs {
   int max_iterations = identify::IdentificationOptions().max_iterations;
   double relative_step = identify::IdentificationOptions().relative_step;
   double noise_deg = 0.0;  // 0: estimated
+  bool central_throughout = false;
   std::string out;
   bool quiet = false;
 };
@@ -44,6 +45,7 @@ int RunIdentify(const IdentifyArgs& a) {
   options.threads = a.threads;
   options.max_iterations = a.max_iterations;
   options.relative_step = a.relative_step;
+  options.central_differences_throughout = a.central_throughout;
   ApplyFitOptions(a.free, a.params, a.set, &options);
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError("identify", "", error);
@@ -104,6 +106,9 @@ void AddIdentifyCommand(CLI::App& root) {
   cmd->add_option("--relative-step", a->relative_step, "Finite-difference step, relative")
       ->capture_default_str()
       ->check(ValidIn(&identify::IdentificationOptions::relative_step));
+  cmd->add_flag("--central-throughout", a->central_throughout,
+                "Second-order differences in every Jacobian (default: first-order forward "
+                "while descending, second order at the final point, for the uncertainty)");
   cmd->add_option("--noise-deg", a->noise_deg,
                   "Measurement noise of the joint angles [deg] (default: estimated per joint "
                   "from the measured twist)")

@@ -97,7 +97,10 @@ std::string IdentificationSummary::FullReport() const {
       << " (1 = at the measurement noise), cost " << Format("%.6g", initial_cost) << " -> "
       << Format("%.6g", final_cost) << "\n";
   out << "  finite differences: relative step " << relative_step
-      << ", central or one-sided second order inside the bounds\n\n";
+      << (central_differences_throughout
+              ? ", second order (central, or one-sided inside the bounds) throughout\n\n"
+              : ", first-order forward while descending, second order (central, or "
+                "one-sided inside the bounds) at the final point\n\n");
   out << "  parameter      start          estimate       std error      95 % interval"
          "                  units\n";
   for (const ParameterEstimate& p : parameters) {
@@ -207,6 +210,7 @@ nlohmann::json ToJson(const IdentificationSummary& s) {
           {"threads", s.threads},
           {"wall_time_s", s.wall_time_s},
           {"relative_step", s.relative_step},
+          {"descent_differences", s.central_differences_throughout ? "second_order" : "forward"},
           {"free", s.free_names},
           {"parameters", parameters},
           {"rms_deg", Number(s.errors.rms_deg_overall)},

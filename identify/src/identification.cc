@@ -54,6 +54,13 @@ struct Evaluation {
   std::string failure;
 };
 
+// One finite-difference run: experiment, free values, simulated angles.
+struct DifferenceRun {
+  std::size_t experiment = 0;
+  std::vector<double> values;
+  Eigen::MatrixXd angles_rad;
+};
+
 class FitProblem {
  public:
   FitProblem(const std::vector<Experiment>& experiments, const IdentificationOptions& options,
@@ -156,12 +163,16 @@ class FitProblem {
     return cache_.back();
   }
 
-  // Jacobian of the weighted residuals with respect to u, by the difference
-  // plans of every free parameter; false (with *failure) when a run failed.
+  // Jacobian of the weighted residuals with respect to u by finite
+  // differences: second order (the difference plans) once UseSecondOrder()
+  // was called or with central_differences_throughout, else first-order
+  // forward differences; false (with *failure) when a run failed.
   bool Jacobian(const double* u, Eigen::MatrixXd* jacobian, std::string* failure) {
+    bool second_order = false;
     {
       const std::lock_guard<std::mutex> lock(mutex_);
-      if (jacobian_u_.size() == free_.size() &&
+      second_order = second_order_;
+      if (jacobian_u_.size() == free_.size() && jacobian_second_order_ == second_order &&
           std::equal(jacobian_u_.begin(), jacobian_u_.end(), u)) {
         *jacobian = jacobian_;
         return true;
@@ -172,58 +183,99 @@ class FitProblem {
       *failure = base.failure;
       return false;
     }
-    const Eigen::VectorXd base_residuals = base.residuals;
     const std::vector<double> p = ValuesAt(u);
+    const std::size_t ne = experiments_.size();
+    // Per free parameter: its difference plan and the trial values it runs.
     std::vector<internal::DifferencePlan> plans;
-    std::vector<RunRequest> requests;
+    std::vector<std::vector<double>> trials(free_.size());
     for (std::size_t i = 0; i < free_.size(); ++i) {
       plans.push_back(PlanFor(i, p[i]));
       if (free_[i].measurement) continue;  // recorded with the base runs
-      for (int t = 0; t < 2; ++t) {
-        std::vector<double> trial = p;
-        trial[i] = plans.back().trial_values[static_cast<std::size_t>(t)];
-        for (std::size_t e = 0; e < experiments_.size(); ++e) {
-          requests.push_back({e, ParametersAt(e, trial), false, {}});
+      if (second_order) {
+        trials[i].assign(plans[i].trial_values.begin(), plans[i].trial_values.end());
+      } else {
+        // The same expression as the central plan's p + h, so that the final
+        // second-order Jacobian finds these runs again.
+        const double h = options_.relative_step * free_[i].scale;
+        trials[i] = {p[i] + h <= free_[i].upper ? p[i] + h : p[i] - h};
+      }
+    }
+    // Runs of the last Jacobian at the same point are not repeated.
+    std::vector<DifferenceRun> runs;
+    std::vector<RunRequest> requests;
+    std::vector<std::size_t> request_of;  // index into runs of each request
+    for (std::size_t i = 0; i < free_.size(); ++i) {
+      for (const double value : trials[i]) {
+        std::vector<double> q = p;
+        q[i] = value;
+        for (std::size_t e = 0; e < ne; ++e) {
+          DifferenceRun run{e, q, {}};
+          const std::lock_guard<std::mutex> lock(mutex_);
+          const auto cached = std::find_if(
+              trial_runs_.begin(), trial_runs_.end(),
+              [&](const DifferenceRun& t) { return t.experiment == e && t.values == q; });
+          if (cached != trial_runs_.end()) {
+            run.angles_rad = cached->angles_rad;
+          } else {
+            requests.push_back({e, ParametersAt(e, q), false, {}});
+            request_of.push_back(runs.size());
+          }
+          runs.push_back(std::move(run));
         }
       }
     }
     const std::vector<RunResult> results = Run(requests);
+    for (std::size_t k = 0; k < results.size(); ++k) {
+      DifferenceRun& run = runs[request_of[k]];
+      if (!results[k].summary.completed()) {
+        std::size_t i = 0;
+        while (run.values[i] == p[i]) ++i;
+        *failure = "finite difference of " + free_[i].name + ": " +
+                   experiments_[run.experiment].name + ": " + results[k].summary.message;
+        return false;
+      }
+      run.angles_rad = results[k].angles_rad;
+    }
     jacobian->resize(static_cast<Eigen::Index>(index_.size()),
                      static_cast<Eigen::Index>(free_.size()));
-    const std::size_t ne = experiments_.size();
-    std::size_t simulated = 0;  // simulated free parameters before i
+    std::size_t next = 0;  // into runs, in the order they were laid out
     for (std::size_t i = 0; i < free_.size(); ++i) {
-      std::vector<Eigen::MatrixXd> trial_angles[2];
-      for (int t = 0; t < 2; ++t) {
+      std::vector<Eigen::VectorXd> r;  // weighted residuals at each trial
+      for (std::size_t t = 0; t < (free_[i].measurement ? 2 : trials[i].size()); ++t) {
         if (free_[i].measurement) {
-          trial_angles[t] = base.measurement_trials[i][static_cast<std::size_t>(t)];
+          r.push_back(Residuals(base.measurement_trials[i][t]));
           continue;
         }
-        for (std::size_t e = 0; e < ne; ++e) {
-          const RunResult& r = results[(simulated * 2 + static_cast<std::size_t>(t)) * ne + e];
-          if (!r.summary.completed()) {
-            *failure = "finite difference of " + free_[i].name + ": " + experiments_[e].name +
-                       ": " + r.summary.message;
-            return false;
-          }
-          trial_angles[t].push_back(r.angles_rad);
-        }
+        std::vector<Eigen::MatrixXd> angles;
+        for (std::size_t e = 0; e < ne; ++e) angles.push_back(runs[next++].angles_rad);
+        r.push_back(Residuals(angles));
       }
-      if (!free_[i].measurement) ++simulated;
-      const Eigen::VectorXd r0 = Residuals(trial_angles[0]);
-      const Eigen::VectorXd r1 = Residuals(trial_angles[1]);
-      const internal::DifferencePlan& plan = plans[i];
-      const double h = options_.relative_step * free_[i].scale;
-      // dr/du = s dr/dp; h dr/dp = (w_b r(p) + w_0 r(t_0) + w_1 r(t_1)) / 2.
-      jacobian->col(static_cast<Eigen::Index>(i)) =
-          (plan.base_weight * base_residuals + plan.trial_weights[0] * r0 +
-           plan.trial_weights[1] * r1) *
-          (free_[i].scale / (2.0 * h));
+      Eigen::VectorXd column;
+      if (r.size() == 1) {
+        // dr/du = s (r(t) - r(p)) / (t - p), first order.
+        column = (r[0] - base.residuals) * (free_[i].scale / (trials[i][0] - p[i]));
+      } else {
+        // dr/du = s dr/dp; h dr/dp = (w_b r(p) + w_0 r(t_0) + w_1 r(t_1)) / 2.
+        const internal::DifferencePlan& plan = plans[i];
+        const double h = options_.relative_step * free_[i].scale;
+        column = (plan.base_weight * base.residuals + plan.trial_weights[0] * r[0] +
+                  plan.trial_weights[1] * r[1]) *
+                 (free_[i].scale / (2.0 * h));
+      }
+      jacobian->col(static_cast<Eigen::Index>(i)) = column;
     }
     const std::lock_guard<std::mutex> lock(mutex_);
     jacobian_u_.assign(u, u + free_.size());
+    jacobian_second_order_ = second_order;
     jacobian_ = *jacobian;
+    trial_runs_ = std::move(runs);
     return true;
+  }
+
+  // From now on every Jacobian is second order (the final point's).
+  void UseSecondOrder() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    second_order_ = true;
   }
 
   // The difference plan of free parameter i at value p_i.
@@ -319,8 +371,11 @@ class FitProblem {
   std::vector<ResidualIndex> index_;
   std::mutex mutex_;
   std::vector<Evaluation> cache_;
+  bool second_order_ = options_.central_differences_throughout;
   std::vector<double> jacobian_u_;
+  bool jacobian_second_order_ = false;
   Eigen::MatrixXd jacobian_;
+  std::vector<DifferenceRun> trial_runs_;  // of the last Jacobian
   std::vector<sim::Trajectory> trajectories_;
   std::int64_t simulations_ = 0;
 };
@@ -709,6 +764,7 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
   IdentificationSummary summary;
   summary.threads = backend->parallelism();
   summary.relative_step = options.relative_step;
+  summary.central_differences_throughout = options.central_differences_throughout;
   summary.residuals = problem.num_residuals();
   for (const FreeParameter& f : free) summary.free_names.push_back(f.name);
 
@@ -790,7 +846,9 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     const double inflation = summary.effective_samples > 0.0 ? n / summary.effective_samples : 1.0;
     const double variance_factor = summary.residual_variance * inflation;
 
-    // Singular values of the scaled Jacobian, and what the data cannot pin down.
+    // Singular values of the scaled Jacobian, and what the data cannot pin
+    // down: a second-order Jacobian from here on.
+    problem.UseSecondOrder();
     Eigen::MatrixXd jacobian;
     std::string failure;
     if (problem.Jacobian(u.data(), &jacobian, &failure)) {
