@@ -473,8 +473,13 @@ class IterationReporter final : public ceres::IterationCallback {
       if (s.iteration == 0) previous_cost_ = s.cost;
       return ceres::SOLVER_CONTINUE;
     }
-    const bool small = StepWithinStandardErrors(s.cost);
-    const bool insignificant = DecreaseInsignificant(s.cost);
+    // A step that the box made small (refusals since the last accepted
+    // step shrank the region) says nothing about convergence.
+    const int outside = problem_->steps_outside_box();
+    const bool shrunk_by_box = outside > outside_at_last_accept_;
+    outside_at_last_accept_ = outside;
+    const bool small = !shrunk_by_box && StepWithinStandardErrors(s.cost);
+    const bool insignificant = !shrunk_by_box && DecreaseInsignificant(s.cost);
     previous_.assign(u_, u_ + problem_->num_free());
     previous_cost_ = s.cost;
     if (small) stop_reason_ = StepRuleMessage(options_.converged_step_fraction);
@@ -576,6 +581,7 @@ class IterationReporter final : public ceres::IterationCallback {
   std::vector<double> previous_;
   double previous_cost_ = 0.0;
   int reported_outside_ = 0;
+  int outside_at_last_accept_ = 0;
   std::string stop_reason_;
 };
 
@@ -720,6 +726,9 @@ bool IdentificationOptions::IsValid(std::string* error) const {
   if (!(max_relative_standard_error > 0.0)) return fail("max_relative_standard_error must be > 0");
   if (!(converged_step_fraction >= 0.0)) return fail("converged_step_fraction must be >= 0");
   if (!(max_step_fraction >= 0.0)) return fail("max_step_fraction must be >= 0");
+  if (!(min_relative_damping >= 0.0 && min_relative_damping <= 1.0)) {
+    return fail("min_relative_damping must be in [0, 1]");
+  }
   if (!(initial_trust_region_radius > 0.0)) return fail("initial_trust_region_radius must be > 0");
   if (!(min_effective_chi2_decrease >= 0.0))
     return fail("min_effective_chi2_decrease must be >= 0");
@@ -839,6 +848,19 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     solver.parameter_tolerance = options.parameter_tolerance;
     solver.gradient_tolerance = options.gradient_tolerance;
     solver.initial_trust_region_radius = options.initial_trust_region_radius;
+    // The damping floor, from the start's Jacobian (which iteration 0 then
+    // finds cached). Without Jacobi scaling Ceres damps by the squared
+    // column norms clipped to [min_lm_diagonal, max_lm_diagonal]: with
+    // scaling on, the same norms of unit columns.
+    Eigen::MatrixXd start_jacobian;
+    std::string ignored;  // a failed run stops the minimiser at iteration 0
+    if (options.min_relative_damping > 0.0 &&
+        problem.Jacobian(u.data(), &start_jacobian, &ignored)) {
+      solver.jacobi_scaling = false;
+      solver.min_lm_diagonal =
+          std::max(options.min_relative_damping * start_jacobian.colwise().squaredNorm().maxCoeff(),
+                   solver.min_lm_diagonal);
+    }
     solver.num_threads = 1;  // the parallelism is in the backend
     solver.logging_type = ceres::SILENT;
     solver.update_state_every_iteration = true;

@@ -130,6 +130,15 @@ struct IdentificationOptions {
   // jump from a smooth region of the cost into a rough one (where static
   // friction exceeds kinetic) and stall there.
   double initial_trust_region_radius = 1.0;
+  // Levenberg-Marquardt damps each free parameter in proportion to its own
+  // curvature (the squared norm of its column of the scaled Jacobian:
+  // Marquardt's scaling), so a parameter the data barely feel is barely
+  // damped and can take a step of many times its size on a gradient that
+  // is mostly noise or nonlinearity. Each parameter is damped at least as
+  // if its curvature were this fraction of the largest one at the start
+  // (ceres::Solver::Options::min_lm_diagonal, Jacobi scaling off, which is
+  // the same scaling above the floor). Default 0.01. 0: Marquardt's alone.
+  double min_relative_damping = 0.01;
   // The largest change of any free parameter in one step, as a fraction of
   // its scale s: the trust region is also a box in the scaled space (as in
   // "dogbox" methods). Levenberg-Marquardt damps each parameter by its own
@@ -169,7 +178,7 @@ struct IdentificationOptions {
   // of bounds, relative_step outside (0, 0.1], threads < 1,
   // max_iterations < 0, tolerances <= 0, max_relative_standard_error <= 0,
   // converged_step_fraction < 0, min_effective_chi2_decrease < 0,
-  // max_step_fraction < 0, a scale
+  // max_step_fraction < 0, min_relative_damping outside [0, 1], a scale
   // for a parameter that is not free or not positive.
   bool IsValid(std::string* error) const;
 };
