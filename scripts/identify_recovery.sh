@@ -16,14 +16,20 @@
 #   C  case 3, +6 -6 deg:       mu, mu_s, T_d0         (static above kinetic)
 #   D  case 4, +4 -6 deg:       mu_c, mu_c_s, T_p, c_lc
 #   E  case 2, +6 -4 deg:       all nine of SPEC 6
+#   F  case 4, +4 -6 deg:       mu_c, mu_c_s, c_lc     (T_p known: 60 N)
+#   G  case 3, +6 -6 deg:       mu, mu_s               (T_d0 known: 120 N)
+# In cases 3 and 4 on this slow protocol the pre-tension and the friction
+# coefficient of the same cables act almost only as their product: D and C
+# name that combination; F and G fix the pre-tension (measured on a real
+# arm) and recover the coefficients.
 # A is the four-experiment benchmark of BENCHMARKS.md. Sets take 3-15
-# minutes each on 2 cores.
+# minutes each on 2 cores; E (nine parameters) longer.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:?usage: scripts/identify_recovery.sh OUT_DIR [SET ...]}
 shift
 sets=("$@")
-if [ ${#sets[@]} -eq 0 ]; then sets=(A B C D E); fi
+if [ ${#sets[@]} -eq 0 ]; then sets=(A B C D E F G); fi
 ccsrm=./build/app/ccsrm
 mkdir -p "$out"
 config="$out/arm.yaml"
@@ -32,9 +38,9 @@ sed -e 's/^  ramp_s: .*/  ramp_s: 8.0/' -e 's/^  hold_s: .*/  hold_s: 2.0/' \
   configs/paper.yaml >"$config"
 
 # Per set: case, amplitudes, free parameters, truth (--set pairs), start.
-case_of() { case "$1" in A | B | E) echo 2 ;; C) echo 3 ;; D) echo 4 ;; esac; }
+case_of() { case "$1" in A | B | E) echo 2 ;; C | G) echo 3 ;; D | F) echo 4 ;; esac; }
 amplitudes_of() {
-  case "$1" in A) echo "6 -6 4 -4" ;; B | E) echo "6 -4" ;; C) echo "6 -6" ;; D) echo "4 -6" ;; esac
+  case "$1" in A) echo "6 -6 4 -4" ;; B | E) echo "6 -4" ;; C | G) echo "6 -6" ;; D | F) echo "4 -6" ;; esac
 }
 free_of() {
   case "$1" in
@@ -43,6 +49,8 @@ free_of() {
     C) echo mu,mu_s,T_d0 ;;
     D) echo mu_c,mu_c_s,T_p,c_lc ;;
     E) echo mu,mu_s,mu_c,mu_c_s,beta,c_sc,c_lc,T_p,T_d0 ;;
+    F) echo mu_c,mu_c_s,c_lc ;;
+    G) echo mu,mu_s ;;
   esac
 }
 truth_of() {
@@ -52,6 +60,8 @@ truth_of() {
     C) echo "mu=0.19 mu_s=0.23 T_d0=120" ;;
     D) echo "mu_c=0.18 mu_c_s=0.22 T_p=60 c_lc=0.08" ;;
     E) echo "mu=0.18 mu_s=0.24 mu_c=0.18 mu_c_s=0.23 beta=0.0015 c_sc=0.08 c_lc=0.08 T_p=60 T_d0=120" ;;
+    F) echo "mu_c=0.18 mu_c_s=0.22 T_p=60 c_lc=0.08" ;;
+    G) echo "mu=0.19 mu_s=0.23 T_d0=120" ;;
   esac
 }
 start_of() {
@@ -61,6 +71,8 @@ start_of() {
     C) echo "mu=0.26 mu_s=0.32 T_d0=80" ;;
     D) echo "mu_c=0.25 mu_c_s=0.30 T_p=40 c_lc=0.05" ;;
     E) echo "mu=0.25 mu_s=0.33 mu_c=0.25 mu_c_s=0.32 beta=0.001 c_sc=0.05 c_lc=0.05 T_p=40 T_d0=80" ;;
+    F) echo "mu_c=0.25 mu_c_s=0.30 c_lc=0.05 T_p=60" ;;
+    G) echo "mu=0.26 mu_s=0.32 T_d0=120" ;;
   esac
 }
 sets_flags() { for kv in $1; do printf -- '--set %s ' "$kv"; done; }
