@@ -148,8 +148,11 @@ struct IdentificationOptions {
   // step, into the rough region of the cost where the arm stick-slips, and
   // the fit crawled from there. A trial step outside the box is refused
   // before it runs (no simulation), and the minimiser shrinks its region and
-  // tries again. Default 0.5. 0 turns the box off.
-  double max_step_fraction = 0.5;
+  // tries again. Default 0 (off): min_relative_damping below keeps such a
+  // parameter in check without refusals (none in the recovery study), while
+  // a box of half the scale held an effect fitted from 0 (scale: its
+  // realistic magnitude, truth 10 times that) to 30 iterations of small steps.
+  double max_step_fraction = 0.0;
   // The fit also stops, as converged, once an accepted step moved every free
   // parameter by less than this fraction of its standard error (as reported,
   // autocorrelation included): further
