@@ -14,29 +14,18 @@
 
 namespace {
 namespace fs = std::filesystem;
+using ccsrm::testing::CountLines;
 using ccsrm::testing::RunCcsrm;
+using ccsrm::testing::ScratchDirectory;
 using ::testing::HasSubstr;
 using Outcome = ccsrm::testing::CommandOutcome;
 
 std::string Paper() { return std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml"; }
 
-fs::path FreshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("ccsrm_identify_cli_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-int Lines(const std::string& text) {
-  int n = 0;
-  for (char c : text) n += c == '\n';
-  return n;
-}
-
 // 0.05 s of case 3: quick runs; mu_c and mu_c_s are 0 there, so they are
 // stepped relative to the configuration's 0.21.
 TEST(DerivativesCommand, PrintsTheTableAndWritesJson) {
-  const fs::path dir = FreshDir("table");
+  const fs::path dir = ScratchDirectory("identify_cli_table");
   const std::string json_path = (dir / "d.json").string();
   const Outcome o = RunCcsrm("derivatives --config " + Paper() +
                              " --case 3 --duration 0.05 --parameters mu,mu_c,T_p --threads 2 "
@@ -95,7 +84,7 @@ TEST(DerivativesCommand, BadOptionsExitWithOneLineNamingTheOption) {
   for (const auto& c : cases) {
     const Outcome o = RunCcsrm(run + c.args);
     EXPECT_EQ(o.status, 2) << c.args << "\n" << o.all();
-    EXPECT_EQ(Lines(o.err), 1) << c.args << "\n" << o.err;
+    EXPECT_EQ(CountLines(o.err), 1) << c.args << "\n" << o.err;
     EXPECT_THAT(o.err, HasSubstr(c.option)) << c.args;
     EXPECT_EQ(o.out, "") << c.args << ": nothing may run before the options are checked";
   }
@@ -105,7 +94,7 @@ TEST(DerivativesCommand, BadOptionsExitWithOneLineNamingTheOption) {
 // free parameter, two iterations: fit.json with the keys, the fitted
 // run and the angles table, and an exit status that says whether it converged.
 TEST(IdentifyCommand, FitsAGeneratedExperimentAndWritesTheFitFolder) {
-  const fs::path dir = FreshDir("fit");
+  const fs::path dir = ScratchDirectory("identify_cli_fit");
   const std::string exp = (dir / "g.h5").string();
   const Outcome g = RunCcsrm("generate --config " + Paper() +
                              " --case 4 --duration 2 --set T_p=60 --quiet --out " + exp);
@@ -143,7 +132,7 @@ TEST(IdentifyCommand, FitsAGeneratedExperimentAndWritesTheFitFolder) {
 // marker noise) and marks occluded markers, so the pipeline sees the same
 // markers and the two fits may differ only by rounding.
 TEST(IdentifyCommand, AC3dRecordingFitsLikeTheExperimentItCameFrom) {
-  const fs::path dir = FreshDir("c3d_route");
+  const fs::path dir = ScratchDirectory("identify_cli_c3d_route");
   const std::string exp = (dir / "g.h5").string();
   // The loop sample's arm: the paper's, with a 9 s protocol whose first 4.5 s
   // (ramp and hold) pin T_p down.
@@ -186,7 +175,7 @@ TEST(IdentifyCommand, AC3dRecordingFitsLikeTheExperimentItCameFrom) {
 }
 
 TEST(IdentifyCommand, BadInputExitsWithOneLineBeforeAnySimulation) {
-  const fs::path dir = FreshDir("bad");
+  const fs::path dir = ScratchDirectory("identify_cli_bad");
   const std::string truncated = (dir / "truncated.h5").string();
   ccsrm::WriteTextFileAtomically(truncated, "HDF5 but not really");
   const std::string params = (dir / "p.yaml").string();
@@ -209,7 +198,7 @@ TEST(IdentifyCommand, BadInputExitsWithOneLineBeforeAnySimulation) {
   for (const auto& c : cases) {
     const Outcome o = RunCcsrm("identify " + c.args + out);
     EXPECT_EQ(o.status, 2) << c.args << "\n" << o.all();
-    EXPECT_EQ(Lines(o.err), 1) << c.args << "\n" << o.err;
+    EXPECT_EQ(CountLines(o.err), 1) << c.args << "\n" << o.err;
     EXPECT_THAT(o.err, HasSubstr(c.message)) << c.args;
     EXPECT_FALSE(fs::exists(dir / "fit")) << c.args;
   }

@@ -13,33 +13,22 @@
 
 namespace {
 namespace fs = std::filesystem;
+using ccsrm::testing::CountLines;
 using ccsrm::testing::RunCcsrm;
+using ccsrm::testing::ScratchDirectory;
 using ::testing::HasSubstr;
 using Outcome = ccsrm::testing::CommandOutcome;
 
 const std::string kSample = std::string(CCSRM_SOURCE_DIR) + "/datasets/samples/loop/";
 
-fs::path FreshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("ccsrm_loop_cli_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-int Lines(const std::string& text) {
-  int n = 0;
-  for (char c : text) n += c == '\n';
-  return n;
-}
-
 void ExpectOneLine(const Outcome& o, const std::string& text) {
   EXPECT_EQ(o.status, 2) << o.all();
-  EXPECT_EQ(Lines(o.err), 1) << o.err;
+  EXPECT_EQ(CountLines(o.err), 1) << o.err;
   EXPECT_THAT(o.err, HasSubstr(text));
 }
 
 TEST(LoopCommand, RefusesBadInputInOneLine) {
-  const fs::path dir = FreshDir("bad");
+  const fs::path dir = ScratchDirectory("loop_cli_bad");
   const std::string data = " --data " + kSample + "train1.h5 ";
   const std::string out = " --out " + (dir / "loop").string();
   ExpectOneLine(RunCcsrm("loop" + data + "--candidates backlash,gremlins" + out),

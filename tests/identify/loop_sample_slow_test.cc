@@ -14,6 +14,7 @@
 namespace {
 namespace fs = std::filesystem;
 using ccsrm::testing::RunCcsrm;
+using ccsrm::testing::ScratchDirectory;
 using ::testing::HasSubstr;
 using Outcome = ccsrm::testing::CommandOutcome;
 
@@ -24,9 +25,7 @@ const std::string kSample = std::string(CCSRM_SOURCE_DIR) + "/datasets/samples/l
 // band near the truth's 2 mrad, and bring the held-out error down to the
 // noise.
 TEST(LoopCommand, FindsTheBundledSamplesUndeclaredEffect) {
-  const fs::path dir = fs::temp_directory_path() / "ccsrm_loop_sample";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = ScratchDirectory("loop_sample");
   const Outcome o =
       RunCcsrm("loop --data " + kSample + "train1.h5 " + kSample + "train2.h5 --holdout " +
                kSample + "holdout.h5 --free mu_c,T_p --out " + (dir / "loop").string());
