@@ -105,6 +105,17 @@ class MapReader {
     Fail(Join(key), node, "expected true or false, found '" + text + "'");
   }
 
+  // A switch added after ccsrm-config/1 was first published: files written
+  // before it leave it out and mean `fallback`.
+  bool OptionalBoolean(const std::string& key, bool fallback) {
+    if (!node_[key].IsDefined()) {
+      read_.insert(key);
+      allowed_.push_back(key);
+      return fallback;
+    }
+    return Boolean(key);
+  }
+
   // A key added after ccsrm-config/1 was first published: files written
   // before it leave it out and get `fallback`; else one of `choices`.
   int OptionalWord(const std::string& key, const std::vector<std::string>& choices, int fallback) {
@@ -501,6 +512,7 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
     sc.smoothing_step_s = s.Number("smoothing_step_s");
     sc.smooth_connecting_friction = s.Boolean("smooth_connecting_friction");
     sc.smooth_connecting_elasticity = s.Boolean("smooth_connecting_elasticity");
+    sc.embed_cable_nodes = s.OptionalBoolean("embed_cable_nodes", true);
     sc.stick_velocity_tolerance_mps = s.Number("stick_velocity_tolerance_mps");
     sc.stick_force_tolerance_n = s.Number("stick_force_tolerance_n");
     sc.large_s_static_velocity_mps = s.Number("large_s_static_velocity_mps");
@@ -638,6 +650,7 @@ std::string ToYaml(const Config& c) {
   out << YAML::Key << "smooth_connecting_friction" << YAML::Value << s.smooth_connecting_friction;
   out << YAML::Key << "smooth_connecting_elasticity" << YAML::Value
       << s.smooth_connecting_elasticity;
+  out << YAML::Key << "embed_cable_nodes" << YAML::Value << s.embed_cable_nodes;
   out << YAML::Key << "stick_velocity_tolerance_mps" << YAML::Value
       << s.stick_velocity_tolerance_mps;
   out << YAML::Key << "stick_force_tolerance_n" << YAML::Value << s.stick_force_tolerance_n;

@@ -123,6 +123,7 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
   reports_.assign(holes, HoleReport{});
   memory_rate_.assign(num_memory_, 0.0);
   rows_.resize(m_);
+  embedding_.resize(layout_.num_cable_nodes());
   force_.resize(n_);
   tension_.resize(model_.num_cables());
   for (int c = 0; c < model_.num_cables(); ++c)
@@ -604,6 +605,8 @@ void ArmDynamics::AddConstraints(double t, const double* q, const double* qd) {
   for (int r = 0; r < m_; ++r) {
     const ConstraintRowLayout& cols = layout_rows[r];
     const RowValues& row = rows_[r];
+    // The embedded system substitutes these rows (embedding_) instead.
+    if (solver_.embed_cable_nodes && cols.node >= 0) continue;
     if (!row.active) {
       values[layout_.row_diagonal(r)] = -1.0;
       rhs[n_ + r] = 0.0;
@@ -624,7 +627,9 @@ void ArmDynamics::AddConstraints(double t, const double* q, const double* qd) {
 }
 
 bool ArmDynamics::SolveAugmentedSystem() {
-  if (!system_.Solve()) {
+  const bool solved =
+      solver_.embed_cable_nodes ? system_.SolveEmbedded(embedding_) : system_.Solve();
+  if (!solved) {
     failure_ = "augmented mass matrix is singular";
     return false;
   }
@@ -699,6 +704,8 @@ void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, b
         phi_dot = v_node - Position(qd, lo) - jac * ed;
         bias = -PointJacobian(ed, node.p_LN) * ed;
       }
+      NodeEmbedding& embedding = embedding_[node_index];
+      embedding.jac = jac;
       for (int a = 0; a < 3; ++a, ++r) {
         RowValues& row = rows_[r];
         if (with_jacobian) {
@@ -709,6 +716,7 @@ void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, b
           }
         }
         finish(row, phi[a], phi_dot[a], bias[a]);
+        embedding.c[a] = -row.b;
       }
       RowValues& srow = rows_[r];
       srow.vals[0] = 1.0;

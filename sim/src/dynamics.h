@@ -155,6 +155,9 @@ class ArmDynamics {
     bool active = true;
   };
   std::vector<RowValues> rows_;
+  // Per cable node, its acceleration as an affine function of its link's
+  // (solver.embed_cable_nodes), filled with the rows.
+  std::vector<NodeEmbedding> embedding_;
   AugmentedSystem system_;
   Eigen::VectorXd force_;
   std::string failure_;

@@ -51,7 +51,9 @@ SparseLayout::SparseLayout(const ArmModel& model) : n_(model.num_coordinates()) 
         std::vector<int> cols{o + a};
         if (cable.nodes[k].link > 0) link_cols(cable.nodes[k].link, a, &cols);
         add_row(cols, -1, o + a);
+        rows_.back().node = num_cable_nodes_;
       }
+      ++num_cable_nodes_;
       const bool is_hole = cable.nodes[k].kind == CableNodeModel::Kind::kHole;
       add_row({o + 3}, is_hole ? hole++ : -1, o + 3);
     }
@@ -120,7 +122,7 @@ SparseLayout::SparseLayout(const ArmModel& model) : n_(model.num_coordinates()) 
     }
     pattern.emplace_back(n_ + r, n_ + r, 0.0);
   }
-  order_ = InterleavedBlockOrder(model, pattern);
+  order_ = BlockOrder(n_ + m_, InterleavedBlocks(model), pattern);
   for (auto& entry : pattern) {
     entry = Eigen::Triplet<double>(order_[entry.row()], order_[entry.col()], 0.0);
   }
@@ -165,6 +167,7 @@ SparseLayout::SparseLayout(const ArmModel& model) : n_(model.num_coordinates()) 
     const int s = model.node_offset(h.cable, h.node) + 3;
     hole_index_.push_back(Index(s, s));
   }
+  embedded_ = std::make_unique<const EmbeddedNodeLayout>(model, *this);
 }
 
 // The elimination order. Under a scalar fill-reducing order the multiplier
@@ -184,11 +187,9 @@ SparseLayout::SparseLayout(const ArmModel& model) : n_(model.num_coordinates()) 
 // arm); the dense supernodal kernels make up for it. Finer groups
 // (a row with one coordinate, a link's quaternion with its two quaternion
 // rows) measured no better.
-std::vector<int> SparseLayout::InterleavedBlockOrder(
-    const ArmModel& model, const std::vector<Eigen::Triplet<double>>& pattern) const {
-  const int size = n_ + m_;
-  std::vector<int> block_of(size, -1);
+std::vector<std::vector<int>> SparseLayout::InterleavedBlocks(const ArmModel& model) const {
   std::vector<std::vector<int>> members;
+  std::vector<int> block_of(n_, -1);
   // Members: coordinates, then rows. The coordinate coupled to all others
   // of its block goes first (a cable node's s, through the element mass; a
   // link's quaternion, through its position rows), so that eliminating it
@@ -207,11 +208,16 @@ std::vector<int> SparseLayout::InterleavedBlockOrder(
     const int o = model.link_offset(i);
     add_block({o + 3, o + 4, o + 5, o + 6, o, o + 1, o + 2});
   }
+  for (int r = 0; r < m_; ++r) members[block_of[row_owner_[r]]].push_back(n_ + r);
+  return members;
+}
+
+std::vector<int> SparseLayout::BlockOrder(int size, const std::vector<std::vector<int>>& members,
+                                          const std::vector<Eigen::Triplet<double>>& pattern) {
   const int num_blocks = static_cast<int>(members.size());
-  for (int r = 0; r < m_; ++r) {
-    block_of[n_ + r] = block_of[row_owner_[r]];
-    members[block_of[n_ + r]].push_back(n_ + r);
-  }
+  std::vector<int> block_of(size, -1);
+  for (int b = 0; b < num_blocks; ++b)
+    for (int k : members[b]) block_of[k] = b;
   for (int k = 0; k < size; ++k) CCSRM_CHECK(block_of[k] >= 0);
 
   std::vector<std::vector<int>> neighbours(num_blocks);
@@ -259,11 +265,17 @@ int SparseLayout::Index(int model_row, int model_col) const {
 }
 
 AugmentedSystem::AugmentedSystem(const SparseLayout& layout)
-    : layout_(layout), matrix_(layout.pattern()), ldlt_(layout.factorisation()) {
+    : layout_(layout),
+      matrix_(layout.pattern()),
+      ldlt_(layout.factorisation()),
+      embedded_values_(static_cast<std::size_t>(layout.embedded().pattern_.nonZeros()), 0.0),
+      embedded_ldlt_(layout.embedded().factorisation()) {
   const int size = layout.num_coordinates() + layout.num_constraints();
   rhs_.setZero(size);
   solution_.setZero(size);
   ordered_.setZero(size);
+  reduced_rhs_.setZero(size);
+  embedded_ordered_.setZero(layout.embedded().size());
 }
 
 void AugmentedSystem::Clear() {
@@ -278,6 +290,256 @@ bool AugmentedSystem::Solve() {
   for (int k = 0; k < size; ++k) ordered_[order[k]] = rhs_[k];
   ldlt_.Solve(ordered_);
   for (int k = 0; k < size; ++k) solution_[k] = ordered_[order[k]];
+  return true;
+}
+
+}  // namespace ccsrm::sim::internal
+
+namespace ccsrm::sim::internal {
+
+EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout& full)
+    : full_size_(full.n_ + full.m_) {
+  const int n = full.n_;
+  // Which full unknowns are a node's position coordinate, a link's
+  // coordinate, or a node's position row (the eliminated ones).
+  std::vector<int> node_of(full_size_, -1), axis_of(full_size_, -1);
+  std::vector<char> eliminated(full_size_, 0), is_link(full_size_, 0);
+  for (int c = 0; c < model.num_cables(); ++c) {
+    const auto& cable = model.cables()[c];
+    for (int k = 0; k < static_cast<int>(cable.nodes.size()); ++k) {
+      NodeInfo info;
+      info.r = model.node_offset(c, k);
+      info.link = cable.nodes[k].link;
+      info.link_offset = info.link > 0 ? model.link_offset(info.link) : 0;
+      for (int a = 0; a < 3; ++a) {
+        node_of[info.r + a] = static_cast<int>(nodes_.size());
+        axis_of[info.r + a] = a;
+        eliminated[info.r + a] = 1;
+      }
+      nodes_.push_back(info);
+    }
+  }
+  for (int i = 1; i <= model.num_links(); ++i)
+    for (int a = 0; a < 7; ++a) is_link[model.link_offset(i) + a] = 1;
+  for (int r = 0; r < full.m_; ++r) {
+    if (full.rows_[r].node >= 0) eliminated[n + r] = 1;
+  }
+  reduced_of_.assign(full_size_, -1);
+  for (int u = 0; u < full_size_; ++u) {
+    if (eliminated[u]) continue;
+    reduced_of_[u] = static_cast<int>(full_of_.size());
+    full_of_.push_back(u);
+  }
+  size_ = static_cast<int>(full_of_.size());
+
+  // Reduced unknown of coordinate p (0..6: position, quaternion) of node
+  // i's link.
+  auto link_unknown = [&](int node, int p) { return reduced_of_[nodes_[node].link_offset + p]; };
+  // The reduced unknowns a full unknown maps to: itself, or its node's
+  // link's position axis and quaternion (none on the ground).
+  auto image = [&](int u, std::vector<int>* out) {
+    out->clear();
+    if (reduced_of_[u] >= 0) {
+      out->push_back(reduced_of_[u]);
+    } else if (node_of[u] >= 0 && nodes_[node_of[u]].link > 0) {
+      out->push_back(link_unknown(node_of[u], axis_of[u]));
+      for (int j = 0; j < 4; ++j) out->push_back(link_unknown(node_of[u], 3 + j));
+    }
+  };
+
+  // The full pattern's entries in model indices.
+  std::vector<int> unknown_at(full_size_);
+  for (int u = 0; u < full_size_; ++u) unknown_at[full.order_[u]] = u;
+  struct Entry {
+    int row, col, value;
+  };
+  std::vector<Entry> entries;
+  const Eigen::SparseMatrix<double>& fp = full.pattern_;
+  for (int col = 0; col < full_size_; ++col) {
+    for (int k = fp.outerIndexPtr()[col]; k < fp.outerIndexPtr()[col + 1]; ++k) {
+      entries.push_back({unknown_at[fp.innerIndexPtr()[k]], unknown_at[col], k});
+    }
+  }
+  auto is_node_row = [&](int u) { return u >= n && eliminated[u]; };
+
+  // Reduced pattern: T^T A T over every entry that is not a node row's.
+  std::vector<Eigen::Triplet<double>> pattern;
+  std::vector<int> image_i, image_j;
+  for (const Entry& e : entries) {
+    if (is_node_row(e.row) || is_node_row(e.col)) continue;
+    image(e.row, &image_i);
+    image(e.col, &image_j);
+    for (int p : image_i)
+      for (int q : image_j) pattern.emplace_back(p, q, 0.0);
+  }
+  for (int p = 0; p < size_; ++p) pattern.emplace_back(p, p, 0.0);
+
+  std::vector<std::vector<int>> members;
+  for (const std::vector<int>& block : full.InterleavedBlocks(model)) {
+    std::vector<int> kept;
+    for (int u : block)
+      if (reduced_of_[u] >= 0) kept.push_back(reduced_of_[u]);
+    if (!kept.empty()) members.push_back(kept);
+  }
+  order_ = SparseLayout::BlockOrder(size_, members, pattern);
+  for (auto& entry : pattern)
+    entry = Eigen::Triplet<double>(order_[entry.row()], order_[entry.col()], 0.0);
+  pattern_.resize(size_, size_);
+  pattern_.setFromTriplets(pattern.begin(), pattern.end());
+  pattern_.makeCompressed();
+  factorisation_ = std::make_unique<const SupernodalStructure>(pattern_);
+
+  // Value index of the lower-triangle entry of reduced unknowns p and q.
+  auto lower = [&](int p, int q) {
+    const int a = std::max(order_[p], order_[q]), b = std::min(order_[p], order_[q]);
+    const int* inner = pattern_.innerIndexPtr();
+    const int* begin = inner + pattern_.outerIndexPtr()[b];
+    const int* end = inner + pattern_.outerIndexPtr()[b + 1];
+    const int* at = std::lower_bound(begin, end, a);
+    CCSRM_CHECK(at != end && *at == a);
+    return static_cast<int>(at - inner);
+  };
+
+  std::vector<std::vector<int>> kept_of_node(nodes_.size());  // node -> index into node_kept_
+  std::vector<std::vector<int>> pair_of_node(nodes_.size());  // node n -> index into node_pairs_
+  for (const Entry& e : entries) {
+    const int ri = reduced_of_[e.row], rj = reduced_of_[e.col];
+    if (ri >= 0 && rj >= 0) {
+      if (order_[ri] >= order_[rj]) copy_.emplace_back(e.value, lower(ri, rj));
+      continue;
+    }
+    const int ni = node_of[e.row];
+    if (ni < 0)
+      continue;  // a node row's entry, or a kept unknown's with a node (its mirror counts)
+    const int nj = node_of[e.col];
+    if (nj < 0) {
+      // Only the node's own position rows couple it to a link, and they
+      // are not assembled.
+      if (rj < 0 || is_link[e.col]) continue;
+      int found = -1;
+      for (int index : kept_of_node[ni])
+        if (node_kept_[index].kept == e.col) found = index;
+      if (found < 0) {
+        NodeKept nk;
+        nk.node = ni;
+        nk.kept = e.col;
+        std::fill(nk.full, nk.full + 3, -1);
+        std::fill(nk.target, nk.target + 7, -1);
+        if (nodes_[ni].link > 0) {
+          for (int p = 0; p < 7; ++p) nk.target[p] = lower(link_unknown(ni, p), rj);
+        }
+        found = static_cast<int>(node_kept_.size());
+        kept_of_node[ni].push_back(found);
+        node_kept_.push_back(nk);
+      }
+      node_kept_[found].full[axis_of[e.row]] = e.value;
+      continue;
+    }
+    if (nj < ni) continue;  // the mirror of a pair counted once
+    int found = -1;
+    for (int index : pair_of_node[ni])
+      if (node_pairs_[index].m == nj) found = index;
+    if (found < 0) {
+      NodePair np;
+      np.n = ni;
+      np.m = nj;
+      std::fill(np.full, np.full + 9, -1);
+      std::fill(np.target, np.target + 49, -1);
+      std::fill(np.twice, np.twice + 49, -1);
+      np.on_links = nodes_[ni].link > 0 && nodes_[nj].link > 0;
+      if (np.on_links) {
+        for (int p = 0; p < 7; ++p) {
+          for (int q = 0; q < 7; ++q) {
+            const int P = link_unknown(ni, p), Q = link_unknown(nj, q);
+            if (ni == nj) {
+              if (order_[P] >= order_[Q]) np.target[7 * p + q] = lower(P, Q);
+            } else {
+              np.target[7 * p + q] = lower(P, Q);
+              if (P == Q) np.twice[7 * p + q] = np.target[7 * p + q];
+            }
+          }
+        }
+      }
+      found = static_cast<int>(node_pairs_.size());
+      pair_of_node[ni].push_back(found);
+      node_pairs_.push_back(np);
+    }
+    node_pairs_[found].full[3 * axis_of[e.row] + axis_of[e.col]] = e.value;
+  }
+}
+
+bool AugmentedSystem::SolveEmbedded(const std::vector<NodeEmbedding>& nodes) {
+  const EmbeddedNodeLayout& em = layout_.embedded();
+  CCSRM_CHECK(nodes.size() == em.nodes_.size());
+  const double* full = matrix_.valuePtr();
+  auto value = [full](int k) { return k >= 0 ? full[k] : 0.0; };
+  double* reduced = embedded_values_.data();
+  std::fill(embedded_values_.begin(), embedded_values_.end(), 0.0);
+  for (const auto& [from, to] : em.copy_) reduced[to] += full[from];
+
+  // g = rhs - A[:, r] c over the full unknowns (only the kept ones and the
+  // nodes' positions are read).
+  Eigen::VectorXd& g = reduced_rhs_;
+  g = rhs_;
+  using Vector3 = Eigen::Vector3d;
+  for (const EmbeddedNodeLayout::NodeKept& nk : em.node_kept_) {
+    const Vector3 a(value(nk.full[0]), value(nk.full[1]), value(nk.full[2]));
+    g[nk.kept] -= a.dot(nodes[nk.node].c);
+    if (nk.target[0] < 0) continue;
+    const Eigen::Matrix<double, 4, 1> t = nodes[nk.node].jac.transpose() * a;
+    for (int p = 0; p < 3; ++p) reduced[nk.target[p]] += a[p];
+    for (int j = 0; j < 4; ++j) reduced[nk.target[3 + j]] += t[j];
+  }
+  for (const EmbeddedNodeLayout::NodePair& np : em.node_pairs_) {
+    Eigen::Matrix3d b;
+    for (int a = 0; a < 3; ++a)
+      for (int c = 0; c < 3; ++c) b(a, c) = value(np.full[3 * a + c]);
+    const int rn = em.nodes_[np.n].r, rm = em.nodes_[np.m].r;
+    g.segment<3>(rn) -= b * nodes[np.m].c;
+    if (np.n != np.m) g.segment<3>(rm) -= b.transpose() * nodes[np.n].c;
+    if (!np.on_links) continue;
+    // X = T_n^T B T_m with T = [I | jac].
+    Eigen::Matrix<double, 3, 7> bt;
+    bt.leftCols<3>() = b;
+    bt.rightCols<4>().noalias() = b * nodes[np.m].jac;
+    Eigen::Matrix<double, 7, 7> x;
+    x.topRows<3>() = bt;
+    x.bottomRows<4>().noalias() = nodes[np.n].jac.transpose() * bt;
+    for (int p = 0; p < 7; ++p) {
+      for (int q = 0; q < 7; ++q) {
+        const int k = 7 * p + q;
+        if (np.target[k] >= 0) reduced[np.target[k]] += x(p, q);
+        if (np.twice[k] >= 0) reduced[np.twice[k]] += x(p, q);
+      }
+    }
+  }
+
+  // Reduced right-hand side: the kept unknowns' g, plus T_n^T g(r_n).
+  Eigen::VectorXd& x = embedded_ordered_;
+  for (int p = 0; p < em.size_; ++p) x[em.order_[p]] = g[em.full_of_[p]];
+  for (std::size_t i = 0; i < em.nodes_.size(); ++i) {
+    const EmbeddedNodeLayout::NodeInfo& node = em.nodes_[i];
+    if (node.link == 0) continue;
+    const Vector3 gr = g.segment<3>(node.r);
+    const Eigen::Matrix<double, 4, 1> t = nodes[i].jac.transpose() * gr;
+    for (int p = 0; p < 3; ++p) x[em.order_[em.reduced_of_[node.link_offset + p]]] += gr[p];
+    for (int j = 0; j < 4; ++j) x[em.order_[em.reduced_of_[node.link_offset + 3 + j]]] += t[j];
+  }
+
+  if (!embedded_ldlt_.Factorize(reduced)) return false;
+  embedded_ldlt_.Solve(x);
+
+  solution_.setZero();
+  for (int p = 0; p < em.size_; ++p) solution_[em.full_of_[p]] = x[em.order_[p]];
+  for (std::size_t i = 0; i < em.nodes_.size(); ++i) {
+    const EmbeddedNodeLayout::NodeInfo& node = em.nodes_[i];
+    Vector3 r_dd = nodes[i].c;
+    if (node.link > 0) {
+      r_dd += solution_.segment<3>(node.link_offset) +
+              nodes[i].jac * solution_.segment<4>(node.link_offset + 3);
+    }
+    solution_.segment<3>(node.r) = r_dd;
+  }
   return true;
 }
 

@@ -8,8 +8,10 @@
 // supernodal factorisation, built once per ArmModel and shared read-only by
 // every run; AugmentedSystem is one run's matrix values, right-hand side
 // and numeric factorisation over it.
+#include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "supernodal_ldlt.h"
@@ -19,6 +21,8 @@ class ArmModel;
 }
 
 namespace ccsrm::sim::internal {
+
+class SparseLayout;
 
 // A hole node of a driving cable: Eulerian, free material coordinate.
 struct HoleNodeRef {
@@ -34,6 +38,68 @@ struct ConstraintRowLayout {
   int count = 0;
   int cols[kMaxColumns];
   int hole = -1;  // the material row of hole node `hole` (its stick constraint), else -1
+  int node = -1;  // a position row of cable node `node` (numbered over all cables), else -1
+};
+
+// A cable node's position rows (eq. 7) say r = r_link + A(e) p_LN (or a
+// fixed point for a node on the ground), so its acceleration is an affine
+// function of its link's: r_dd = T q_dd(link) + c with T = [I | jac] over
+// the link's (position, quaternion) and c = -b, b the rows' Baumgarte
+// right-hand side. Filled per evaluation for every cable node.
+struct NodeEmbedding {
+  Eigen::Matrix<double, 3, 4> jac = Eigen::Matrix<double, 3, 4>::Zero();
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+};
+
+// The augmented system with every cable node's position (and its 3 rows)
+// eliminated by NodeEmbedding: unknowns the material coordinates, the links'
+// coordinates and the other rows (docs/model-notes.md, row 23). Built from a
+// SparseLayout; the reduced matrix is assembled from the full one's values.
+class EmbeddedNodeLayout {
+ public:
+  EmbeddedNodeLayout(const ArmModel& model, const SparseLayout& full);
+
+  int size() const { return size_; }
+  const SupernodalStructure& factorisation() const { return *factorisation_; }
+
+ private:
+  friend class AugmentedSystem;
+  struct NodeInfo {
+    int r = 0;     // model index of its x coordinate
+    int link = 0;  // 0: on the ground
+    int link_offset = 0;
+  };
+  // Full entries A[r_n a, k] (a = 0..2, -1 where not stored) of a node and a
+  // kept unknown k; where T_n^T A[r_n, k] lands in the reduced lower
+  // triangle (-1: upper or a ground node).
+  struct NodeKept {
+    int node = 0;
+    int kept = 0;  // full model index
+    int full[3];
+    int target[7];
+  };
+  // Full entries A[r_n a, r_m b] of two nodes n <= m (row-major 3 x 3) and
+  // where X = T_n^T B T_m lands: X(p, q) goes to target[7p + q] (-1: not
+  // stored there), and to twice[7p + q] too where both images coincide.
+  struct NodePair {
+    int n = 0, m = 0;
+    bool on_links = false;  // both nodes on links (else only the right-hand side)
+    int full[9];
+    int target[49];
+    int twice[49];
+  };
+
+  int size_ = 0;
+  int full_size_ = 0;
+  std::vector<NodeInfo> nodes_;
+  std::vector<int> reduced_of_;            // full unknown -> reduced unknown, -1 if eliminated
+  std::vector<int> full_of_;               // reduced unknown -> full unknown
+  std::vector<int> order_;                 // reduced unknown -> position in elimination order
+  Eigen::SparseMatrix<double> pattern_;    // in elimination order
+  std::vector<std::pair<int, int>> copy_;  // (full value index, reduced value index)
+  std::vector<NodeKept> node_kept_;
+  std::vector<NodePair> node_pairs_;
+  std::unique_ptr<const SupernodalStructure> factorisation_;
 };
 
 class SparseLayout {
@@ -73,11 +139,21 @@ class SparseLayout {
   const std::vector<int>& order() const { return order_; }
   // The symbolic factorisation of the pattern in that order.
   const SupernodalStructure& factorisation() const { return *factorisation_; }
+  // The same system with the cable nodes' positions eliminated.
+  const EmbeddedNodeLayout& embedded() const { return *embedded_; }
+  int num_cable_nodes() const { return num_cable_nodes_; }
+
+  // Elimination order for the unknowns of `members` (blocks, each listing
+  // coordinates first, then rows; every unknown in exactly one block):
+  // blocks ordered by AMD on the block graph of `pattern`, each laid out
+  // whole. Returns, per unknown, its position.
+  static std::vector<int> BlockOrder(int size, const std::vector<std::vector<int>>& members,
+                                     const std::vector<Eigen::Triplet<double>>& pattern);
 
  private:
+  friend class EmbeddedNodeLayout;
   int Index(int model_row, int model_col) const;
-  std::vector<int> InterleavedBlockOrder(const ArmModel& model,
-                                         const std::vector<Eigen::Triplet<double>>& pattern) const;
+  std::vector<std::vector<int>> InterleavedBlocks(const ArmModel& model) const;
 
   int n_ = 0;
   int m_ = 0;
@@ -95,6 +171,8 @@ class SparseLayout {
   std::vector<int> row_diag_index_;
   std::vector<int> hole_index_;
   std::unique_ptr<const SupernodalStructure> factorisation_;
+  std::unique_ptr<const EmbeddedNodeLayout> embedded_;
+  int num_cable_nodes_ = 0;
 };
 
 // One run's augmented system over a shared layout. The matrix is stored
@@ -113,6 +191,11 @@ class AugmentedSystem {
   // Factorises and solves; false when the matrix is singular. The solution
   // (q_dd, then lambda) is in the model's order.
   bool Solve();
+  // The same solution through the system with every cable node's position
+  // eliminated (`nodes`, one per cable node): the matrix and right-hand
+  // side must have been assembled without the nodes' position rows. Their
+  // multipliers are not computed (set to 0).
+  bool SolveEmbedded(const std::vector<NodeEmbedding>& nodes);
   const Eigen::VectorXd& solution() const { return solution_; }
 
  private:
@@ -121,6 +204,12 @@ class AugmentedSystem {
   SupernodalLdlt ldlt_;
   Eigen::VectorXd rhs_, solution_;
   Eigen::VectorXd ordered_;  // right-hand side, then solution, in elimination order
+  // The embedded system's values (its pattern's storage), factorisation and
+  // vectors.
+  std::vector<double> embedded_values_;
+  SupernodalLdlt embedded_ldlt_;
+  Eigen::VectorXd reduced_rhs_;  // g = rhs - A[:, r] c, over the full unknowns
+  Eigen::VectorXd embedded_ordered_;
 };
 
 }  // namespace ccsrm::sim::internal

@@ -144,6 +144,31 @@ TEST(ArmDynamics, DefaultTolerancesAreConvergedForJointAngles) {
   EXPECT_LT(difference, 5e-3);
 }
 
+TEST(ArmDynamics, EmbeddedCableNodesGiveTheFullSystemsRun) {
+  // solver.embed_cable_nodes solves the same equations with the nodes'
+  // positions substituted (the full system differs only by its -1e-10
+  // regularisation of their rows, a relative O(1e-10) change of the
+  // accelerations), so a run must match the full system's up to what the
+  // integrator leaves open once the step sequences part. This fast run
+  // grows roundoff-level differences to 1e-4-1e-3 deg: ten times tighter
+  // tolerances move it by 1.7e-4 deg (DefaultTolerancesAreConverged...),
+  // c_sc = 1e-12 instead of 0 by 9e-4 deg (simulate_test). A term lost or doubled
+  // in the substitution moves them by orders more (the sparse system test
+  // checks the solve itself to 1e-12). Case 2: every friction term on.
+  Config embedded = LoadConfig(kPaper);
+  ASSERT_TRUE(embedded.solver.embed_cable_nodes);  // the default
+  Config full = embedded;
+  full.solver.embed_cable_nodes = false;
+  const SimulationResult a = RunCompressedCase(2, embedded);
+  const SimulationResult b = RunCompressedCase(2, full);
+  ASSERT_TRUE(a.summary.completed() && b.summary.completed());
+  const double difference = MaxJointAngleDifferenceDeg(a.trajectory, b.trajectory);
+  std::printf("case 2, 2 s: %lld steps embedded vs %lld full, joint angles differ by %.2e deg\n",
+              static_cast<long long>(a.summary.steps), static_cast<long long>(b.summary.steps),
+              difference);
+  EXPECT_LT(difference, 1e-3);
+}
+
 TEST(ArmDynamics, ConnectingCableSmoothingChangesJointAnglesLittle) {
   // Smoothing the connecting springs over h only moves their 150-300 Hz
   // torsional modes down to ~40 Hz; the motion must barely notice it, even

@@ -115,7 +115,15 @@ TEST(Simulate, ParameterAtZeroAndAtOneBillionthGiveTheSameRun) {
   // local error bound per step is relative_tolerance |theta| +
   // absolute_tolerance = 1e-5 x 0.1 + 1e-7 rad; a different step sequence
   // may leave a few of those, so the bound is 1e-5 rad (6e-4 deg, fifty
-  // times below the 0.03 deg mocap noise floor).
+  // times below the 0.03 deg mocap noise floor). Where the run itself
+  // amplifies them, that bound says nothing about the structure: with
+  // c_sc = 0 the small-S couples are undamped, and 1e-12 instead of 0 moves
+  // the angles by 1.5e-5 rad (measured), not a millionth of what 1e-6 does.
+  // Above 1e-5 rad the test measures that floor as the change between 1e-9
+  // and 2e-9, where the model is surely the same, and 0 must stay within 10
+  // times it: the largest of ~15k angle differences between two runs of the
+  // same noise scatters by a few times (0 against 1e-12 and 1e-9 gave 3.5
+  // and 2.7 times it), while a term switched on at 0 changes the model.
   //
   // Each parameter with a lower bound of 0 is perturbed from the paper's
   // case 2, and each friction pair together (the two switches that used to
@@ -146,7 +154,17 @@ TEST(Simulate, ParameterAtZeroAndAtOneBillionthGiveTheSameRun) {
     std::printf("%-12s 0 vs 1e-9: %lld vs %lld steps, joint angles differ by %.2e rad\n",
                 label.c_str(), static_cast<long long>(a.summary.steps),
                 static_cast<long long>(b.summary.steps), difference);
-    EXPECT_LT(difference, 1e-5) << label;
+    double allowed = 1e-5;
+    if (difference >= allowed) {
+      ArmParameters twice = tiny;
+      for (const std::string& name : names) twice.*FindParameter(name, "test").field = 2e-9;
+      const SimulationResult d = Simulate(c.model, twice, c.inputs, options);
+      ASSERT_TRUE(d.summary.completed()) << label;
+      const double floor = MaxJointAngleDifference(b.trajectory, d.trajectory);
+      std::printf("%-12s 1e-9 vs 2e-9 (the run's own noise): %.2e rad\n", label.c_str(), floor);
+      allowed = 10.0 * floor;
+    }
+    EXPECT_LT(difference, allowed) << label;
   }
 }
 

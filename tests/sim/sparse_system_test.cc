@@ -128,8 +128,10 @@ std::vector<std::vector<double>> ConstraintJacobian(const ArmModel& model,
 // connecting-pair terms, Phi_q^T Phi_q, the coupling and the multiplier
 // diagonal: -delta, or -1 on the stick rows switched off), with a random
 // right-hand side. Every other hole node slips.
+// With `skip_node_rows`, the cable nodes' position rows are left out, as
+// ArmDynamics leaves them out for the embedded system.
 void Assemble(const ArmModel& model, const Config& config, const BentState& state,
-              AugmentedSystem* system) {
+              AugmentedSystem* system, bool skip_node_rows = false) {
   const SparseLayout& layout = model.sparse_layout();
   const int n = layout.num_coordinates();
   std::mt19937 random(7);
@@ -186,6 +188,7 @@ void Assemble(const ArmModel& model, const Config& config, const BentState& stat
   for (int r = 0; r < layout.num_constraints(); ++r) {
     const ConstraintRowLayout& row = layout.rows()[r];
     ASSERT_EQ(static_cast<int>(jacobian[r].size()), row.count);
+    if (skip_node_rows && row.node >= 0) continue;
     if (row.hole >= 0 && row.hole % 2 == 1) {
       values[layout.row_diagonal(r)] = -1.0;
       rhs[n + r] = 0.0;
@@ -288,6 +291,79 @@ TEST_F(SparseSystemTest, ScalarAmdSimplicialLdltFailsTheForwardBound) {
   const Eigen::SparseMatrix<double> l = old.matrixL();
   std::printf("scalar-AMD SimplicialLDLT: nnz(L) %ld\n", static_cast<long>(l.nonZeros()));
   EXPECT_GT(forward_q, 1e-10);
+}
+
+// Writing every cable node's position as a function of its link's pose
+// (EmbeddedNodeLayout) solves the same equations: the right-hand side is
+// made consistent (F - Phi_q^T b over the coordinates, -b on the rows, as
+// AddConstraints builds it), and the embedded system, assembled without
+// the node rows, gets their b through NodeEmbedding's c = -b.
+TEST_F(SparseSystemTest, EmbeddedNodesSolveTheSameEquations) {
+  const SparseLayout& layout = model_->sparse_layout();
+  const int n = layout.num_coordinates(), m = layout.num_constraints();
+  const BentState state = MakeBentState(*model_, config_);
+  AugmentedSystem embedded(layout);
+  Assemble(*model_, config_, state, &embedded, /*skip_node_rows=*/true);
+  const EmbeddedNodeLayout& em = layout.embedded();
+  std::printf("embedded: %d unknowns (full %d), nnz(L) %zu, %.3g multiply-adds\n", em.size(), n + m,
+              em.factorisation().factor_nonzeros(), em.factorisation().factor_flops());
+  EXPECT_EQ(em.size(), n + m - 720);  // 120 nodes' 3 coordinates and 3 rows
+
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Eigen::VectorXd force(n), b(m);
+  for (int k = 0; k < n; ++k) force[k] = uniform(random);
+  for (int r = 0; r < m; ++r) b[r] = uniform(random);
+  const std::vector<std::vector<double>> jacobian = ConstraintJacobian(*model_, state.q);
+  std::vector<NodeEmbedding> nodes(layout.num_cable_nodes());
+  Eigen::VectorXd full_rhs = Eigen::VectorXd::Zero(n + m);
+  full_rhs.head(n) = force;
+  Eigen::VectorXd& embedded_rhs = embedded.rhs();
+  embedded_rhs = full_rhs;
+  for (int r = 0; r < m; ++r) {
+    const ConstraintRowLayout& row = layout.rows()[r];
+    if (row.hole >= 0 && row.hole % 2 == 1) continue;  // switched off: lambda = 0
+    if (row.node >= 0) {
+      // Rows of a node come in axis order; their Jacobian is [1, -1, -jac].
+      NodeEmbedding& node = nodes[row.node];
+      const int axis = (r > 0 && layout.rows()[r - 1].node == row.node)
+                           ? ((r > 1 && layout.rows()[r - 2].node == row.node) ? 2 : 1)
+                           : 0;
+      node.c[axis] = -b[r];
+      if (row.count > 1)
+        for (int k = 0; k < 4; ++k) node.jac(axis, k) = -jacobian[r][2 + k];
+    }
+    full_rhs[n + r] = -b[r];
+    for (int a = 0; a < row.count; ++a) full_rhs[row.cols[a]] -= jacobian[r][a] * b[r];
+    if (row.node >= 0) continue;
+    embedded_rhs[n + r] = -b[r];
+    for (int a = 0; a < row.count; ++a) embedded_rhs[row.cols[a]] -= jacobian[r][a] * b[r];
+  }
+  // The reference: the full system with the node rows exact (no -delta on
+  // their diagonal, which the embedding does not have), by dense LU.
+  Eigen::MatrixXd exact(a_);
+  for (int r = 0; r < m; ++r)
+    if (layout.rows()[r].node >= 0) exact(n + r, n + r) = 0.0;
+  const Eigen::VectorXd reference = exact.partialPivLu().solve(full_rhs);
+  ASSERT_TRUE(embedded.SolveEmbedded(nodes));
+  const Eigen::VectorXd& x = embedded.solution();
+  // The same equations, so the same answer to the dense solve's own error
+  // (~1e-14 at this conditioning): 1e-12. With -delta on the node rows the
+  // difference is O(delta lambda), ~1e-9 here.
+  const double forward_q = RelativeError(x.head(n), reference.head(n));
+  double forward_lambda = 0.0, reference_lambda = 0.0;
+  for (int r = 0; r < m; ++r) {
+    if (layout.rows()[r].node >= 0) continue;
+    forward_lambda += std::pow(x[n + r] - reference[n + r], 2);
+    reference_lambda += std::pow(reference[n + r], 2);
+  }
+  forward_lambda = std::sqrt(forward_lambda / reference_lambda);
+  std::printf("embedded against the full dense solve: q_dd %.2e, lambda %.2e\n", forward_q,
+              forward_lambda);
+  EXPECT_LT(forward_q, 1e-12);
+  EXPECT_LT(forward_lambda, 1e-12);
+  // Its factorisation is the cheaper one, or it has no reason to exist.
+  EXPECT_LT(em.factorisation().factor_flops(), layout.factorisation().factor_flops());
 }
 
 }  // namespace

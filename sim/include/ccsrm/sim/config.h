@@ -101,6 +101,12 @@ struct SolverConfig {
   // docs/model-notes.md): their torsional modes (150-300 Hz against the link
   // inertia) otherwise cap explicit steps near 1.7 ms.
   bool smooth_connecting_elasticity = true;
+  // Solve the equations with every driving-cable node's position written
+  // as a function of its link's pose (eq. 7 substituted; 720 of the 1104
+  // unknowns of the augmented system go). The same equations as the full
+  // system, to the regularisation delta; false solves the full system
+  // (docs/model-notes.md, row 23).
+  bool embed_cable_nodes = true;
   double stick_velocity_tolerance_mps = 1e-6;
   double stick_force_tolerance_n = 1e-3;
   double large_s_static_velocity_mps = 1e-4;
