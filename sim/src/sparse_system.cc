@@ -293,10 +293,6 @@ bool AugmentedSystem::Solve() {
   return true;
 }
 
-}  // namespace ccsrm::sim::internal
-
-namespace ccsrm::sim::internal {
-
 EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout& full)
     : full_size_(full.n_ + full.m_) {
   const int n = full.n_;

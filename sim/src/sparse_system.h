@@ -7,7 +7,8 @@
 // touches), the sparsity pattern, its elimination order and the symbolic
 // supernodal factorisation, built once per ArmModel and shared read-only by
 // every run; AugmentedSystem is one run's matrix values, right-hand side
-// and numeric factorisation over it.
+// and numeric factorisation over it. EmbeddedNodeLayout is the same system
+// with the cable nodes' positions substituted (solver.embed_cable_nodes).
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>
@@ -71,7 +72,8 @@ class EmbeddedNodeLayout {
   };
   // Full entries A[r_n a, k] (a = 0..2, -1 where not stored) of a node and a
   // kept unknown k; where T_n^T A[r_n, k] lands in the reduced lower
-  // triangle (-1: upper or a ground node).
+  // triangle (-1 for a node on the ground, which only moves the right-hand
+  // side).
   struct NodeKept {
     int node = 0;
     int kept = 0;  // full model index
