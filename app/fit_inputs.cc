@@ -73,14 +73,10 @@ void PrintFitProgress(identify::IdentificationOptions* options, const std::strin
       values += text;
     }
     std::fprintf(stderr, "\r%-100s\r", "");
-    std::string refused;
-    if (p.steps_outside_box > 0) {
-      refused = ", " + std::to_string(p.steps_outside_box) + " steps beyond the box refused";
-    }
-    std::printf("%siteration %2d: cost %.6g, RMS %.4f deg%s, %lld simulations%s, %.0f s;%s\n",
+    std::printf("%siteration %2d: cost %.6g, RMS %.4f deg%s, %lld simulations, %.0f s;%s\n",
                 indent.c_str(), p.iteration, p.cost, p.rms_deg,
                 p.step_accepted ? "" : " (step rejected)", static_cast<long long>(p.simulations),
-                refused.c_str(), p.wall_time_s, values.c_str());
+                p.wall_time_s, values.c_str());
     std::fflush(stdout);
   };
   options->on_run = [](std::size_t finished, std::size_t total, const identify::RunResult& r) {

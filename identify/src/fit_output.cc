@@ -206,7 +206,6 @@ nlohmann::json ToJson(const IdentificationSummary& s) {
           {"termination", TerminationName(s.termination)},
           {"message", s.message},
           {"iterations", s.iterations},
-          {"steps_outside_box", s.steps_outside_box},
           {"simulations", s.simulations},
           {"threads", s.threads},
           {"wall_time_s", s.wall_time_s},

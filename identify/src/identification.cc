@@ -272,31 +272,6 @@ class FitProblem {
     return true;
   }
 
-  // The point the minimiser last accepted, the centre of the step box.
-  void SetAccepted(const double* u) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    accepted_u_.assign(u, u + free_.size());
-  }
-
-  // Whether u changes some free parameter by more than max_step_fraction of
-  // its scale from the accepted point.
-  bool OutsideStepBox(const double* u) {
-    if (!(options_.max_step_fraction > 0.0)) return false;
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (accepted_u_.size() != free_.size()) return false;
-    for (std::size_t i = 0; i < free_.size(); ++i) {
-      if (std::abs(u[i] - accepted_u_[i]) > options_.max_step_fraction) {
-        ++steps_outside_box_;
-        return true;
-      }
-    }
-    return false;
-  }
-  int steps_outside_box() {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    return steps_outside_box_;
-  }
-
   // From now on every Jacobian is second order (the final point's).
   void UseSecondOrder() {
     const std::lock_guard<std::mutex> lock(mutex_);
@@ -397,8 +372,6 @@ class FitProblem {
   std::mutex mutex_;
   std::vector<Evaluation> cache_;
   bool second_order_ = options_.central_differences_throughout;
-  std::vector<double> accepted_u_;
-  int steps_outside_box_ = 0;
   std::vector<double> jacobian_u_;
   bool jacobian_second_order_ = false;
   Eigen::MatrixXd jacobian_;
@@ -419,10 +392,6 @@ class SimulatedAnglesCost final : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
     try {
-      // A trial step (cost only) outside the step box: refused unrun, so
-      // the minimiser shrinks its region.
-      const bool trial = jacobians == nullptr || jacobians[0] == nullptr;
-      if (trial && problem_->OutsideStepBox(parameters[0])) return false;
       const Evaluation ev = problem_->Evaluate(parameters[0]);
       if (!ev.ok) {
         last_failure_ = ev.failure;
@@ -467,19 +436,13 @@ class IterationReporter final : public ceres::IterationCallback {
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     if (s.step_is_successful || s.iteration == 0) costs_->push_back(s.cost);
     Report(s);
-    if (s.iteration == 0 || s.step_is_successful) problem_->SetAccepted(u_);
     if (s.iteration == 0) previous_.assign(u_, u_ + problem_->num_free());
     if (s.iteration == 0 || !s.step_is_successful) {
       if (s.iteration == 0) previous_cost_ = s.cost;
       return ceres::SOLVER_CONTINUE;
     }
-    // A step that the box made small (refusals since the last accepted
-    // step shrank the region) says nothing about convergence.
-    const int outside = problem_->steps_outside_box();
-    const bool shrunk_by_box = outside > outside_at_last_accept_;
-    outside_at_last_accept_ = outside;
-    const bool small = !shrunk_by_box && StepWithinStandardErrors(s.cost);
-    const bool insignificant = !shrunk_by_box && DecreaseInsignificant(s.cost);
+    const bool small = StepWithinStandardErrors(s.cost);
+    const bool insignificant = DecreaseInsignificant(s.cost);
     previous_.assign(u_, u_ + problem_->num_free());
     previous_cost_ = s.cost;
     if (small) stop_reason_ = StepRuleMessage(options_.converged_step_fraction);
@@ -549,11 +512,7 @@ class IterationReporter final : public ceres::IterationCallback {
   }
 
   void Report(const ceres::IterationSummary& s) {
-    const int outside = problem_->steps_outside_box();
-    // Ceres books a refused trial as a rejected step of infinite cost.
-    const bool refused = !s.step_is_successful && outside > reported_outside_;
-    reported_outside_ = outside;
-    if (options_.on_iteration && !refused) {
+    if (options_.on_iteration) {
       IterationProgress p;
       p.iteration = s.iteration;
       p.cost = s.cost;
@@ -562,7 +521,6 @@ class IterationReporter final : public ceres::IterationCallback {
       p.trust_region_radius = s.trust_region_radius;
       p.step_accepted = s.step_is_successful;
       p.simulations = problem_->simulations();
-      p.steps_outside_box = outside;
       p.wall_time_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
       const std::vector<double> values = problem_->ValuesAt(u_);
@@ -580,8 +538,6 @@ class IterationReporter final : public ceres::IterationCallback {
   std::vector<double>* costs_;
   std::vector<double> previous_;
   double previous_cost_ = 0.0;
-  int reported_outside_ = 0;
-  int outside_at_last_accept_ = 0;
   std::string stop_reason_;
 };
 
@@ -725,7 +681,6 @@ bool IdentificationOptions::IsValid(std::string* error) const {
   }
   if (!(max_relative_standard_error > 0.0)) return fail("max_relative_standard_error must be > 0");
   if (!(converged_step_fraction >= 0.0)) return fail("converged_step_fraction must be >= 0");
-  if (!(max_step_fraction >= 0.0)) return fail("max_step_fraction must be >= 0");
   if (!(min_relative_damping >= 0.0 && min_relative_damping <= 1.0)) {
     return fail("min_relative_damping must be in [0, 1]");
   }
@@ -827,7 +782,6 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
   ceres::Problem ceres_problem(problem_options);
   SimulatedAnglesCost cost(&problem);
   ceres_problem.AddResidualBlock(&cost, nullptr, u.data());
-  problem.SetAccepted(u.data());
   for (std::size_t i = 0; i < free.size(); ++i) {
     ceres_problem.SetParameterLowerBound(u.data(), static_cast<int>(i),
                                          free[i].lower / free[i].scale);
@@ -869,9 +823,6 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     // finite-difference Jacobian, and one bound-hugging fit spent 50
     // simulations there for no gain.
     solver.max_num_line_search_step_size_iterations = 0;
-    // A step refused by the step box counts as invalid; each halves the
-    // region, and a step 50 times too large needs about 6 of them.
-    solver.max_num_consecutive_invalid_steps = 20;
     IterationReporter progress(&problem, u.data(), options, clock_start, &summary.cost_history);
     solver.callbacks.push_back(&progress);
     ceres::Solver::Summary ceres_summary;
@@ -883,7 +834,6 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
       summary.message += " (" + cost.last_failure() + ")";
     }
     summary.iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
-    summary.steps_outside_box = problem.steps_outside_box();
     summary.initial_cost = ceres_summary.initial_cost;
     summary.final_cost = ceres_summary.final_cost;
     // Ceres leaves u at the best point it accepted.

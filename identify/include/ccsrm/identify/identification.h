@@ -73,9 +73,6 @@ struct IterationProgress {
   double trust_region_radius = 0.0;
   bool step_accepted = true;
   std::int64_t simulations = 0;  // so far
-  // Trial steps so far that left the step box (max_step_fraction), refused
-  // unrun; such iterations are not reported on their own.
-  int steps_outside_box = 0;
   double wall_time_s = 0.0;
   std::vector<std::pair<std::string, double>> values;  // the free parameters
 };
@@ -139,20 +136,6 @@ struct IdentificationOptions {
   // (ceres::Solver::Options::min_lm_diagonal, Jacobi scaling off, which is
   // the same scaling above the floor). Default 0.01. 0: Marquardt's alone.
   double min_relative_damping = 0.01;
-  // The largest change of any free parameter in one step, as a fraction of
-  // its scale s: the trust region is also a box in the scaled space (as in
-  // "dogbox" methods). Levenberg-Marquardt damps each parameter by its own
-  // curvature, so a parameter the data barely determine (a kinetic friction
-  // coefficient where slip stays below the Stribeck velocity) can take a
-  // step of several times its size; from 0.25 one went to 0.044 in one
-  // step, into the rough region of the cost where the arm stick-slips, and
-  // the fit crawled from there. A trial step outside the box is refused
-  // before it runs (no simulation), and the minimiser shrinks its region and
-  // tries again. Default 0 (off): min_relative_damping below keeps such a
-  // parameter in check without refusals (none in the recovery study), while
-  // a box of half the scale held an effect fitted from 0 (scale: its
-  // realistic magnitude, truth 10 times that) to 30 iterations of small steps.
-  double max_step_fraction = 0.0;
   // The fit also stops, as converged, once an accepted step moved every free
   // parameter by less than this fraction of its standard error (as reported,
   // autocorrelation included): further
@@ -181,7 +164,7 @@ struct IdentificationOptions {
   // of bounds, relative_step outside (0, 0.1], threads < 1,
   // max_iterations < 0, tolerances <= 0, max_relative_standard_error <= 0,
   // converged_step_fraction < 0, min_effective_chi2_decrease < 0,
-  // max_step_fraction < 0, min_relative_damping outside [0, 1], a scale
+  // min_relative_damping outside [0, 1], a scale
   // for a parameter that is not free or not positive.
   bool IsValid(std::string* error) const;
 };
@@ -254,9 +237,8 @@ struct ExperimentFit {
 struct IdentificationSummary {
   IdentificationTermination termination = IdentificationTermination::kFailed;
   bool converged() const { return termination == IdentificationTermination::kConverged; }
-  std::string message;        // Ceres' reason, or why the fit stopped
-  int iterations = 0;         // minimiser iterations (successful and not)
-  int steps_outside_box = 0;  // of those, trial steps refused unrun (max_step_fraction)
+  std::string message;  // Ceres' reason, or why the fit stopped
+  int iterations = 0;   // minimiser iterations (successful and not)
   std::int64_t simulations = 0;
   int threads = 0;
   double wall_time_s = 0.0;
