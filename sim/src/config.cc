@@ -69,12 +69,16 @@ class MapReader {
   // A key added after ccsrm-config/1 was first published: files written
   // before it leave it out and mean `fallback`.
   double OptionalNumber(const std::string& key, double fallback) {
-    if (!node_[key].IsDefined()) {
-      read_.insert(key);
-      allowed_.push_back(key);
-      return fallback;
-    }
-    return Number(key);
+    return Absent(key) ? fallback : Number(key);
+  }
+
+  // An optional key, known to the reader either way: true when the file
+  // leaves it out.
+  bool Absent(const std::string& key) {
+    if (node_[key].IsDefined()) return false;
+    read_.insert(key);
+    allowed_.push_back(key);
+    return true;
   }
 
   bool Has(const std::string& key) const { return node_[key].IsDefined(); }
@@ -108,12 +112,7 @@ class MapReader {
   // A switch added after ccsrm-config/1 was first published: files written
   // before it leave it out and mean `fallback`.
   bool OptionalBoolean(const std::string& key, bool fallback) {
-    if (!node_[key].IsDefined()) {
-      read_.insert(key);
-      allowed_.push_back(key);
-      return fallback;
-    }
-    return Boolean(key);
+    return Absent(key) ? fallback : Boolean(key);
   }
 
   // A key added after ccsrm-config/1 was first published: files written

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/kinematics.h"
@@ -125,23 +126,39 @@ double MaxJointAngleDifferenceDeg(const Trajectory& a, const Trajectory& b) {
   return worst * 180.0 / M_PI;
 }
 
+// The compressed case run under two configurations: both runs, their
+// largest joint-angle difference [deg] (infinite when a run did not
+// complete), printed with the step counts.
+struct RunPair {
+  SimulationResult a, b;
+  double difference_deg = 0.0;
+};
+RunPair CompareCompressedCase(int case_number, const Config& a_config, const char* a_name,
+                              const Config& b_config, const char* b_name) {
+  RunPair pair{RunCompressedCase(case_number, a_config), RunCompressedCase(case_number, b_config)};
+  if (!pair.a.summary.completed() || !pair.b.summary.completed()) {
+    ADD_FAILURE() << "case " << case_number << ": a run did not complete";
+    pair.difference_deg = std::numeric_limits<double>::infinity();
+    return pair;
+  }
+  pair.difference_deg = MaxJointAngleDifferenceDeg(pair.a.trajectory, pair.b.trajectory);
+  std::printf("case %d, 2 s: %lld steps %s vs %lld %s, joint angles differ by %.2e deg at most\n",
+              case_number, static_cast<long long>(pair.a.summary.steps), a_name,
+              static_cast<long long>(pair.b.summary.steps), b_name, pair.difference_deg);
+  return pair;
+}
+
 TEST(ArmDynamics, DefaultTolerancesAreConvergedForJointAngles) {
   // The default RK45 tolerances must not be what the joint angles depend on:
   // ten times tighter moves them by far less than mocap resolves (~0.01 deg).
-  // Measured 8.5e-4 deg: with stick-slip, a switch a little earlier leaves
-  // the arm stuck a little elsewhere, so this is not an O(tol) difference.
+  // Measured 1.7e-4 deg (8.5e-4 before the cable nodes were embedded): a
+  // slip a little earlier leaves the arm a little elsewhere, so this is not
+  // an O(tol) difference.
   const Config paper = LoadConfig(kPaper);
   Config tight = paper;
   tight.solver.relative_tolerance /= 10.0;
   tight.solver.absolute_tolerance /= 10.0;
-  const SimulationResult a = RunCompressedCase(2, paper);
-  const SimulationResult b = RunCompressedCase(2, tight);
-  ASSERT_TRUE(a.summary.completed() && b.summary.completed());
-  const double difference = MaxJointAngleDifferenceDeg(a.trajectory, b.trajectory);
-  std::printf("case 2, 2 s: %lld vs %lld steps, joint angles differ by %.2e deg at most\n",
-              static_cast<long long>(a.summary.steps), static_cast<long long>(b.summary.steps),
-              difference);
-  EXPECT_LT(difference, 5e-3);
+  EXPECT_LT(CompareCompressedCase(2, paper, "default", tight, "tight").difference_deg, 5e-3);
 }
 
 TEST(ArmDynamics, EmbeddedCableNodesGiveTheFullSystemsRun) {
@@ -159,14 +176,7 @@ TEST(ArmDynamics, EmbeddedCableNodesGiveTheFullSystemsRun) {
   ASSERT_TRUE(embedded.solver.embed_cable_nodes);  // the default
   Config full = embedded;
   full.solver.embed_cable_nodes = false;
-  const SimulationResult a = RunCompressedCase(2, embedded);
-  const SimulationResult b = RunCompressedCase(2, full);
-  ASSERT_TRUE(a.summary.completed() && b.summary.completed());
-  const double difference = MaxJointAngleDifferenceDeg(a.trajectory, b.trajectory);
-  std::printf("case 2, 2 s: %lld steps embedded vs %lld full, joint angles differ by %.2e deg\n",
-              static_cast<long long>(a.summary.steps), static_cast<long long>(b.summary.steps),
-              difference);
-  EXPECT_LT(difference, 1e-3);
+  EXPECT_LT(CompareCompressedCase(2, embedded, "embedded", full, "full").difference_deg, 1e-3);
 }
 
 TEST(ArmDynamics, ConnectingCableSmoothingChangesJointAnglesLittle) {
@@ -180,17 +190,10 @@ TEST(ArmDynamics, ConnectingCableSmoothingChangesJointAnglesLittle) {
   Config unsmoothed = paper;
   unsmoothed.solver.smooth_connecting_elasticity = false;
   for (int case_number : {1, 2}) {
-    const SimulationResult a = RunCompressedCase(case_number, paper);
-    const SimulationResult b = RunCompressedCase(case_number, unsmoothed);
-    ASSERT_TRUE(a.summary.completed() && b.summary.completed());
-    const double difference = MaxJointAngleDifferenceDeg(a.trajectory, b.trajectory);
-    std::printf(
-        "case %d: %lld steps smoothed vs %lld unsmoothed, joint angles differ by %.2e deg at "
-        "most\n",
-        case_number, static_cast<long long>(a.summary.steps),
-        static_cast<long long>(b.summary.steps), difference);
-    EXPECT_LT(difference, 0.04) << "case " << case_number;
-    EXPECT_LT(a.summary.steps, b.summary.steps) << "case " << case_number;
+    const RunPair runs =
+        CompareCompressedCase(case_number, paper, "smoothed", unsmoothed, "unsmoothed");
+    EXPECT_LT(runs.difference_deg, 0.04) << "case " << case_number;
+    EXPECT_LT(runs.a.summary.steps, runs.b.summary.steps) << "case " << case_number;
   }
 }
 
