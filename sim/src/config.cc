@@ -22,6 +22,8 @@ constexpr double kDegToRad = kPi / 180.0;
 constexpr const char* kSchema = "ccsrm-config/1";
 // The YAML words of HoleFrictionModel, in its order.
 const std::vector<std::string> kHoleFrictionWords = {"events", "smoothed", "off"};
+// The YAML words of RungeKuttaStepper, in its order (GSL's names).
+const std::vector<std::string> kStepperWords = {"rkck", "rkf45"};
 
 // Line (1-based) of every key path seen while parsing, so that Validate can
 // name the line of a value that is out of range.
@@ -512,6 +514,7 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
     sc.smooth_connecting_friction = s.Boolean("smooth_connecting_friction");
     sc.smooth_connecting_elasticity = s.Boolean("smooth_connecting_elasticity");
     sc.embed_cable_nodes = s.OptionalBoolean("embed_cable_nodes", true);
+    sc.stepper = static_cast<RungeKuttaStepper>(s.OptionalWord("stepper", kStepperWords, 0));
     sc.stick_velocity_tolerance_mps = s.Number("stick_velocity_tolerance_mps");
     sc.stick_force_tolerance_n = s.Number("stick_force_tolerance_n");
     sc.large_s_static_velocity_mps = s.Number("large_s_static_velocity_mps");
@@ -650,6 +653,7 @@ std::string ToYaml(const Config& c) {
   out << YAML::Key << "smooth_connecting_elasticity" << YAML::Value
       << s.smooth_connecting_elasticity;
   out << YAML::Key << "embed_cable_nodes" << YAML::Value << s.embed_cable_nodes;
+  out << YAML::Key << "stepper" << YAML::Value << kStepperWords[static_cast<int>(s.stepper)];
   out << YAML::Key << "stick_velocity_tolerance_mps" << YAML::Value
       << s.stick_velocity_tolerance_mps;
   out << YAML::Key << "stick_force_tolerance_n" << YAML::Value << s.stick_force_tolerance_n;

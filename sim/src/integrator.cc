@@ -20,27 +20,30 @@ int RightHandSide(double t, const double y[], double dydt[], void* params) {
 
 // GSL's stepper and step-size control. The step loop is ours rather than
 // gsl_odeiv2_evolve_apply: evolve evaluates the derivative at the start of
-// every step although RKF45 already computed it at the end of the previous
-// one, and the hole reports of that end-of-step evaluation are what the
-// stick-slip scan needs (6 evaluations per step instead of 8).
-class Rkf45Integrator : public Integrator {
+// every step although the stepper already computed it at the end of the
+// previous one, and the hole reports of that end-of-step evaluation are what
+// the stick-slip scan needs (6 evaluations per step instead of 7 or 8).
+class GslIntegrator : public Integrator {
  public:
-  Rkf45Integrator(ArmDynamics* dynamics, const SolverConfig& solver)
+  GslIntegrator(ArmDynamics* dynamics, const SolverConfig& solver)
       : dim_(dynamics->state_size()),
         system_{RightHandSide, nullptr, dim_, dynamics},
         error_(dim_) {
     UseGslErrorCodes();
-    step_ = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rkf45, dim_);
+    const gsl_odeiv2_step_type* type = solver.stepper == RungeKuttaStepper::kCashKarp
+                                           ? gsl_odeiv2_step_rkck
+                                           : gsl_odeiv2_step_rkf45;
+    step_ = gsl_odeiv2_step_alloc(type, dim_);
     const std::vector<double> scale = dynamics->ErrorScales();
     control_ = gsl_odeiv2_control_scaled_new(solver.absolute_tolerance, solver.relative_tolerance,
                                              1.0, 0.0, scale.data(), dim_);
   }
-  ~Rkf45Integrator() override {
+  ~GslIntegrator() override {
     gsl_odeiv2_control_free(control_);
     gsl_odeiv2_step_free(step_);
   }
-  Rkf45Integrator(const Rkf45Integrator&) = delete;
-  Rkf45Integrator& operator=(const Rkf45Integrator&) = delete;
+  GslIntegrator(const GslIntegrator&) = delete;
+  GslIntegrator& operator=(const GslIntegrator&) = delete;
 
   bool TryStep(double t0, const double* y0, const double* dydt0, double dt, double* y1,
                double* dydt1) override {
@@ -66,8 +69,8 @@ class Rkf45Integrator : public Integrator {
 
 }  // namespace
 
-std::unique_ptr<Integrator> MakeRkf45Integrator(ArmDynamics* dynamics, const SolverConfig& solver) {
-  return std::make_unique<Rkf45Integrator>(dynamics, solver);
+std::unique_ptr<Integrator> MakeIntegrator(ArmDynamics* dynamics, const SolverConfig& solver) {
+  return std::make_unique<GslIntegrator>(dynamics, solver);
 }
 
 }  // namespace ccsrm::sim::internal

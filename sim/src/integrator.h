@@ -29,8 +29,9 @@ class Integrator {
                                double* h_next) = 0;
 };
 
-// Runge-Kutta-Fehlberg 4(5) (GSL odeiv2) with the solver's tolerances;
-// velocities get absolute_tolerance / velocity_tolerance_time_s.
-std::unique_ptr<Integrator> MakeRkf45Integrator(ArmDynamics* dynamics, const SolverConfig& solver);
+// GSL odeiv2's embedded Runge-Kutta 4(5) stepper of solver.stepper
+// (Cash-Karp or Fehlberg) with GSL's standard step control and the solver's
+// tolerances, scaled per state entry by ArmDynamics::ErrorScales.
+std::unique_ptr<Integrator> MakeIntegrator(ArmDynamics* dynamics, const SolverConfig& solver);
 
 }  // namespace ccsrm::sim::internal

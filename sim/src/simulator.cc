@@ -49,7 +49,7 @@ class StepLoop {
       : options_(options),
         solver_(options.solver),
         dynamics_(model, parameters, inputs, options.solver),
-        integrator_(internal::MakeRkf45Integrator(&dynamics_, solver_)),
+        integrator_(internal::MakeIntegrator(&dynamics_, solver_)),
         stick_slip_(
             internal::MakeTrialAndErrorStickSlip(model, &dynamics_, integrator_.get(), solver_)),
         sampler_(internal::SampleTimes(options)),

@@ -123,6 +123,17 @@ TEST(Config, YamlRoundTripKeepsEveryValue) {
   EXPECT_EQ(b.arm.driving.cables[5].hole_angle_rad, a.arm.driving.cables[5].hole_angle_rad);
 }
 
+TEST(Config, StepperIsOneOfGslsFourFivePairsAndDefaultsToCashKarp) {
+  // `solver.stepper` chooses how, not what, is integrated: a file without
+  // the key (written before it existed) gets the default.
+  EXPECT_EQ(ParseConfig(Edited("  stepper: rkck\n", ""), "s.yaml").solver.stepper,
+            RungeKuttaStepper::kCashKarp);
+  EXPECT_EQ(ParseConfig(Edited("stepper: rkck", "stepper: rkf45"), "s.yaml").solver.stepper,
+            RungeKuttaStepper::kFehlberg);
+  EXPECT_THAT(ErrorOf(Edited("stepper: rkck", "stepper: rk4")),
+              HasSubstr("key 'solver.stepper': expected one of 'rkck', 'rkf45', found 'rk4'"));
+}
+
 TEST(Config, KeysAddedLaterMayBeLeftOutAndMeanThePapersLaw) {
   // `solver.hole_friction`, the Stribeck velocities and the frictional
   // memories came after ccsrm-config/1 was first published; a run file's

@@ -179,6 +179,20 @@ TEST(ArmDynamics, EmbeddedCableNodesGiveTheFullSystemsRun) {
   EXPECT_LT(CompareCompressedCase(2, embedded, "embedded", full, "full").difference_deg, 1e-3);
 }
 
+TEST(ArmDynamics, CashKarpAndFehlbergStepsGiveTheSameRun) {
+  // solver.stepper only chooses which embedded 4(5) pair of GSL integrates
+  // the same equations to the same tolerances, so the two runs may differ by
+  // no more than the integration error those tolerances leave, which
+  // DefaultTolerancesAreConvergedForJointAngles bounds at 5e-3 deg. A wrong
+  // stepper (a lower order, tolerances not passed on) moves them by more.
+  Config cash_karp = LoadConfig(kPaper);
+  ASSERT_EQ(cash_karp.solver.stepper, RungeKuttaStepper::kCashKarp);  // the default
+  Config fehlberg = cash_karp;
+  fehlberg.solver.stepper = RungeKuttaStepper::kFehlberg;
+  EXPECT_LT(CompareCompressedCase(2, cash_karp, "Cash-Karp", fehlberg, "Fehlberg").difference_deg,
+            5e-3);
+}
+
 TEST(ArmDynamics, ConnectingCableSmoothingChangesJointAnglesLittle) {
   // Smoothing the connecting springs over h only moves their 150-300 Hz
   // torsional modes down to ~40 Hz; the motion must barely notice it, even
