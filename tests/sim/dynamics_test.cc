@@ -185,8 +185,7 @@ TEST(ArmDynamics, CashKarpAndFehlbergStepsGiveTheSameRun) {
   // solver.stepper only chooses which embedded 4(5) pair of GSL integrates
   // the same equations to the same tolerances, so the two runs may differ by
   // no more than the integration error those tolerances leave, which
-  // DefaultTolerancesAreConvergedForJointAngles bounds at 5e-3 deg. A wrong
-  // stepper (a lower order, tolerances not passed on) moves them by more.
+  // DefaultTolerancesAreConvergedForJointAngles bounds at 5e-3 deg.
   Config cash_karp = LoadConfig(kPaper);
   ASSERT_EQ(cash_karp.solver.stepper, RungeKuttaStepper::kCashKarp);  // the default
   Config fehlberg = cash_karp;
