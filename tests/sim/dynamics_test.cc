@@ -190,8 +190,12 @@ TEST(ArmDynamics, CashKarpAndFehlbergStepsGiveTheSameRun) {
   ASSERT_EQ(cash_karp.solver.stepper, RungeKuttaStepper::kCashKarp);  // the default
   Config fehlberg = cash_karp;
   fehlberg.solver.stepper = RungeKuttaStepper::kFehlberg;
-  EXPECT_LT(CompareCompressedCase(2, cash_karp, "Cash-Karp", fehlberg, "Fehlberg").difference_deg,
-            5e-3);
+  const RunPair runs = CompareCompressedCase(2, cash_karp, "Cash-Karp", fehlberg, "Fehlberg");
+  EXPECT_LT(runs.difference_deg, 5e-3);
+  // Why Cash-Karp is the default: its stages cross a hole node's stick band
+  // less often, so it takes fewer steps where nodes slip just outside it
+  // (docs/model-notes.md, row 15; 856 against 1673 here).
+  EXPECT_LT(runs.a.summary.steps, runs.b.summary.steps);
 }
 
 TEST(ArmDynamics, ConnectingCableSmoothingChangesJointAnglesLittle) {
