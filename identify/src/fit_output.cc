@@ -67,8 +67,10 @@ std::vector<std::string> OutputStems(const IdentificationSummary& summary) {
 std::string UnidentifiableDirection::Describe() const {
   std::string out;
   for (const auto& [name, c] : components) {
+    // A small component (a parameter leaking into another's undetermined
+    // direction) keeps two significant digits instead of printing as 0.00.
     char text[64];
-    std::snprintf(text, sizeof(text), "%s%.2f %s",
+    std::snprintf(text, sizeof(text), std::abs(c) < 0.005 ? "%s%.1e %s" : "%s%.2f %s",
                   out.empty() ? (c < 0 ? "-" : "") : (c < 0 ? " - " : " + "), std::abs(c),
                   name.c_str());
     out += text;

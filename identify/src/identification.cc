@@ -883,38 +883,26 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
             sv[d] > tiny ? sigma_res / sv[d] : std::numeric_limits<double>::infinity();
         if (!(sv[d] > tiny)) ++null_rank;
       }
+      // Errors relative to the estimate (u is in units of the start's
+      // magnitude), with a floor of a tenth of that magnitude, so that an
+      // estimate the data pin near zero is not called undetermined for
+      // being small.
+      std::vector<double> relative_scale(p_count);
       for (std::size_t i = 0; i < p_count; ++i) {
-        double var = 0.0;
-        for (Eigen::Index d = 0; d < sv.size(); ++d) {
-          const double c = v(static_cast<Eigen::Index>(i), d);
-          if (c != 0.0) var += c * c * direction_error[d] * direction_error[d];
-        }
-        // Relative to the estimate (u is in units of the start's magnitude),
-        // with a floor of a tenth of that magnitude, so that an estimate the
-        // data pin near zero is not called undetermined for being small.
-        const double relative =
-            std::sqrt(var) * free[i].scale / std::max(std::abs(p_final[i]), 0.1 * free[i].scale);
-        identifiable[i] =
-            std::isfinite(relative) && relative <= options.max_relative_standard_error;
+        relative_scale[i] = free[i].scale / std::max(std::abs(p_final[i]), 0.1 * free[i].scale);
       }
-      for (Eigen::Index d = 0; d < sv.size(); ++d) {
-        // The largest relative error the direction gives any parameter, on
-        // the same footing as the parameters' own test above.
-        double worst = 0.0;
-        for (std::size_t i = 0; i < p_count; ++i) {
-          const double c = std::abs(v(static_cast<Eigen::Index>(i), d));
-          if (c == 0.0) continue;
-          worst = std::max(worst, c * direction_error[d] * free[i].scale /
-                                      std::max(std::abs(p_final[i]), 0.1 * free[i].scale));
-        }
-        if (!(worst > options.max_relative_standard_error)) continue;
+      constexpr double kComponentFloor = 0.2;  // smaller shares are left out of a name
+      const internal::Identifiability assessed = internal::AssessIdentifiability(
+          v, direction_error, relative_scale, options.max_relative_standard_error, kComponentFloor);
+      identifiable = assessed.identifiable;
+      for (const internal::Identifiability::Direction& named : assessed.named) {
+        const int d = named.column;
         UnidentifiableDirection dir;
         dir.singular_value = sv[d];
-        dir.relative_std_error = worst;
+        dir.relative_std_error = assessed.direction_worst[static_cast<std::size_t>(d)];
         std::vector<std::pair<std::string, double>> parts;
-        for (std::size_t i = 0; i < p_count; ++i) {
-          const double c = v(static_cast<Eigen::Index>(i), d);
-          if (std::abs(c) >= 0.2) parts.emplace_back(free[i].name, c);
+        for (const int i : named.members) {
+          parts.emplace_back(free[static_cast<std::size_t>(i)].name, v(i, d));
         }
         std::sort(parts.begin(), parts.end(), [](const auto& a, const auto& b) {
           return std::abs(a.second) > std::abs(b.second);

@@ -45,4 +45,64 @@ double StudentT975(double dof) {
   return gsl_cdf_tdist_Pinv(0.975, dof);
 }
 
+Identifiability AssessIdentifiability(const Eigen::MatrixXd& v,
+                                      const Eigen::VectorXd& direction_error,
+                                      const std::vector<double>& relative_scale, double threshold,
+                                      double component_floor) {
+  const Eigen::Index p = v.rows(), k = v.cols();
+  Identifiability out;
+  out.identifiable.assign(static_cast<std::size_t>(p), true);
+  out.direction_worst.assign(static_cast<std::size_t>(k), 0.0);
+  // share(i, d): the relative error direction d gives parameter i.
+  const auto share = [&](Eigen::Index i, Eigen::Index d) {
+    const double c = std::abs(v(i, d));
+    return c == 0.0 ? 0.0 : c * direction_error[d] * relative_scale[static_cast<std::size_t>(i)];
+  };
+  for (Eigen::Index i = 0; i < p; ++i) {
+    double var = 0.0;
+    for (Eigen::Index d = 0; d < k; ++d) var += share(i, d) * share(i, d);
+    const double relative = std::sqrt(var);
+    out.identifiable[static_cast<std::size_t>(i)] =
+        std::isfinite(relative) && relative <= threshold;
+  }
+  // members[d]: the parameters direction d names; it is named when any.
+  std::vector<std::vector<int>> members(static_cast<std::size_t>(k));
+  for (Eigen::Index d = 0; d < k; ++d) {
+    double worst = 0.0;
+    for (Eigen::Index i = 0; i < p; ++i) worst = std::max(worst, share(i, d));
+    out.direction_worst[static_cast<std::size_t>(d)] = worst;
+    if (!(worst > threshold)) continue;
+    for (Eigen::Index i = 0; i < p; ++i) {
+      if (std::abs(v(i, d)) >= component_floor) {
+        members[static_cast<std::size_t>(d)].push_back(static_cast<int>(i));
+      }
+    }
+  }
+  for (Eigen::Index i = 0; i < p; ++i) {
+    if (out.identifiable[static_cast<std::size_t>(i)]) continue;
+    bool held = false;
+    Eigen::Index largest = -1;
+    for (Eigen::Index d = 0; d < k; ++d) {
+      const std::vector<int>& m = members[static_cast<std::size_t>(d)];
+      if (std::find(m.begin(), m.end(), static_cast<int>(i)) != m.end()) held = true;
+      if (largest < 0 || share(i, d) > share(i, largest)) largest = d;
+    }
+    if (held || largest < 0) continue;
+    std::vector<int>& m = members[static_cast<std::size_t>(largest)];
+    if (m.empty()) {  // newly named: its own large components first
+      for (Eigen::Index j = 0; j < p; ++j) {
+        if (std::abs(v(j, largest)) >= component_floor) m.push_back(static_cast<int>(j));
+      }
+    }
+    if (std::find(m.begin(), m.end(), static_cast<int>(i)) == m.end()) {
+      m.insert(std::upper_bound(m.begin(), m.end(), static_cast<int>(i)), static_cast<int>(i));
+    }
+  }
+  for (Eigen::Index d = 0; d < k; ++d) {
+    if (members[static_cast<std::size_t>(d)].empty()) continue;
+    out.named.push_back({static_cast<int>(d), std::move(members[static_cast<std::size_t>(d)])});
+  }
+  return out;
+}
+
 }  // namespace ccsrm::identify::internal

@@ -1,6 +1,8 @@
 #pragma once
 // Residual statistics of a fit: how many independent samples autocorrelated
-// residuals are worth, and the t quantile of the intervals.
+// residuals are worth, the t quantile of the intervals, and which
+// parameters and directions the data leave undetermined.
+#include <Eigen/Core>
 #include <vector>
 
 namespace ccsrm::identify::internal {
@@ -17,5 +19,33 @@ double EffectiveSampleSize(const std::vector<std::vector<double>>& series);
 // The 97.5 % quantile of Student's t with `dof` degrees of freedom (1.96 for
 // large dof); NaN for dof < 1.
 double StudentT975(double dof);
+
+// What the data cannot pin down, from the SVD of the scaled Jacobian: v's
+// columns are the singular directions, direction_error[d] the standard
+// error along direction d (σ_res / σ_d, inf for σ_d = 0), relative_scale[i]
+// turns an error of parameter i in scaled units into one relative to its
+// estimate. A parameter is identifiable when its relative standard error,
+// over all directions, is at most `threshold`.
+struct Identifiability {
+  struct Direction {
+    int column = 0;            // of v
+    std::vector<int> members;  // parameters it names, in increasing order
+  };
+  std::vector<bool> identifiable;       // per parameter
+  std::vector<Direction> named;         // in increasing column order
+  std::vector<double> direction_worst;  // per direction: the largest relative
+                                        // error it gives any parameter
+};
+// Named: every direction that alone gives some parameter more than the
+// threshold, with the parameters whose component is at least
+// `component_floor`. An undetermined parameter that no such direction holds
+// (its error spread over several directions, or leaking into another
+// parameter's null direction through a small component) is added as a
+// member to the direction that contributes most to its error, so that every
+// undetermined parameter is named in some combination.
+Identifiability AssessIdentifiability(const Eigen::MatrixXd& v,
+                                      const Eigen::VectorXd& direction_error,
+                                      const std::vector<double>& relative_scale, double threshold,
+                                      double component_floor);
 
 }  // namespace ccsrm::identify::internal

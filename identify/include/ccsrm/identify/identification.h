@@ -191,11 +191,15 @@ struct ParameterEstimate {
   bool at_bound = false;  // the estimate sits on a bound: its interval is not symmetric
 };
 
-// A direction of the scaled parameters that the data do not pin down.
+// A direction of the scaled parameters that the data do not pin down: one
+// that alone gives some parameter more than max_relative_standard_error, or
+// the largest contributor to the error of an undetermined parameter that no
+// such direction holds (its error spread over several directions).
 struct UnidentifiableDirection {
   double singular_value = 0.0;
   // The largest standard error the direction gives a parameter, relative to
-  // its estimate as in the parameters' test (inf for σ_k = 0).
+  // its estimate as in the parameters' test (inf for σ_k = 0); below the
+  // threshold for a direction of the second kind.
   double relative_std_error = 0.0;
   // The parameters that make up the direction, largest share first, with
   // their component in the (unit) singular vector.
