@@ -67,16 +67,18 @@ Identifiability AssessIdentifiability(const Eigen::MatrixXd& v,
   }
   // members[d]: the parameters direction d names; it is named when any.
   std::vector<std::vector<int>> members(static_cast<std::size_t>(k));
-  for (Eigen::Index d = 0; d < k; ++d) {
-    double worst = 0.0;
-    for (Eigen::Index i = 0; i < p; ++i) worst = std::max(worst, share(i, d));
-    out.direction_worst[static_cast<std::size_t>(d)] = worst;
-    if (!(worst > threshold)) continue;
+  const auto name_large_components = [&](Eigen::Index d) {
     for (Eigen::Index i = 0; i < p; ++i) {
       if (std::abs(v(i, d)) >= component_floor) {
         members[static_cast<std::size_t>(d)].push_back(static_cast<int>(i));
       }
     }
+  };
+  for (Eigen::Index d = 0; d < k; ++d) {
+    double worst = 0.0;
+    for (Eigen::Index i = 0; i < p; ++i) worst = std::max(worst, share(i, d));
+    out.direction_worst[static_cast<std::size_t>(d)] = worst;
+    if (worst > threshold) name_large_components(d);
   }
   for (Eigen::Index i = 0; i < p; ++i) {
     if (out.identifiable[static_cast<std::size_t>(i)]) continue;
@@ -89,11 +91,7 @@ Identifiability AssessIdentifiability(const Eigen::MatrixXd& v,
     }
     if (held || largest < 0) continue;
     std::vector<int>& m = members[static_cast<std::size_t>(largest)];
-    if (m.empty()) {  // newly named: its own large components first
-      for (Eigen::Index j = 0; j < p; ++j) {
-        if (std::abs(v(j, largest)) >= component_floor) m.push_back(static_cast<int>(j));
-      }
-    }
+    if (m.empty()) name_large_components(largest);  // newly named: its own components too
     if (std::find(m.begin(), m.end(), static_cast<int>(i)) == m.end()) {
       m.insert(std::upper_bound(m.begin(), m.end(), static_cast<int>(i)), static_cast<int>(i));
     }
