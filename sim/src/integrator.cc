@@ -28,7 +28,8 @@ class GslIntegrator : public Integrator {
   GslIntegrator(ArmDynamics* dynamics, const SolverConfig& solver)
       : dim_(dynamics->state_size()),
         system_{RightHandSide, nullptr, dim_, dynamics},
-        error_(dim_) {
+        error_(dim_),
+        unused_rate_(dim_, 0.0) {
     UseGslErrorCodes();
     const gsl_odeiv2_step_type* type = solver.stepper == RungeKuttaStepper::kCashKarp
                                            ? gsl_odeiv2_step_rkck
@@ -53,16 +54,19 @@ class GslIntegrator : public Integrator {
            GSL_SUCCESS;
   }
 
-  bool ErrorAcceptable(const double* y1, const double* dydt1, double dt, double* h_next) override {
+  // The control weighs the derivative by a_dydt = 0, so a zero vector
+  // stands in for it (an end derivative is not always evaluated).
+  bool ErrorAcceptable(const double* y1, double dt, double* h_next) override {
     *h_next = dt;
-    return gsl_odeiv2_control_hadjust(control_, step_, y1, error_.data(), dydt1, h_next) !=
-           GSL_ODEIV_HADJ_DEC;
+    return gsl_odeiv2_control_hadjust(control_, step_, y1, error_.data(), unused_rate_.data(),
+                                      h_next) != GSL_ODEIV_HADJ_DEC;
   }
 
  private:
   std::size_t dim_;
   gsl_odeiv2_system system_;
   std::vector<double> error_;
+  std::vector<double> unused_rate_;
   gsl_odeiv2_step* step_ = nullptr;
   gsl_odeiv2_control* control_ = nullptr;
 };
