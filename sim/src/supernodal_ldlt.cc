@@ -8,9 +8,6 @@
 namespace ccsrm::sim::internal {
 namespace {
 
-using PanelMap = Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
-using ConstPanelMap = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
-
 // Position of `row` in the sorted list [begin, end) (which holds it).
 int PositionOf(const int* begin, const int* end, int row) {
   const int* at = std::lower_bound(begin, end, row);
@@ -247,33 +244,50 @@ bool SupernodalLdlt::Factorize(const double* values) {
   return true;
 }
 
-void SupernodalLdlt::Solve(Eigen::VectorXd& x) {
+// Plain loops rather than Eigen's triangular solves and products: the
+// panels are small (most a few columns), where the calls' set-up cost more
+// than the arithmetic.
+void SupernodalLdlt::Solve(Eigen::VectorXd& x_vector) {
   const SupernodalStructure& st = structure_;
+  double* x = x_vector.data();
+  double* gathered = gathered_.data();
   for (const SupernodalStructure::Supernode& s : st.supernodes_) {
-    const ConstPanelMap panel(storage_.data() + s.storage_offset, s.num_rows, s.num_cols,
-                              Eigen::OuterStride<>(s.num_rows));
-    auto head = x.segment(s.first_col, s.num_cols);
-    panel.topRows(s.num_cols).triangularView<Eigen::UnitLower>().solveInPlace(head);
-    const int num_below = s.num_rows - s.num_cols;
+    const double* panel = storage_.data() + s.storage_offset;
+    const int rows = s.num_rows, cols = s.num_cols, num_below = rows - cols;
+    double* head = x + s.first_col;
+    // L_head y = b over the supernode's own columns (unit lower).
+    for (int j = 0; j < cols; ++j) {
+      const double* col = panel + static_cast<std::size_t>(j) * rows;
+      const double xj = head[j];
+      for (int i = j + 1; i < cols; ++i) head[i] -= col[i] * xj;
+    }
     if (num_below == 0) continue;
-    auto gathered = gathered_.head(num_below);
-    gathered.noalias() = panel.bottomRows(num_below) * head;
-    const int* below_rows = &st.row_index_[s.rows_begin + s.num_cols];
+    Combination(panel + cols, rows, head, cols, num_below, gathered);
+    const int* below_rows = &st.row_index_[s.rows_begin + cols];
     for (int i = 0; i < num_below; ++i) x[below_rows[i]] -= gathered[i];
   }
-  x.array() /= pivots_.array();
+  for (int k = 0; k < st.size_; ++k) x[k] /= pivots_[k];
   for (auto s = st.supernodes_.rbegin(); s != st.supernodes_.rend(); ++s) {
-    const ConstPanelMap panel(storage_.data() + s->storage_offset, s->num_rows, s->num_cols,
-                              Eigen::OuterStride<>(s->num_rows));
-    auto head = x.segment(s->first_col, s->num_cols);
-    const int num_below = s->num_rows - s->num_cols;
+    const double* panel = storage_.data() + s->storage_offset;
+    const int rows = s->num_rows, cols = s->num_cols, num_below = rows - cols;
+    double* head = x + s->first_col;
     if (num_below > 0) {
-      auto gathered = gathered_.head(num_below);
-      const int* below_rows = &st.row_index_[s->rows_begin + s->num_cols];
+      const int* below_rows = &st.row_index_[s->rows_begin + cols];
       for (int i = 0; i < num_below; ++i) gathered[i] = x[below_rows[i]];
-      head.noalias() -= panel.bottomRows(num_below).transpose() * gathered;
+      for (int j = 0; j < cols; ++j) {
+        const double* col = panel + static_cast<std::size_t>(j) * rows + cols;
+        double sum = 0.0;
+        for (int i = 0; i < num_below; ++i) sum += col[i] * gathered[i];
+        head[j] -= sum;
+      }
     }
-    panel.topRows(s->num_cols).triangularView<Eigen::UnitLower>().transpose().solveInPlace(head);
+    // L_head^T x = y (unit upper).
+    for (int j = cols - 1; j >= 0; --j) {
+      const double* col = panel + static_cast<std::size_t>(j) * rows;
+      double sum = 0.0;
+      for (int i = j + 1; i < cols; ++i) sum += col[i] * head[i];
+      head[j] -= sum;
+    }
   }
 }
 
