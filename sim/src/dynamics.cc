@@ -73,7 +73,8 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
       solver_(solver),
       n_(model.num_coordinates()),
       m_(model.sparse_layout().num_constraints()),
-      system_(model.sparse_layout()) {
+      system_(model.sparse_layout(),
+              has_stick_slip() ? HoleStickRows::kKept : HoleStickRows::kLeftOut) {
   CCSRM_CHECK(inputs.num_cables() == model.num_cables());
   const ArmConfig& arm = model_.arm();
   ale_.linear_density_kgpm = arm.driving.density_kgpm3 * arm.driving.cross_section_m2;
@@ -131,6 +132,7 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
   rotation_.resize(model_.num_links());
   rate_matrix_.resize(model_.num_links());
   omega_.resize(model_.num_links());
+  point_kinematics_.resize(model_.num_links());
   relative_rotation_.resize(model_.num_joints());
   joint_moment_.resize(model_.num_joints());
   theta_.resize(model_.num_joints());
@@ -234,6 +236,7 @@ void ArmDynamics::ComputeLinkKinematics(const double* q, const double* qd) {
     rotation_[i - 1] = RotationFromQuaternion(e);
     rate_matrix_[i - 1] = QuaternionRateMatrix(e);
     omega_[i - 1] = rate_matrix_[i - 1] * ed;
+    point_kinematics_[i - 1] = BodyPointKinematics(e, ed);
   }
 }
 
@@ -698,11 +701,12 @@ void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, b
         phi_dot = v_node;
       } else {
         const int lo = model_.link_offset(node.link);
-        const Vector4 e = Quaternion(q, lo), ed = Quaternion(qd, lo);
-        jac = PointJacobian(e, node.p_LN);
+        const Vector4 ed = Quaternion(qd, lo);
+        const BodyPointKinematics& points = point_kinematics_[node.link - 1];
+        jac = points.Jacobian(node.p_LN);
         phi = r_node - Position(q, lo) - rotation_[node.link - 1] * node.p_LN;
         phi_dot = v_node - Position(qd, lo) - jac * ed;
-        bias = -PointJacobian(ed, node.p_LN) * ed;
+        bias = -points.VelocityProduct(node.p_LN);
       }
       NodeEmbedding& embedding = embedding_[node_index];
       embedding.jac = jac;
@@ -747,21 +751,22 @@ void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, b
   for (int j = 1; j <= model_.num_joints(); ++j) {
     const Vector3 u_p = model_.p_parent_joint(j), u_c = model_.p_child_joint(j);
     const int oc = model_.link_offset(j);
-    const Vector4 ec = Quaternion(q, oc), edc = Quaternion(qd, oc);
-    const Eigen::Matrix<double, 3, 4> jc = PointJacobian(ec, u_c);
+    const Vector4 edc = Quaternion(qd, oc);
+    const BodyPointKinematics& child = point_kinematics_[j - 1];
+    const Eigen::Matrix<double, 3, 4> jc = child.Jacobian(u_c);
     Vector3 phi = -Position(q, oc) - rotation_[j - 1] * u_c;
     Vector3 phi_dot = -Position(qd, oc) - jc * edc;
-    Vector3 bias = -PointJacobian(edc, u_c) * edc;
+    Vector3 bias = -child.VelocityProduct(u_c);
     Eigen::Matrix<double, 3, 4> jp;
-    Vector4 ep, edp;
+    Vector4 edp;
     if (j > 1) {
       const int op = model_.link_offset(j - 1);
-      ep = Quaternion(q, op);
       edp = Quaternion(qd, op);
-      jp = PointJacobian(ep, u_p);
+      const BodyPointKinematics& parent = point_kinematics_[j - 2];
+      jp = parent.Jacobian(u_p);
       phi += Position(q, op) + rotation_[j - 2] * u_p;
       phi_dot += Position(qd, op) + jp * edp;
-      bias += PointJacobian(edp, u_p) * edp;
+      bias += parent.VelocityProduct(u_p);
     } else {
       phi += u_p;
     }
@@ -779,18 +784,19 @@ void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, b
     // Orientation (eq. 37): (A_p x')^T (A_c y') = 0.
     const Vector3 a_vec = j > 1 ? Vector3(rotation_[j - 2] * x_axis) : x_axis;
     const Vector3 c_vec = rotation_[j - 1] * y_axis;
-    const Eigen::Matrix<double, 3, 4> dc = PointJacobian(ec, y_axis);
+    const Eigen::Matrix<double, 3, 4>& dc = child.axis_jacobian[1];
     const Vector3 c_dot = dc * edc;
     Vector3 a_dot = Vector3::Zero();
-    double bias_o = a_vec.dot(PointJacobian(edc, y_axis) * edc);
+    double bias_o = a_vec.dot(child.rate_quadratic.col(1));
     RowValues& row = rows_[r++];
     int v = 0;
     if (j > 1) {
-      const Eigen::Matrix<double, 3, 4> dp = PointJacobian(ep, x_axis);
+      const BodyPointKinematics& parent = point_kinematics_[j - 2];
+      const Eigen::Matrix<double, 3, 4>& dp = parent.axis_jacobian[0];
       a_dot = dp * edp;
       const Eigen::Matrix<double, 1, 4> g = c_vec.transpose() * dp;
       for (int k = 0; k < 4; ++k) row.vals[v++] = g[k];
-      bias_o += c_vec.dot(PointJacobian(edp, x_axis) * edp) + 2.0 * a_dot.dot(c_dot);
+      bias_o += c_vec.dot(parent.rate_quadratic.col(0)) + 2.0 * a_dot.dot(c_dot);
     }
     const Eigen::Matrix<double, 1, 4> g = a_vec.transpose() * dc;
     for (int k = 0; k < 4; ++k) row.vals[v++] = g[k];
@@ -800,9 +806,7 @@ void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, b
 }
 
 double ArmDynamics::ConstraintViolation(double t, const double* y) {
-  for (int i = 1; i <= model_.num_links(); ++i) {
-    rotation_[i - 1] = RotationFromQuaternion(Quaternion(y, model_.link_offset(i)));
-  }
+  ComputeLinkKinematics(y, y + n_);
   FillConstraints(t, y, y + n_, false);
   double sum = 0.0;
   for (const RowValues& row : rows_) {

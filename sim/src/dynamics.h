@@ -26,6 +26,7 @@
 #include "kernels/ale_element.h"
 #include "kernels/connecting.h"
 #include "kernels/hole_friction.h"
+#include "kernels/rigid_body.h"
 #include "sparse_system.h"
 
 namespace ccsrm::sim::internal {
@@ -170,6 +171,7 @@ class ArmDynamics {
   std::vector<Eigen::Matrix3d> rotation_;                 // per link A(e)
   std::vector<Eigen::Matrix<double, 3, 4>> rate_matrix_;  // per link G(e)
   std::vector<Eigen::Vector3d> omega_;                    // per link w' [rad/s]
+  std::vector<BodyPointKinematics> point_kinematics_;     // per link
   std::vector<Eigen::Matrix3d> relative_rotation_;        // per joint R_{L(i-1) L(i)}
   std::vector<Eigen::Vector2d> joint_moment_;             // per joint [N m]
   std::vector<Eigen::Vector2d> theta_, theta_dot_;        // per joint [rad], [rad/s]

@@ -2,6 +2,7 @@
 
 #include <Eigen/OrderingMethods>
 #include <algorithm>
+#include <map>
 #include <memory>
 
 #include "ccsrm/common/error.h"
@@ -167,7 +168,9 @@ SparseLayout::SparseLayout(const ArmModel& model) : n_(model.num_coordinates()) 
     const int s = model.node_offset(h.cable, h.node) + 3;
     hole_index_.push_back(Index(s, s));
   }
-  embedded_ = std::make_unique<const EmbeddedNodeLayout>(model, *this);
+  embedded_ = std::make_unique<const EmbeddedNodeLayout>(model, *this, HoleStickRows::kKept);
+  embedded_without_holes_ =
+      std::make_unique<const EmbeddedNodeLayout>(model, *this, HoleStickRows::kLeftOut);
 }
 
 // The elimination order. Under a scalar fill-reducing order the multiplier
@@ -264,18 +267,19 @@ int SparseLayout::Index(int model_row, int model_col) const {
   return static_cast<int>(at - inner);
 }
 
-AugmentedSystem::AugmentedSystem(const SparseLayout& layout)
+AugmentedSystem::AugmentedSystem(const SparseLayout& layout, HoleStickRows hole_rows)
     : layout_(layout),
+      embedded_(layout.embedded(hole_rows)),
       matrix_(layout.pattern()),
       ldlt_(layout.factorisation()),
-      embedded_values_(static_cast<std::size_t>(layout.embedded().pattern_.nonZeros()), 0.0),
-      embedded_ldlt_(layout.embedded().factorisation()) {
+      embedded_values_(static_cast<std::size_t>(embedded_.pattern_.nonZeros()), 0.0),
+      embedded_ldlt_(embedded_.factorisation()) {
   const int size = layout.num_coordinates() + layout.num_constraints();
   rhs_.setZero(size);
   solution_.setZero(size);
   ordered_.setZero(size);
   reduced_rhs_.setZero(size);
-  embedded_ordered_.setZero(layout.embedded().size());
+  embedded_ordered_.setZero(embedded_.size());
 }
 
 void AugmentedSystem::Clear() {
@@ -293,7 +297,8 @@ bool AugmentedSystem::Solve() {
   return true;
 }
 
-EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout& full)
+EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout& full,
+                                       HoleStickRows hole_rows)
     : full_size_(full.n_ + full.m_) {
   const int n = full.n_;
   // Which full unknowns are a node's position coordinate, a link's
@@ -319,6 +324,8 @@ EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout
     for (int a = 0; a < 7; ++a) is_link[model.link_offset(i) + a] = 1;
   for (int r = 0; r < full.m_; ++r) {
     if (full.rows_[r].node >= 0) eliminated[n + r] = 1;
+    // A row left out has no image: its entries are dropped, lambda = 0.
+    if (hole_rows == HoleStickRows::kLeftOut && full.rows_[r].hole >= 0) eliminated[n + r] = 1;
   }
   reduced_of_.assign(full_size_, -1);
   for (int u = 0; u < full_size_; ++u) {
@@ -398,6 +405,7 @@ EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout
 
   std::vector<std::vector<int>> kept_of_node(nodes_.size());  // node -> index into node_kept_
   std::vector<std::vector<int>> pair_of_node(nodes_.size());  // node n -> index into node_pairs_
+  std::map<std::pair<int, int>, int> link_block_of;           // (lo, hi) links -> link_blocks_
   for (const Entry& e : entries) {
     const int ri = reduced_of_[e.row], rj = reduced_of_[e.col];
     if (ri >= 0 && rj >= 0) {
@@ -440,20 +448,30 @@ EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout
       np.n = ni;
       np.m = nj;
       std::fill(np.full, np.full + 9, -1);
-      std::fill(np.target, np.target + 49, -1);
-      std::fill(np.twice, np.twice + 49, -1);
-      np.on_links = nodes_[ni].link > 0 && nodes_[nj].link > 0;
-      if (np.on_links) {
-        for (int p = 0; p < 7; ++p) {
-          for (int q = 0; q < 7; ++q) {
-            const int P = link_unknown(ni, p), Q = link_unknown(nj, q);
-            if (ni == nj) {
-              if (order_[P] >= order_[Q]) np.target[7 * p + q] = lower(P, Q);
-            } else {
-              np.target[7 * p + q] = lower(P, Q);
-              if (P == Q) np.twice[7 * p + q] = np.target[7 * p + q];
+      const int link_n = nodes_[ni].link, link_m = nodes_[nj].link;
+      if (link_n > 0 && link_m > 0) {
+        const int lo = std::min(link_n, link_m), hi = std::max(link_n, link_m);
+        auto at = link_block_of.find({lo, hi});
+        if (at == link_block_of.end()) {
+          LinkBlock block;
+          const int lo_offset = nodes_[link_n == lo ? ni : nj].link_offset;
+          const int hi_offset = nodes_[link_n == hi ? ni : nj].link_offset;
+          for (int p = 0; p < 7; ++p) {
+            for (int q = 0; q < 7; ++q) {
+              const int P = reduced_of_[lo_offset + p], Q = reduced_of_[hi_offset + q];
+              const bool stored = lo != hi || order_[P] >= order_[Q];
+              block.target[p + 7 * q] = stored ? lower(P, Q) : -1;
             }
           }
+          at = link_block_of.emplace(std::make_pair(lo, hi), static_cast<int>(link_blocks_.size()))
+                   .first;
+          link_blocks_.push_back(block);
+        }
+        np.block = at->second;
+        if (link_n == link_m) {
+          np.into = ni == nj ? NodePair::Into::kAsIs : NodePair::Into::kWithMirror;
+        } else {
+          np.into = link_n == lo ? NodePair::Into::kAsIs : NodePair::Into::kTransposed;
         }
       }
       found = static_cast<int>(node_pairs_.size());
@@ -465,7 +483,7 @@ EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout
 }
 
 bool AugmentedSystem::SolveEmbedded(const std::vector<NodeEmbedding>& nodes) {
-  const EmbeddedNodeLayout& em = layout_.embedded();
+  const EmbeddedNodeLayout& em = embedded_;
   CCSRM_CHECK(nodes.size() == em.nodes_.size());
   const double* full = matrix_.valuePtr();
   auto value = [full](int k) { return k >= 0 ? full[k] : 0.0; };
@@ -486,6 +504,11 @@ bool AugmentedSystem::SolveEmbedded(const std::vector<NodeEmbedding>& nodes) {
     for (int p = 0; p < 3; ++p) reduced[nk.target[p]] += a[p];
     for (int j = 0; j < 4; ++j) reduced[nk.target[3 + j]] += t[j];
   }
+  // Node pairs on links: X = T_n^T B T_m with T = [I | jac], summed per
+  // pair of links and added to the reduced matrix once per link block.
+  link_block_sums_.resize(em.link_blocks_.size());
+  for (Eigen::Matrix<double, 7, 7>& sum : link_block_sums_) sum.setZero();
+  using Into = EmbeddedNodeLayout::NodePair::Into;
   for (const EmbeddedNodeLayout::NodePair& np : em.node_pairs_) {
     Eigen::Matrix3d b;
     for (int a = 0; a < 3; ++a)
@@ -493,21 +516,31 @@ bool AugmentedSystem::SolveEmbedded(const std::vector<NodeEmbedding>& nodes) {
     const int rn = em.nodes_[np.n].r, rm = em.nodes_[np.m].r;
     g.segment<3>(rn) -= b * nodes[np.m].c;
     if (np.n != np.m) g.segment<3>(rm) -= b.transpose() * nodes[np.n].c;
-    if (!np.on_links) continue;
-    // X = T_n^T B T_m with T = [I | jac].
+    if (np.block < 0) continue;
     Eigen::Matrix<double, 3, 7> bt;
     bt.leftCols<3>() = b;
     bt.rightCols<4>().noalias() = b * nodes[np.m].jac;
     Eigen::Matrix<double, 7, 7> x;
     x.topRows<3>() = bt;
     x.bottomRows<4>().noalias() = nodes[np.n].jac.transpose() * bt;
-    for (int p = 0; p < 7; ++p) {
-      for (int q = 0; q < 7; ++q) {
-        const int k = 7 * p + q;
-        if (np.target[k] >= 0) reduced[np.target[k]] += x(p, q);
-        if (np.twice[k] >= 0) reduced[np.twice[k]] += x(p, q);
-      }
+    Eigen::Matrix<double, 7, 7>& sum = link_block_sums_[np.block];
+    switch (np.into) {
+      case Into::kAsIs:
+        sum += x;
+        break;
+      case Into::kTransposed:
+        sum += x.transpose();
+        break;
+      case Into::kWithMirror:
+        sum += x + x.transpose();
+        break;
     }
+  }
+  for (std::size_t k = 0; k < em.link_blocks_.size(); ++k) {
+    const int* target = em.link_blocks_[k].target;
+    const double* sum = link_block_sums_[k].data();
+    for (int e = 0; e < 49; ++e)
+      if (target[e] >= 0) reduced[target[e]] += sum[e];
   }
 
   // Reduced right-hand side: the kept unknowns' g, plus T_n^T g(r_n).

@@ -52,13 +52,20 @@ struct NodeEmbedding {
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
 };
 
+// Whether a system keeps the hole nodes' stick constraints. Only the events
+// treatment of hole friction ever switches one on; under the smoothed
+// treatment they are always off (lambda = 0), and leaving them out takes a
+// quarter off the embedded system's factorisation.
+enum class HoleStickRows { kKept, kLeftOut };
+
 // The augmented system with every cable node's position (and its 3 rows)
 // eliminated by NodeEmbedding: unknowns the material coordinates, the links'
-// coordinates and the other rows (docs/model-notes.md, row 23). Built from a
+// coordinates and the other rows (docs/model-notes.md, row 23), the hole
+// nodes' stick rows only with HoleStickRows::kKept. Built from a
 // SparseLayout; the reduced matrix is assembled from the full one's values.
 class EmbeddedNodeLayout {
  public:
-  EmbeddedNodeLayout(const ArmModel& model, const SparseLayout& full);
+  EmbeddedNodeLayout(const ArmModel& model, const SparseLayout& full, HoleStickRows hole_rows);
 
   int size() const { return size_; }
   const SupernodalStructure& factorisation() const { return *factorisation_; }
@@ -80,15 +87,24 @@ class EmbeddedNodeLayout {
     int full[3];
     int target[7];
   };
-  // Full entries A[r_n a, r_m b] of two nodes n <= m (row-major 3 x 3) and
-  // where X = T_n^T B T_m lands: X(p, q) goes to target[7p + q] (-1: not
-  // stored there), and to twice[7p + q] too where both images coincide.
+  // Full entries A[r_n a, r_m b] of two nodes n <= m (row-major 3 x 3).
+  // With both nodes on links, X = T_n^T B T_m (7 x 7) is summed into the
+  // block of their two links (LinkBlock `block`): as X, as X^T (the block's
+  // rows are the other node's link), or as X + X^T (two nodes of one link:
+  // the pair and its mirror).
   struct NodePair {
+    enum class Into : char { kAsIs, kTransposed, kWithMirror };
     int n = 0, m = 0;
-    bool on_links = false;  // both nodes on links (else only the right-hand side)
+    int block = -1;  // -1: a node on the ground (only the right-hand side)
+    Into into = Into::kAsIs;
     int full[9];
+  };
+  // The 7 x 7 block of the reduced matrix over links (lo, hi), lo <= hi,
+  // summed over node pairs first and then added once: entry (p, q),
+  // column-major, goes to target[p + 7q] (-1: the upper triangle of a
+  // diagonal block).
+  struct LinkBlock {
     int target[49];
-    int twice[49];
   };
 
   int size_ = 0;
@@ -101,6 +117,7 @@ class EmbeddedNodeLayout {
   std::vector<std::pair<int, int>> copy_;  // (full value index, reduced value index)
   std::vector<NodeKept> node_kept_;
   std::vector<NodePair> node_pairs_;
+  std::vector<LinkBlock> link_blocks_;
   std::unique_ptr<const SupernodalStructure> factorisation_;
 };
 
@@ -142,7 +159,9 @@ class SparseLayout {
   // The symbolic factorisation of the pattern in that order.
   const SupernodalStructure& factorisation() const { return *factorisation_; }
   // The same system with the cable nodes' positions eliminated.
-  const EmbeddedNodeLayout& embedded() const { return *embedded_; }
+  const EmbeddedNodeLayout& embedded(HoleStickRows hole_rows) const {
+    return hole_rows == HoleStickRows::kKept ? *embedded_ : *embedded_without_holes_;
+  }
   int num_cable_nodes() const { return num_cable_nodes_; }
 
   // Elimination order for the unknowns of `members` (blocks, each listing
@@ -174,6 +193,7 @@ class SparseLayout {
   std::vector<int> hole_index_;
   std::unique_ptr<const SupernodalStructure> factorisation_;
   std::unique_ptr<const EmbeddedNodeLayout> embedded_;
+  std::unique_ptr<const EmbeddedNodeLayout> embedded_without_holes_;
   int num_cable_nodes_ = 0;
 };
 
@@ -183,7 +203,10 @@ class SparseLayout {
 // right-hand side and the solution are in the model's order.
 class AugmentedSystem {
  public:
-  explicit AugmentedSystem(const SparseLayout& layout);
+  // `hole_rows`: which embedded system SolveEmbedded uses; kLeftOut only
+  // where no hole node's stick row is ever on.
+  explicit AugmentedSystem(const SparseLayout& layout,
+                           HoleStickRows hole_rows = HoleStickRows::kKept);
 
   // Zeroes the matrix values and the right-hand side.
   void Clear();
@@ -196,12 +219,14 @@ class AugmentedSystem {
   // The same solution through the system with every cable node's position
   // eliminated (`nodes`, one per cable node): the matrix and right-hand
   // side must have been assembled without the nodes' position rows. Their
-  // multipliers are not computed (set to 0).
+  // multipliers are not computed (set to 0), nor, with
+  // HoleStickRows::kLeftOut, the hole nodes' (0, as they are off).
   bool SolveEmbedded(const std::vector<NodeEmbedding>& nodes);
   const Eigen::VectorXd& solution() const { return solution_; }
 
  private:
   const SparseLayout& layout_;
+  const EmbeddedNodeLayout& embedded_;
   Eigen::SparseMatrix<double> matrix_;
   SupernodalLdlt ldlt_;
   Eigen::VectorXd rhs_, solution_;
@@ -211,6 +236,7 @@ class AugmentedSystem {
   std::vector<double> embedded_values_;
   SupernodalLdlt embedded_ldlt_;
   Eigen::VectorXd reduced_rhs_;  // g = rhs - A[:, r] c, over the full unknowns
+  std::vector<Eigen::Matrix<double, 7, 7>> link_block_sums_;
   Eigen::VectorXd embedded_ordered_;
 };
 

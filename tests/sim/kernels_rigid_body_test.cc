@@ -97,6 +97,22 @@ TEST(RigidBody, PointAccelerationBiasIsRateJacobianTimesRate) {
   EXPECT_LT((PointJacobian(e_dot, u) * e_dot - fd).norm(), 1e-8);
 }
 
+// The per-body shortcut the dynamics uses for every cable node and joint
+// point: the same Jacobian and velocity product as the direct formulas, to
+// rounding, anywhere (off the unit sphere too).
+TEST(RigidBody, BodyPointKinematicsGivesEachPointsJacobianAndVelocityProduct) {
+  std::mt19937 rng(45);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Vector4d e = RandomVector4(&rng), e_dot = RandomVector4(&rng);
+    const BodyPointKinematics body(e, e_dot);
+    for (int point = 0; point < 5; ++point) {
+      const Eigen::Vector3d u = RandomVector3(&rng);
+      EXPECT_LT((body.Jacobian(u) - PointJacobian(e, u)).norm(), 1e-14);
+      EXPECT_LT((body.VelocityProduct(u) - PointJacobian(e_dot, u) * e_dot).norm(), 1e-14);
+    }
+  }
+}
+
 TEST(RigidBody, BodyAngularVelocityMatchesRotationRate) {
   // A^T A_dot = Skew(w') along a path on the unit sphere.
   std::mt19937 rng(45);

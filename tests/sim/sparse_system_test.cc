@@ -127,11 +127,16 @@ std::vector<std::vector<double>> ConstraintJacobian(const ArmModel& model,
 // Fills `system` as ArmDynamics::Evaluate does (element and link masses,
 // connecting-pair terms, Phi_q^T Phi_q, the coupling and the multiplier
 // diagonal: -delta, or -1 on the stick rows switched off), with a random
-// right-hand side. Every other hole node slips.
+// right-hand side. Every other hole node slips, or with `every_hole_slips`
+// all of them (as under the smoothed treatment).
 // With `skip_node_rows`, the cable nodes' position rows are left out, as
 // ArmDynamics leaves them out for the embedded system.
+bool SwitchedOff(const ConstraintRowLayout& row, bool every_hole_slips) {
+  return row.hole >= 0 && (every_hole_slips || row.hole % 2 == 1);
+}
+
 void Assemble(const ArmModel& model, const Config& config, const BentState& state,
-              AugmentedSystem* system, bool skip_node_rows = false) {
+              AugmentedSystem* system, bool skip_node_rows = false, bool every_hole_slips = false) {
   const SparseLayout& layout = model.sparse_layout();
   const int n = layout.num_coordinates();
   std::mt19937 random(7);
@@ -189,7 +194,7 @@ void Assemble(const ArmModel& model, const Config& config, const BentState& stat
     const ConstraintRowLayout& row = layout.rows()[r];
     ASSERT_EQ(static_cast<int>(jacobian[r].size()), row.count);
     if (skip_node_rows && row.node >= 0) continue;
-    if (row.hole >= 0 && row.hole % 2 == 1) {
+    if (SwitchedOff(row, every_hole_slips)) {
       values[layout.row_diagonal(r)] = -1.0;
       rhs[n + r] = 0.0;
       continue;
@@ -297,24 +302,31 @@ TEST_F(SparseSystemTest, ScalarAmdSimplicialLdltFailsTheForwardBound) {
 // (EmbeddedNodeLayout) solves the same equations: the right-hand side is
 // made consistent (F - Phi_q^T b over the coordinates, -b on the rows, as
 // AddConstraints builds it), and the embedded system, assembled without
-// the node rows, gets their b through NodeEmbedding's c = -b.
-TEST_F(SparseSystemTest, EmbeddedNodesSolveTheSameEquations) {
-  const SparseLayout& layout = model_->sparse_layout();
+// the node rows, gets their b through NodeEmbedding's c = -b. With the hole
+// nodes' stick rows left out, every hole node slips (their lambda is 0).
+void ExpectEmbeddedSolvesTheSameEquations(const ArmModel& model, const Config& config,
+                                          HoleStickRows hole_rows) {
+  const SparseLayout& layout = model.sparse_layout();
   const int n = layout.num_coordinates(), m = layout.num_constraints();
-  const BentState state = MakeBentState(*model_, config_);
-  AugmentedSystem embedded(layout);
-  Assemble(*model_, config_, state, &embedded, /*skip_node_rows=*/true);
-  const EmbeddedNodeLayout& em = layout.embedded();
-  std::printf("embedded: %d unknowns (full %d), nnz(L) %zu, %.3g multiply-adds\n", em.size(), n + m,
+  const bool every_hole_slips = hole_rows == HoleStickRows::kLeftOut;
+  const BentState state = MakeBentState(model, config);
+  AugmentedSystem full(layout);
+  Assemble(model, config, state, &full, /*skip_node_rows=*/false, every_hole_slips);
+  AugmentedSystem embedded(layout, hole_rows);
+  Assemble(model, config, state, &embedded, /*skip_node_rows=*/true, every_hole_slips);
+  const EmbeddedNodeLayout& em = layout.embedded(hole_rows);
+  std::printf("embedded (hole rows %s): %d unknowns (full %d), nnz(L) %zu, %.3g multiply-adds\n",
+              every_hole_slips ? "left out" : "kept", em.size(), n + m,
               em.factorisation().factor_nonzeros(), em.factorisation().factor_flops());
-  EXPECT_EQ(em.size(), n + m - 720);  // 120 nodes' 3 coordinates and 3 rows
+  // 120 nodes' 3 coordinates and 3 rows; left out, the 108 hole nodes' rows.
+  EXPECT_EQ(em.size(), n + m - 720 - (every_hole_slips ? 108 : 0));
 
   std::mt19937 random(11);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   Eigen::VectorXd force(n), b(m);
   for (int k = 0; k < n; ++k) force[k] = uniform(random);
   for (int r = 0; r < m; ++r) b[r] = uniform(random);
-  const std::vector<std::vector<double>> jacobian = ConstraintJacobian(*model_, state.q);
+  const std::vector<std::vector<double>> jacobian = ConstraintJacobian(model, state.q);
   std::vector<NodeEmbedding> nodes(layout.num_cable_nodes());
   Eigen::VectorXd full_rhs = Eigen::VectorXd::Zero(n + m);
   full_rhs.head(n) = force;
@@ -322,7 +334,7 @@ TEST_F(SparseSystemTest, EmbeddedNodesSolveTheSameEquations) {
   embedded_rhs = full_rhs;
   for (int r = 0; r < m; ++r) {
     const ConstraintRowLayout& row = layout.rows()[r];
-    if (row.hole >= 0 && row.hole % 2 == 1) continue;  // switched off: lambda = 0
+    if (SwitchedOff(row, every_hole_slips)) continue;  // lambda = 0
     if (row.node >= 0) {
       // Rows of a node come in axis order; their Jacobian is [1, -1, -jac].
       NodeEmbedding& node = nodes[row.node];
@@ -341,7 +353,7 @@ TEST_F(SparseSystemTest, EmbeddedNodesSolveTheSameEquations) {
   }
   // The reference: the full system with the node rows exact (no -delta on
   // their diagonal, which the embedding does not have), by dense LU.
-  Eigen::MatrixXd exact(a_);
+  Eigen::MatrixXd exact(ModelOrderMatrix(layout, full));
   for (int r = 0; r < m; ++r)
     if (layout.rows()[r].node >= 0) exact(n + r, n + r) = 0.0;
   const Eigen::VectorXd reference = exact.partialPivLu().solve(full_rhs);
@@ -362,8 +374,19 @@ TEST_F(SparseSystemTest, EmbeddedNodesSolveTheSameEquations) {
               forward_lambda);
   EXPECT_LT(forward_q, 1e-12);
   EXPECT_LT(forward_lambda, 1e-12);
-  // Its factorisation is the cheaper one, or it has no reason to exist.
-  EXPECT_LT(em.factorisation().factor_flops(), layout.factorisation().factor_flops());
+  // Each is the cheaper factorisation, or it has no reason to exist.
+  const double cheaper_than =
+      every_hole_slips ? layout.embedded(HoleStickRows::kKept).factorisation().factor_flops()
+                       : layout.factorisation().factor_flops();
+  EXPECT_LT(em.factorisation().factor_flops(), cheaper_than);
+}
+
+TEST_F(SparseSystemTest, EmbeddedNodesSolveTheSameEquations) {
+  ExpectEmbeddedSolvesTheSameEquations(*model_, config_, HoleStickRows::kKept);
+}
+
+TEST_F(SparseSystemTest, EmbeddedNodesWithoutHoleStickRowsSolveTheSameEquationsWhenEveryHoleSlips) {
+  ExpectEmbeddedSolvesTheSameEquations(*model_, config_, HoleStickRows::kLeftOut);
 }
 
 }  // namespace

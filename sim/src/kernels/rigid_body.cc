@@ -45,6 +45,11 @@ Matrix34d PointJacobian(const Eigen::Vector4d& e, const Eigen::Vector3d& u_body)
   return d;
 }
 
+BodyPointKinematics::BodyPointKinematics(const Eigen::Vector4d& e, const Eigen::Vector4d& e_dot)
+    : rate_quadratic(2.0 * RotationFromQuaternion(e_dot)) {
+  for (int k = 0; k < 3; ++k) axis_jacobian[k] = PointJacobian(e, Eigen::Vector3d::Unit(k));
+}
+
 Eigen::Matrix4d QuaternionMass(const Eigen::Vector4d& e, const Eigen::Matrix3d& inertia_body) {
   const Matrix34d g = QuaternionRateMatrix(e);
   return g.transpose() * inertia_body * g;

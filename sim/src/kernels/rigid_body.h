@@ -39,6 +39,28 @@ Eigen::Vector3d BodyAngularVelocity(const Eigen::Vector4d& e, const Eigen::Vecto
 // x_C'' + D(e, u') e'' + D(e_dot, u') e_dot.
 Matrix34d PointJacobian(const Eigen::Vector4d& e, const Eigen::Vector3d& u_body);
 
+// PointJacobian and the velocity product D(e_dot, u') e_dot of every point of
+// one body, from work done once per body: D is linear in u', so D(e, u') =
+// sum_k u'_k D(e, e_k); and D(a, u') a = 2 A(a) u' (A's formula is a
+// quadratic form in e). A link carries many cable nodes, each needing both.
+struct BodyPointKinematics {
+  BodyPointKinematics() = default;
+  BodyPointKinematics(const Eigen::Vector4d& e, const Eigen::Vector4d& e_dot);
+
+  // D(e, u') (3 x 4).
+  Matrix34d Jacobian(const Eigen::Vector3d& u_body) const {
+    return axis_jacobian[0] * u_body.x() + axis_jacobian[1] * u_body.y() +
+           axis_jacobian[2] * u_body.z();
+  }
+  // D(e_dot, u') e_dot, the acceleration of the point at e'' = 0 and x_C'' = 0.
+  Eigen::Vector3d VelocityProduct(const Eigen::Vector3d& u_body) const {
+    return rate_quadratic * u_body;
+  }
+
+  Matrix34d axis_jacobian[3];                                // D(e, e_k), k = x, y, z
+  Eigen::Matrix3d rate_quadratic = Eigen::Matrix3d::Zero();  // 2 A(e_dot)
+};
+
 // Quaternion block of the mass matrix, m_e = G^T J' G (eq. 31) [kg m^2].
 // Singular (m_e e = 0): the caller adds the constraint e.e = 1 (eq. 35).
 Eigen::Matrix4d QuaternionMass(const Eigen::Vector4d& e, const Eigen::Matrix3d& inertia_body);
