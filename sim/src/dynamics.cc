@@ -267,9 +267,7 @@ bool ArmDynamics::AddCableElements(const double* q, const double* qd) {
       }
       const AleElementTerms terms = EvaluateAleElement(ale_, qe, qde);
       const int* index = layout_.element_block(element);
-      const Matrix8d mass = terms.mass + terms.elastic_mass;
-      for (int a = 0; a < 8; ++a)
-        for (int b = 0; b < 8; ++b) values[index[8 * a + b]] += mass(a, b);
+      AddSymmetricBlock(terms.mass + terms.elastic_mass, index, values);
       const Vector8d f = terms.ale_inertia_force + terms.elastic_force;
       for (int a = 0; a < 8; ++a) force_[cols[a]] += f[a];
       tension_[c][e] = terms.tension;
@@ -492,9 +490,8 @@ void ArmDynamics::AddConnectingMoments(double t, const double* memory) {
         Eigen::Matrix2d form = friction_smoothing;
         form += smoothing_mass * (Eigen::Matrix2d() << 1.0, -1.0, -1.0, 1.0).finished();
         const Eigen::Matrix<double, 12, 12> added = jac.transpose() * form * jac;
-        const int* block = layout_.pair_block(static_cast<int>(p));
-        for (int a = 0; a < width; ++a)
-          for (int b = 0; b < width; ++b) values[block[width * a + b]] += added(a, b);
+        AddSymmetricBlock(added.topLeftCorner(width, width),
+                          layout_.pair_block(static_cast<int>(p)), values);
         // The smoothing moments -form * theta_dd do work on the rates; it is
         // booked as dissipation once q_dd is known.
         SmoothingPower power;
@@ -545,8 +542,8 @@ void ArmDynamics::AddEffectJointMoment(int joint, int axis, double moment, doubl
   const double mass = 0.5 * h * damping;
   double* values = system_.values();
   const int* block = layout_.row_block(r);
-  for (int a = 0; a < width; ++a)
-    for (int b = 0; b < width; ++b) values[block[width * a + b]] += mass * jac[a] * jac[b];
+  for (int a = 0, k = 0; a < width; ++a)
+    for (int b = 0; b <= a; ++b) values[block[k++]] += mass * jac[a] * jac[b];
   // The smoothing moment -mass theta_dd does work on the rate; booked once
   // q_dd is known.
   SmoothingPower power;
@@ -586,9 +583,7 @@ void ArmDynamics::AddLinkInertia(const double* q, const double* qd) {
     const Eigen::Matrix3d inertia = link.inertia_kgm2.asDiagonal();
     const int* index = layout_.link_block(i);
     for (int a = 0; a < 3; ++a) values[index[a]] += link.mass_kg;
-    const Eigen::Matrix4d me = QuaternionMass(e, inertia);
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) values[index[3 + 4 * a + b]] += me(a, b);
+    AddSymmetricBlock(QuaternionMass(e, inertia), index + 3, values);
     force_.segment<3>(o) += link.mass_kg * model_.arm().gravity_mps2;
     force_.segment<4>(o + 3) += QuaternionVelocityForce(e, ed, inertia);
     kinetic_ += 0.5 * link.mass_kg * Position(qd, o).squaredNorm() +
@@ -619,12 +614,10 @@ void ArmDynamics::AddConstraints(double t, const double* q, const double* qd) {
     rhs[n_ + r] = -row.b;
     const int* block = layout_.row_block(r);
     const int* coupling = layout_.row_coupling(r);
-    for (int a = 0; a < cols.count; ++a) {
+    for (int a = 0, k = 0; a < cols.count; ++a) {
       rhs[cols.cols[a]] -= row.vals[a] * row.b;
-      values[coupling[2 * a]] += row.vals[a];
-      values[coupling[2 * a + 1]] += row.vals[a];
-      for (int b = 0; b < cols.count; ++b)
-        values[block[cols.count * a + b]] += row.vals[a] * row.vals[b];
+      values[coupling[a]] += row.vals[a];
+      for (int b = 0; b <= a; ++b) values[block[k++]] += row.vals[a] * row.vals[b];
     }
   }
 }

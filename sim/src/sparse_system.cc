@@ -124,8 +124,10 @@ SparseLayout::SparseLayout(const ArmModel& model) : n_(model.num_coordinates()) 
     pattern.emplace_back(n_ + r, n_ + r, 0.0);
   }
   order_ = BlockOrder(n_ + m_, InterleavedBlocks(model), pattern);
+  // Each symmetric pair once, in the lower triangle.
   for (auto& entry : pattern) {
-    entry = Eigen::Triplet<double>(order_[entry.row()], order_[entry.col()], 0.0);
+    const int i = order_[entry.row()], j = order_[entry.col()];
+    entry = Eigen::Triplet<double>(std::max(i, j), std::min(i, j), 0.0);
   }
   pattern_.resize(n_ + m_, n_ + m_);
   pattern_.setFromTriplets(pattern.begin(), pattern.end());
@@ -135,33 +137,27 @@ SparseLayout::SparseLayout(const ArmModel& model) : n_(model.num_coordinates()) 
   for (int c = 0; c < model.num_cables(); ++c) {
     for (int e = 0; e < model.cables()[c].num_elements(); ++e) {
       ElementColumns(model, c, e, cols);
-      for (int a : cols)
-        for (int b : cols) element_index_.push_back(Index(a, b));
+      PackedLowerIndex(cols, 8, &element_index_);
     }
   }
   for (int i = 1; i <= model.num_links(); ++i) {
     const int o = model.link_offset(i);
     for (int a = 0; a < 3; ++a) link_index_.push_back(Index(o + a, o + a));
-    for (int a = 3; a < 7; ++a)
-      for (int b = 3; b < 7; ++b) link_index_.push_back(Index(o + a, o + b));
+    const int quaternion[4] = {o + 3, o + 4, o + 5, o + 6};
+    PackedLowerIndex(quaternion, 4, &link_index_);
   }
   for (const std::vector<int>& links : pair_links_) {
+    const std::vector<int> quaternions = pair_cols(links);
     std::vector<int> index;
-    for (int a : pair_cols(links))
-      for (int b : pair_cols(links)) index.push_back(Index(a, b));
+    PackedLowerIndex(quaternions.data(), static_cast<int>(quaternions.size()), &index);
     pair_index_.push_back(index);
   }
   for (int r = 0; r < m_; ++r) {
     const ConstraintRowLayout& row = rows_[r];
     row_kkt_offset_.push_back(static_cast<int>(row_kkt_index_.size()));
-    for (int a = 0; a < row.count; ++a) {
-      row_kkt_index_.push_back(Index(n_ + r, row.cols[a]));
-      row_kkt_index_.push_back(Index(row.cols[a], n_ + r));
-    }
+    for (int a = 0; a < row.count; ++a) row_kkt_index_.push_back(Index(n_ + r, row.cols[a]));
     row_pair_offset_.push_back(static_cast<int>(row_pair_index_.size()));
-    for (int a = 0; a < row.count; ++a)
-      for (int b = 0; b < row.count; ++b)
-        row_pair_index_.push_back(Index(row.cols[a], row.cols[b]));
+    PackedLowerIndex(row.cols, row.count, &row_pair_index_);
     row_diag_index_.push_back(Index(n_ + r, n_ + r));
   }
   for (const HoleNodeRef& h : holes_) {
@@ -258,13 +254,19 @@ std::vector<int> SparseLayout::BlockOrder(int size, const std::vector<std::vecto
 }
 
 int SparseLayout::Index(int model_row, int model_col) const {
-  const int row = order_[model_row], col = order_[model_col];
+  const int row = std::max(order_[model_row], order_[model_col]);
+  const int col = std::min(order_[model_row], order_[model_col]);
   const int* inner = pattern_.innerIndexPtr();
   const int begin = pattern_.outerIndexPtr()[col];
   const int end = pattern_.outerIndexPtr()[col + 1];
   const int* at = std::lower_bound(inner + begin, inner + end, row);
   CCSRM_CHECK(at != inner + end && *at == row);
   return static_cast<int>(at - inner);
+}
+
+void SparseLayout::PackedLowerIndex(const int* cols, int count, std::vector<int>* index) const {
+  for (int a = 0; a < count; ++a)
+    for (int b = 0; b <= a; ++b) index->push_back(Index(cols[a], cols[b]));
 }
 
 AugmentedSystem::AugmentedSystem(const SparseLayout& layout, HoleStickRows hole_rows)
@@ -372,8 +374,12 @@ EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout
     if (is_node_row(e.row) || is_node_row(e.col)) continue;
     image(e.row, &image_i);
     image(e.col, &image_j);
-    for (int p : image_i)
-      for (int q : image_j) pattern.emplace_back(p, q, 0.0);
+    for (int p : image_i) {
+      for (int q : image_j) {
+        pattern.emplace_back(p, q, 0.0);
+        pattern.emplace_back(q, p, 0.0);
+      }
+    }
   }
   for (int p = 0; p < size_; ++p) pattern.emplace_back(p, p, 0.0);
 
@@ -385,8 +391,10 @@ EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout
     if (!kept.empty()) members.push_back(kept);
   }
   order_ = SparseLayout::BlockOrder(size_, members, pattern);
-  for (auto& entry : pattern)
-    entry = Eigen::Triplet<double>(order_[entry.row()], order_[entry.col()], 0.0);
+  for (auto& entry : pattern) {
+    const int i = order_[entry.row()], j = order_[entry.col()];
+    entry = Eigen::Triplet<double>(std::max(i, j), std::min(i, j), 0.0);
+  }
   pattern_.resize(size_, size_);
   pattern_.setFromTriplets(pattern.begin(), pattern.end());
   pattern_.makeCompressed();
@@ -406,15 +414,19 @@ EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout
   std::vector<std::vector<int>> kept_of_node(nodes_.size());  // node -> index into node_kept_
   std::vector<std::vector<int>> pair_of_node(nodes_.size());  // node n -> index into node_pairs_
   std::map<std::pair<int, int>, int> link_block_of;           // (lo, hi) links -> link_blocks_
-  for (const Entry& e : entries) {
-    const int ri = reduced_of_[e.row], rj = reduced_of_[e.col];
-    if (ri >= 0 && rj >= 0) {
-      if (order_[ri] >= order_[rj]) copy_.emplace_back(e.value, lower(ri, rj));
+  for (const Entry& stored : entries) {
+    if (reduced_of_[stored.row] >= 0 && reduced_of_[stored.col] >= 0) {
+      copy_.emplace_back(stored.value, lower(reduced_of_[stored.row], reduced_of_[stored.col]));
       continue;
     }
+    // The full pattern stores each pair once, either way round: read it
+    // with a node's position first (of two nodes, the lower-numbered).
+    Entry e = stored;
+    if (node_of[e.row] < 0 || (node_of[e.col] >= 0 && node_of[e.col] < node_of[e.row]))
+      std::swap(e.row, e.col);
+    const int rj = reduced_of_[e.col];
     const int ni = node_of[e.row];
-    if (ni < 0)
-      continue;  // a node row's entry, or a kept unknown's with a node (its mirror counts)
+    if (ni < 0) continue;  // a node row's entry, or a row left out
     const int nj = node_of[e.col];
     if (nj < 0) {
       // Only the node's own position rows couple it to a link, and they
@@ -439,7 +451,6 @@ EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout
       node_kept_[found].full[axis_of[e.row]] = e.value;
       continue;
     }
-    if (nj < ni) continue;  // the mirror of a pair counted once
     int found = -1;
     for (int index : pair_of_node[ni])
       if (node_pairs_[index].m == nj) found = index;
@@ -479,6 +490,8 @@ EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout
       node_pairs_.push_back(np);
     }
     node_pairs_[found].full[3 * axis_of[e.row] + axis_of[e.col]] = e.value;
+    // A node's own block holds its lower triangle: the mirror is the same.
+    if (ni == nj) node_pairs_[found].full[3 * axis_of[e.col] + axis_of[e.row]] = e.value;
   }
 }
 

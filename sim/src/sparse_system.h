@@ -25,6 +25,16 @@ namespace ccsrm::sim::internal {
 
 class SparseLayout;
 
+// Adds the lower triangle (b <= a) of the symmetric matrix `block` at the
+// packed positions `index` of one of SparseLayout's block tables: each
+// symmetric pair is stored once.
+template <typename Derived>
+void AddSymmetricBlock(const Eigen::MatrixBase<Derived>& block, const int* index, double* values) {
+  int k = 0;
+  for (int a = 0; a < block.rows(); ++a)
+    for (int b = 0; b <= a; ++b) values[index[k++]] += block(a, b);
+}
+
 // A hole node of a driving cable: Eulerian, free material coordinate.
 struct HoleNodeRef {
   int cable = 0;
@@ -137,14 +147,16 @@ class SparseLayout {
   // (joint_i - 1, joint_i, joint_i + 1, those >= 1).
   const std::vector<int>& pair_links(int p) const { return pair_links_[p]; }
 
-  // Positions in the matrix's value array (model order in, storage out):
-  // per element its 8 x 8 block over (r1, r2, s1, s2); per link 3 diagonal
-  // translational entries then its 4 x 4 quaternion block; per connecting
-  // pair the square block over its links' quaternions; per row r its
-  // (n + r, col) and (col, n + r) entries, its count x count block of
-  // Phi_q^T Phi_q, and its (n + r, n + r) diagonal.
-  const int* element_block(int element) const { return &element_index_[64 * element]; }
-  const int* link_block(int link) const { return &link_index_[19 * (link - 1)]; }
+  // Positions in the matrix's value array (model order in, storage out),
+  // which holds each symmetric pair of entries once. A block over a list of
+  // coordinates is its packed lower triangle, (a, b) for b <= a row by row
+  // (AddSymmetricBlock): per element the block over (r1, r2, s1, s2) (36);
+  // per link its 3 diagonal translational entries, then its quaternion block
+  // (10); per connecting pair the block over its links' quaternions; per row
+  // r its (n + r, col) entries, the block of Phi_q^T Phi_q over its columns,
+  // and its (n + r, n + r) diagonal.
+  const int* element_block(int element) const { return &element_index_[36 * element]; }
+  const int* link_block(int link) const { return &link_index_[13 * (link - 1)]; }
   const int* pair_block(int p) const { return pair_index_[p].data(); }
   const int* row_coupling(int r) const { return &row_kkt_index_[row_kkt_offset_[r]]; }
   const int* row_block(int r) const { return &row_pair_index_[row_pair_offset_[r]]; }
@@ -152,8 +164,9 @@ class SparseLayout {
   // The (s, s) entry of hole node h (its material coordinate).
   int hole_material_diagonal(int h) const { return hole_index_[h]; }
 
-  // The pattern with zero values, stored in the elimination order (see
-  // InterleavedBlockOrder), and the position of model unknown k in it.
+  // The pattern with zero values, its lower triangle stored in the
+  // elimination order (see InterleavedBlockOrder), and the position of model
+  // unknown k in it.
   const Eigen::SparseMatrix<double>& pattern() const { return pattern_; }
   const std::vector<int>& order() const { return order_; }
   // The symbolic factorisation of the pattern in that order.
@@ -173,7 +186,10 @@ class SparseLayout {
 
  private:
   friend class EmbeddedNodeLayout;
+  // The stored entry of (model_row, model_col), either way round.
   int Index(int model_row, int model_col) const;
+  // Appends the positions of the packed lower triangle over `cols`.
+  void PackedLowerIndex(const int* cols, int count, std::vector<int>* index) const;
   std::vector<std::vector<int>> InterleavedBlocks(const ArmModel& model) const;
 
   int n_ = 0;
@@ -198,7 +214,7 @@ class SparseLayout {
 };
 
 // One run's augmented system over a shared layout. The matrix is stored
-// (both triangles) in the layout's elimination order, so that each
+// (its lower triangle) in the layout's elimination order, so that each
 // factorisation reads it in place instead of permuting a copy; the
 // right-hand side and the solution are in the model's order.
 class AugmentedSystem {

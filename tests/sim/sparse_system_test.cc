@@ -161,9 +161,7 @@ void Assemble(const ArmModel& model, const Config& config, const BentState& stat
         qde[k] = state.qd[cols[k]];
       }
       const AleElementTerms terms = EvaluateAleElement(ale, qe, qde);
-      const Matrix8d mass = terms.mass + terms.elastic_mass;
-      const int* index = layout.element_block(element);
-      for (int a = 0; a < 64; ++a) values[index[a]] += mass(a / 8, a % 8);
+      AddSymmetricBlock(terms.mass + terms.elastic_mass, layout.element_block(element), values);
     }
   }
   for (int i = 1; i <= model.num_links(); ++i) {
@@ -172,7 +170,7 @@ void Assemble(const ArmModel& model, const Config& config, const BentState& stat
                                               link.inertia_kgm2.asDiagonal().toDenseMatrix());
     const int* index = layout.link_block(i);
     for (int a = 0; a < 3; ++a) values[index[a]] += link.mass_kg;
-    for (int a = 0; a < 16; ++a) values[index[3 + a]] += me(a / 4, a % 4);
+    AddSymmetricBlock(me, index + 3, values);
   }
   // The connecting pairs' smoothed stiffness on their links' quaternions:
   // a small symmetric positive semi-definite block (rank 2, as a spring
@@ -182,8 +180,7 @@ void Assemble(const ArmModel& model, const Config& config, const BentState& stat
     Eigen::MatrixXd g(2, size);
     for (int k = 0; k < g.size(); ++k) g(k) = uniform(random);
     const Eigen::MatrixXd block = 1e-4 * g.transpose() * g;
-    const int* index = layout.pair_block(static_cast<int>(p));
-    for (int a = 0; a < size * size; ++a) values[index[a]] += block(a / size, a % size);
+    AddSymmetricBlock(block, layout.pair_block(static_cast<int>(p)), values);
   }
 
   Eigen::VectorXd& rhs = system->rhs();
@@ -202,16 +199,15 @@ void Assemble(const ArmModel& model, const Config& config, const BentState& stat
     values[layout.row_diagonal(r)] = -kDelta;
     const int* block = layout.row_block(r);
     const int* coupling = layout.row_coupling(r);
-    for (int a = 0; a < row.count; ++a) {
-      values[coupling[2 * a]] += jacobian[r][a];
-      values[coupling[2 * a + 1]] += jacobian[r][a];
-      for (int b = 0; b < row.count; ++b)
-        values[block[row.count * a + b]] += jacobian[r][a] * jacobian[r][b];
+    for (int a = 0, k = 0; a < row.count; ++a) {
+      values[coupling[a]] += jacobian[r][a];
+      for (int b = 0; b <= a; ++b) values[block[k++]] += jacobian[r][a] * jacobian[r][b];
     }
   }
 }
 
-// The assembled matrix in the model's order.
+// The assembled matrix in the model's order (both triangles; the layout
+// stores each symmetric pair once).
 Eigen::SparseMatrix<double> ModelOrderMatrix(const SparseLayout& layout,
                                              const AugmentedSystem& system) {
   const Eigen::SparseMatrix<double>& pattern = layout.pattern();
@@ -221,8 +217,11 @@ Eigen::SparseMatrix<double> ModelOrderMatrix(const SparseLayout& layout,
   std::vector<Eigen::Triplet<double>> entries;
   const double* values = const_cast<AugmentedSystem&>(system).values();
   for (int j = 0; j < pattern.outerSize(); ++j) {
-    for (int k = pattern.outerIndexPtr()[j]; k < pattern.outerIndexPtr()[j + 1]; ++k)
-      entries.emplace_back(model_of[pattern.innerIndexPtr()[k]], model_of[j], values[k]);
+    for (int k = pattern.outerIndexPtr()[j]; k < pattern.outerIndexPtr()[j + 1]; ++k) {
+      const int i = pattern.innerIndexPtr()[k];
+      entries.emplace_back(model_of[i], model_of[j], values[k]);
+      if (i != j) entries.emplace_back(model_of[j], model_of[i], values[k]);
+    }
   }
   Eigen::SparseMatrix<double> a(pattern.rows(), pattern.cols());
   a.setFromTriplets(entries.begin(), entries.end());
