@@ -271,7 +271,7 @@ bool ArmDynamics::AddCableElements(const double* q, const double* qd) {
       const Vector8d f = terms.ale_inertia_force + terms.elastic_force;
       for (int a = 0; a < 8; ++a) force_[cols[a]] += f[a];
       tension_[c][e] = terms.tension;
-      kinetic_ += 0.5 * qde.dot(terms.mass * qde);
+      kinetic_ += terms.kinetic_energy;
       const double k = terms.taut ? 1.0 : 0.0;
       elastic_ += 0.5 * ale_.axial_stiffness_n * k * terms.strain * terms.strain * ds;
       const double beta_p = beta + k * h / 2.0;
@@ -489,9 +489,12 @@ void ArmDynamics::AddConnectingMoments(double t, const double* memory) {
         // Both smoothings in one 2x2 form on (theta_dot_i, theta_dot_j).
         Eigen::Matrix2d form = friction_smoothing;
         form += smoothing_mass * (Eigen::Matrix2d() << 1.0, -1.0, -1.0, 1.0).finished();
-        const Eigen::Matrix<double, 12, 12> added = jac.transpose() * form * jac;
-        AddSymmetricBlock(added.topLeftCorner(width, width),
-                          layout_.pair_block(static_cast<int>(p)), values);
+        // jac^T form jac, its packed lower triangle only (a 12 x 12
+        // product would go through Eigen's general matrix kernel).
+        const Eigen::Matrix<double, 12, 2> jac_form = jac.transpose() * form;
+        const int* block = layout_.pair_block(static_cast<int>(p));
+        for (int a = 0, k = 0; a < width; ++a)
+          for (int b = 0; b <= a; ++b) values[block[k++]] += jac_form.row(a).dot(jac.col(b));
         // The smoothing moments -form * theta_dd do work on the rates; it is
         // booked as dissipation once q_dd is known.
         SmoothingPower power;

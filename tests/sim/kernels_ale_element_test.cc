@@ -90,6 +90,8 @@ TEST(AleElement, KineticEnergyMatchesFineQuadratureOfVelocity) {
     // dT/dq_dot = M q_dot by central differences.
     const AleElementTerms terms = EvaluateAleElement(p, st.q, st.q_dot);
     const Vector8d momentum = terms.mass * st.q_dot;
+    // The evaluation's energy is the same quadratic form of the same mass.
+    EXPECT_NEAR(terms.kinetic_energy, 0.5 * st.q_dot.dot(momentum), 1e-12 * t_quad);
     for (int i = 0; i < 8; ++i) {
       const double step = 1e-6;
       Vector8d plus = st.q_dot;

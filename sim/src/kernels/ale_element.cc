@@ -44,6 +44,15 @@ void FillMass(double rho_a, const Kinematics& k, Matrix8d* mass) {
   }
 }
 
+// q_dot^T M_ele q_dot / 2 from M_ele's pattern: with u_a = r_a_dot - r' s_a_dot
+// (the material velocity at node a), it is rho A Δs sum_ab m_ab u_a.u_b / 2.
+double KineticEnergy(double rho_a, const Kinematics& k, const Vector8d& q_dot) {
+  const Eigen::Vector3d u1 = q_dot.segment<3>(0) - k.r_s * q_dot(6);
+  const Eigen::Vector3d u2 = q_dot.segment<3>(3) - k.r_s * q_dot(7);
+  return 0.5 * rho_a * k.ds *
+         (kM11 * (u1.squaredNorm() + u2.squaredNorm()) + 2.0 * kM12 * u1.dot(u2));
+}
+
 }  // namespace
 
 Eigen::Matrix<double, 3, 8> AleShapeMatrix(const Vector8d& q, double zeta) {
@@ -68,6 +77,7 @@ AleElementTerms EvaluateAleElement(const AleElementParams& params, const Vector8
   AleElementTerms out;
 
   FillMass(params.linear_density_kgpm, k, &out.mass);
+  out.kinetic_energy = KineticEnergy(params.linear_density_kgpm, k, q_dot);
 
   // Strain (eq. 6), its Jacobian and rates (eq. 18).
   out.strain = 0.5 * (rr - 1.0);
@@ -121,10 +131,7 @@ double AleStrainEnergy(const AleElementParams& params, const Vector8d& q) {
 }
 
 double AleKineticEnergy(const AleElementParams& params, const Vector8d& q, const Vector8d& q_dot) {
-  const Kinematics k = ComputeKinematics(q, q_dot);
-  Matrix8d mass;
-  FillMass(params.linear_density_kgpm, k, &mass);
-  return 0.5 * q_dot.dot(mass * q_dot);
+  return KineticEnergy(params.linear_density_kgpm, ComputeKinematics(q, q_dot), q_dot);
 }
 
 }  // namespace ccsrm::sim::internal

@@ -43,6 +43,7 @@ struct AleElementTerms {
   double strain_rate = 0.0;        // eps_dot = eps_q q_dot [1/s]
   double strain_accel_bias = 0.0;  // eps_dot_q q_dot = q_dot^T eps_qq q_dot [1/s^2]
   double tension = 0.0;            // T = EA (k eps + beta eps_dot) (eq. 13) [N]
+  double kinetic_energy = 0.0;     // q_dot^T M_ele q_dot / 2 [J]
   bool taut = false;               // k of eq. 6: eps > 0
 };
 
