@@ -470,8 +470,8 @@ EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout
           for (int p = 0; p < 7; ++p) {
             for (int q = 0; q < 7; ++q) {
               const int P = reduced_of_[lo_offset + p], Q = reduced_of_[hi_offset + q];
-              const bool stored = lo != hi || order_[P] >= order_[Q];
-              block.target[p + 7 * q] = stored ? lower(P, Q) : -1;
+              const bool in_lower = lo != hi || order_[P] >= order_[Q];
+              block.target[p + 7 * q] = in_lower ? lower(P, Q) : -1;
             }
           }
           at = link_block_of.emplace(std::make_pair(lo, hi), static_cast<int>(link_blocks_.size()))
