@@ -16,25 +16,53 @@ int PositionOf(const int* begin, const int* end, int row) {
 }
 
 // y[i] = sum_k a[k * stride + i] w[k] for i < length: the kernel of both
-// the panel factorisation and the updates. Four columns at a time, so that
-// each pass over y does four multiply-adds per load and store; the i loops
-// are contiguous and vectorise.
+// the panel factorisation and the updates. The count % 4 leading columns in
+// one pass that also sets y, then four columns at a time, so that each pass
+// over y does up to four multiply-adds per load and store; the i loops are
+// contiguous and vectorise.
 void Combination(const double* a, int stride, const double* w, int count, int length, double* y) {
-  for (int i = 0; i < length; ++i) y[i] = 0.0;
-  int k = 0;
+  auto column = [&](int k) { return a + static_cast<std::size_t>(k) * stride; };
+  int k = count % 4;
+  switch (k) {
+    case 0:
+      for (int i = 0; i < length; ++i) y[i] = 0.0;
+      break;
+    case 1: {
+      const double* a0 = column(0);
+      for (int i = 0; i < length; ++i) y[i] = a0[i] * w[0];
+      break;
+    }
+    case 2: {
+      const double *a0 = column(0), *a1 = column(1);
+      for (int i = 0; i < length; ++i) y[i] = a0[i] * w[0] + a1[i] * w[1];
+      break;
+    }
+    default: {
+      const double *a0 = column(0), *a1 = column(1), *a2 = column(2);
+      for (int i = 0; i < length; ++i) y[i] = a0[i] * w[0] + a1[i] * w[1] + a2[i] * w[2];
+      break;
+    }
+  }
   for (; k + 4 <= count; k += 4) {
-    const double* a0 = a + static_cast<std::size_t>(k) * stride;
-    const double* a1 = a0 + stride;
-    const double* a2 = a1 + stride;
-    const double* a3 = a2 + stride;
+    const double *a0 = column(k), *a1 = column(k + 1), *a2 = column(k + 2), *a3 = column(k + 3);
     const double w0 = w[k], w1 = w[k + 1], w2 = w[k + 2], w3 = w[k + 3];
     for (int i = 0; i < length; ++i) y[i] += a0[i] * w0 + a1[i] * w1 + a2[i] * w2 + a3[i] * w3;
   }
-  for (; k < count; ++k) {
-    const double* a0 = a + static_cast<std::size_t>(k) * stride;
-    const double w0 = w[k];
-    for (int i = 0; i < length; ++i) y[i] += a0[i] * w0;
+}
+
+// sum_i a[i] b[i] over four partial sums: a single sum is one chain of
+// dependent additions, which the compiler may not reorder.
+double Dot(const double* a, const double* b, int n) {
+  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+  int i = 0;
+  for (; i + 4 <= n; i += 4) {
+    s0 += a[i] * b[i];
+    s1 += a[i + 1] * b[i + 1];
+    s2 += a[i + 2] * b[i + 2];
+    s3 += a[i + 3] * b[i + 3];
   }
+  for (; i < n; ++i) s0 += a[i] * b[i];
+  return (s0 + s1) + (s2 + s3);
 }
 
 }  // namespace
@@ -274,19 +302,13 @@ void SupernodalLdlt::Solve(Eigen::VectorXd& x_vector) {
     if (num_below > 0) {
       const int* below_rows = &st.row_index_[s->rows_begin + cols];
       for (int i = 0; i < num_below; ++i) gathered[i] = x[below_rows[i]];
-      for (int j = 0; j < cols; ++j) {
-        const double* col = panel + static_cast<std::size_t>(j) * rows + cols;
-        double sum = 0.0;
-        for (int i = 0; i < num_below; ++i) sum += col[i] * gathered[i];
-        head[j] -= sum;
-      }
+      for (int j = 0; j < cols; ++j)
+        head[j] -= Dot(panel + static_cast<std::size_t>(j) * rows + cols, gathered, num_below);
     }
     // L_head^T x = y (unit upper).
     for (int j = cols - 1; j >= 0; --j) {
       const double* col = panel + static_cast<std::size_t>(j) * rows;
-      double sum = 0.0;
-      for (int i = j + 1; i < cols; ++i) sum += col[i] * head[i];
-      head[j] -= sum;
+      head[j] -= Dot(col + j + 1, head + j + 1, cols - j - 1);
     }
   }
 }
