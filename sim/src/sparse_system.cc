@@ -274,7 +274,6 @@ AugmentedSystem::AugmentedSystem(const SparseLayout& layout, HoleStickRows hole_
       embedded_(layout.embedded(hole_rows)),
       matrix_(layout.pattern()),
       ldlt_(layout.factorisation()),
-      embedded_values_(static_cast<std::size_t>(embedded_.pattern_.nonZeros()), 0.0),
       embedded_ldlt_(embedded_.factorisation()) {
   const int size = layout.num_coordinates() + layout.num_constraints();
   rhs_.setZero(size);
@@ -493,6 +492,16 @@ EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout
     // A node's own block holds its lower triangle: the mirror is the same.
     if (ni == nj) node_pairs_[found].full[3 * axis_of[e.col] + axis_of[e.row]] = e.value;
   }
+
+  // The reduced matrix is assembled straight into its factor's storage.
+  auto to_storage = [&](int& value) {
+    if (value >= 0) value = factorisation_->StorageIndex(value);
+  };
+  for (auto& entry : copy_) to_storage(entry.second);
+  for (NodeKept& nk : node_kept_)
+    for (int& target : nk.target) to_storage(target);
+  for (LinkBlock& block : link_blocks_)
+    for (int& target : block.target) to_storage(target);
 }
 
 bool AugmentedSystem::SolveEmbedded(const std::vector<NodeEmbedding>& nodes) {
@@ -500,8 +509,8 @@ bool AugmentedSystem::SolveEmbedded(const std::vector<NodeEmbedding>& nodes) {
   CCSRM_CHECK(nodes.size() == em.nodes_.size());
   const double* full = matrix_.valuePtr();
   auto value = [full](int k) { return k >= 0 ? full[k] : 0.0; };
-  double* reduced = embedded_values_.data();
-  std::fill(embedded_values_.begin(), embedded_values_.end(), 0.0);
+  embedded_ldlt_.Zero();
+  double* reduced = embedded_ldlt_.storage();
   for (const auto& [from, to] : em.copy_) reduced[to] += full[from];
 
   // g = rhs - A[:, r] c over the full unknowns (only the kept ones and the
@@ -568,7 +577,7 @@ bool AugmentedSystem::SolveEmbedded(const std::vector<NodeEmbedding>& nodes) {
     for (int j = 0; j < 4; ++j) x[em.order_[em.reduced_of_[node.link_offset + 3 + j]]] += t[j];
   }
 
-  if (!embedded_ldlt_.Factorize(reduced)) return false;
+  if (!embedded_ldlt_.FactorizeAssembled()) return false;
   embedded_ldlt_.Solve(x);
 
   solution_.setZero();

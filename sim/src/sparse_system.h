@@ -88,9 +88,8 @@ class EmbeddedNodeLayout {
     int link_offset = 0;
   };
   // Full entries A[r_n a, k] (a = 0..2, -1 where not stored) of a node and a
-  // kept unknown k; where T_n^T A[r_n, k] lands in the reduced lower
-  // triangle (-1 for a node on the ground, which only moves the right-hand
-  // side).
+  // kept unknown k; where T_n^T A[r_n, k] lands in the factor's storage
+  // (-1 for a node on the ground, which only moves the right-hand side).
   struct NodeKept {
     int node = 0;
     int kept = 0;  // full model index
@@ -111,8 +110,8 @@ class EmbeddedNodeLayout {
   };
   // The 7 x 7 block of the reduced matrix over links (lo, hi), lo <= hi,
   // summed over node pairs first and then added once: entry (p, q),
-  // column-major, goes to target[p + 7q] (-1: the upper triangle of a
-  // diagonal block).
+  // column-major, goes to storage()[target[p + 7q]] of the factor (-1:
+  // the upper triangle of a diagonal block).
   struct LinkBlock {
     int target[49];
   };
@@ -124,7 +123,7 @@ class EmbeddedNodeLayout {
   std::vector<int> full_of_;               // reduced unknown -> full unknown
   std::vector<int> order_;                 // reduced unknown -> position in elimination order
   Eigen::SparseMatrix<double> pattern_;    // in elimination order
-  std::vector<std::pair<int, int>> copy_;  // (full value index, reduced value index)
+  std::vector<std::pair<int, int>> copy_;  // (full value index, factor storage index)
   std::vector<NodeKept> node_kept_;
   std::vector<NodePair> node_pairs_;
   std::vector<LinkBlock> link_blocks_;
@@ -249,9 +248,8 @@ class AugmentedSystem {
   Eigen::VectorXd ordered_;  // right-hand side, then solution, in elimination order
   // The embedded system's values (its pattern's storage), factorisation and
   // vectors.
-  std::vector<double> embedded_values_;
-  SupernodalLdlt embedded_ldlt_;
-  Eigen::VectorXd reduced_rhs_;  // g = rhs - A[:, r] c, over the full unknowns
+  SupernodalLdlt embedded_ldlt_;  // assembled in place
+  Eigen::VectorXd reduced_rhs_;   // g = rhs - A[:, r] c, over the full unknowns
   std::vector<Eigen::Matrix<double, 7, 7>> link_block_sums_;
   Eigen::VectorXd embedded_ordered_;
 };

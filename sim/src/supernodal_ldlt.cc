@@ -160,6 +160,7 @@ SupernodalStructure::SupernodalStructure(const Eigen::SparseMatrix<double>& patt
   }
 
   // Where each lower-triangle value of the matrix goes in the panels.
+  storage_of_value_.assign(static_cast<std::size_t>(pattern.nonZeros()), -1);
   for (int j = 0; j < n; ++j) {
     const Supernode& s = supernodes_[owner[j]];
     const int* rows = &row_index_[s.rows_begin];
@@ -170,6 +171,7 @@ SupernodalStructure::SupernodalStructure(const Eigen::SparseMatrix<double>& patt
       value_target_.push_back(static_cast<int>(
           s.storage_offset + static_cast<std::size_t>(j - s.first_col) * s.num_rows +
           PositionOf(rows, rows + s.num_rows, i)));
+      storage_of_value_[k] = value_target_.back();
     }
   }
 }
@@ -215,11 +217,18 @@ SupernodalLdlt::SupernodalLdlt(const SupernodalStructure& structure)
   gathered_.setZero(std::max(1, structure.max_below_));
 }
 
+void SupernodalLdlt::Zero() { std::fill(storage_.begin(), storage_.end(), 0.0); }
+
 bool SupernodalLdlt::Factorize(const double* values) {
   const SupernodalStructure& st = structure_;
-  std::fill(storage_.begin(), storage_.end(), 0.0);
+  Zero();
   for (std::size_t k = 0; k < st.value_source_.size(); ++k)
     storage_[st.value_target_[k]] = values[st.value_source_[k]];
+  return FactorizeAssembled();
+}
+
+bool SupernodalLdlt::FactorizeAssembled() {
+  const SupernodalStructure& st = structure_;
 
   // Right-looking over supernodes: factor a panel, then subtract its
   // contribution from the panels of the later supernodes it touches. Within

@@ -27,6 +27,9 @@ class SupernodalStructure {
   std::size_t factor_nonzeros() const;
   double factor_flops() const;
   int largest_supernode() const;
+  // Where value k of the pattern's lower triangle sits in the factor's
+  // storage (SupernodalLdlt::storage), for assembling in place.
+  int StorageIndex(int value) const { return storage_of_value_[value]; }
 
  private:
   friend class SupernodalLdlt;
@@ -64,6 +67,7 @@ class SupernodalStructure {
   // Pattern value k (lower triangle only) goes to storage[value_target_[k]].
   std::vector<int> value_source_;
   std::vector<int> value_target_;
+  std::vector<int> storage_of_value_;  // per pattern value, -1 above the diagonal
   std::size_t storage_size_ = 0;
   int max_below_ = 0;  // largest below-diagonal row count
 };
@@ -75,6 +79,11 @@ class SupernodalLdlt {
   // Factorises the matrix whose values (in the pattern's storage order) are
   // `values`; false when a pivot is zero or not finite.
   bool Factorize(const double* values);
+  // The same with the matrix assembled in place: Zero(), add each value at
+  // storage()[structure.StorageIndex(k)], then FactorizeAssembled().
+  void Zero();
+  double* storage() { return storage_.data(); }
+  bool FactorizeAssembled();
   // Solves L D L^T x = b in place, b and x in elimination order.
   void Solve(Eigen::VectorXd& x);
 
