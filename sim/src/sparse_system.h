@@ -225,6 +225,8 @@ class AugmentedSystem {
 
   // Zeroes the matrix values and the right-hand side.
   void Clear();
+  // The matrix values, each symmetric pair once, at the positions of the
+  // layout's tables.
   double* values() { return matrix_.valuePtr(); }
   Eigen::VectorXd& rhs() { return rhs_; }
 
@@ -246,11 +248,11 @@ class AugmentedSystem {
   SupernodalLdlt ldlt_;
   Eigen::VectorXd rhs_, solution_;
   Eigen::VectorXd ordered_;  // right-hand side, then solution, in elimination order
-  // The embedded system's values (its pattern's storage), factorisation and
-  // vectors.
-  SupernodalLdlt embedded_ldlt_;  // assembled in place
-  Eigen::VectorXd reduced_rhs_;   // g = rhs - A[:, r] c, over the full unknowns
-  std::vector<Eigen::Matrix<double, 7, 7>> link_block_sums_;
+  // The embedded system's factorisation (its matrix assembled in the
+  // factor's storage) and vectors.
+  SupernodalLdlt embedded_ldlt_;
+  Eigen::VectorXd reduced_rhs_;  // g = rhs - A[:, r] c, over the full unknowns
+  std::vector<Eigen::Matrix<double, 7, 7>> link_block_sums_;  // per LinkBlock
   Eigen::VectorXd embedded_ordered_;
 };
 
