@@ -394,17 +394,18 @@ EmbeddedNodeLayout::EmbeddedNodeLayout(const ArmModel& model, const SparseLayout
     const int i = order_[entry.row()], j = order_[entry.col()];
     entry = Eigen::Triplet<double>(std::max(i, j), std::min(i, j), 0.0);
   }
-  pattern_.resize(size_, size_);
-  pattern_.setFromTriplets(pattern.begin(), pattern.end());
-  pattern_.makeCompressed();
-  factorisation_ = std::make_unique<const SupernodalStructure>(pattern_);
+  Eigen::SparseMatrix<double> reduced_pattern(size_,
+                                              size_);  // lower triangle, in elimination order
+  reduced_pattern.setFromTriplets(pattern.begin(), pattern.end());
+  reduced_pattern.makeCompressed();
+  factorisation_ = std::make_unique<const SupernodalStructure>(reduced_pattern);
 
   // Value index of the lower-triangle entry of reduced unknowns p and q.
   auto lower = [&](int p, int q) {
     const int a = std::max(order_[p], order_[q]), b = std::min(order_[p], order_[q]);
-    const int* inner = pattern_.innerIndexPtr();
-    const int* begin = inner + pattern_.outerIndexPtr()[b];
-    const int* end = inner + pattern_.outerIndexPtr()[b + 1];
+    const int* inner = reduced_pattern.innerIndexPtr();
+    const int* begin = inner + reduced_pattern.outerIndexPtr()[b];
+    const int* end = inner + reduced_pattern.outerIndexPtr()[b + 1];
     const int* at = std::lower_bound(begin, end, a);
     CCSRM_CHECK(at != end && *at == a);
     return static_cast<int>(at - inner);

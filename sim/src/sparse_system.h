@@ -122,7 +122,6 @@ class EmbeddedNodeLayout {
   std::vector<int> reduced_of_;            // full unknown -> reduced unknown, -1 if eliminated
   std::vector<int> full_of_;               // reduced unknown -> full unknown
   std::vector<int> order_;                 // reduced unknown -> position in elimination order
-  Eigen::SparseMatrix<double> pattern_;    // in elimination order
   std::vector<std::pair<int, int>> copy_;  // (full value index, factor storage index)
   std::vector<NodeKept> node_kept_;
   std::vector<NodePair> node_pairs_;

@@ -167,11 +167,9 @@ SupernodalStructure::SupernodalStructure(const Eigen::SparseMatrix<double>& patt
     for (int k = pattern.outerIndexPtr()[j]; k < pattern.outerIndexPtr()[j + 1]; ++k) {
       const int i = pattern.innerIndexPtr()[k];
       if (i < j) continue;
-      value_source_.push_back(k);
-      value_target_.push_back(static_cast<int>(
+      storage_of_value_[k] = static_cast<int>(
           s.storage_offset + static_cast<std::size_t>(j - s.first_col) * s.num_rows +
-          PositionOf(rows, rows + s.num_rows, i)));
-      storage_of_value_[k] = value_target_.back();
+          PositionOf(rows, rows + s.num_rows, i));
     }
   }
 }
@@ -222,8 +220,8 @@ void SupernodalLdlt::Zero() { std::fill(storage_.begin(), storage_.end(), 0.0); 
 bool SupernodalLdlt::Factorize(const double* values) {
   const SupernodalStructure& st = structure_;
   Zero();
-  for (std::size_t k = 0; k < st.value_source_.size(); ++k)
-    storage_[st.value_target_[k]] = values[st.value_source_[k]];
+  for (std::size_t k = 0; k < st.storage_of_value_.size(); ++k)
+    if (st.storage_of_value_[k] >= 0) storage_[st.storage_of_value_[k]] = values[k];
   return FactorizeAssembled();
 }
 

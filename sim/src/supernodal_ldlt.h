@@ -64,10 +64,9 @@ class SupernodalStructure {
   std::vector<int> row_index_;
   std::vector<Update> updates_;
   std::vector<int> relative_index_;
-  // Pattern value k (lower triangle only) goes to storage[value_target_[k]].
-  std::vector<int> value_source_;
-  std::vector<int> value_target_;
-  std::vector<int> storage_of_value_;  // per pattern value, -1 above the diagonal
+  // Pattern value k goes to storage[storage_of_value_[k]] (-1 above the
+  // diagonal, which is not factorised).
+  std::vector<int> storage_of_value_;
   std::size_t storage_size_ = 0;
   int max_below_ = 0;  // largest below-diagonal row count
 };
