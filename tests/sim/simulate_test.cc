@@ -168,6 +168,27 @@ TEST(Simulate, ParameterAtZeroAndAtOneBillionthGiveTheSameRun) {
   }
 }
 
+TEST(Simulate, ARejectedStepDoesNotEvaluateItsEnd) {
+  // A 4(5) step costs its five new stages and the derivative at its end
+  // (the next step's first stage); a rejected trial never uses that end, so
+  // it costs five. Beyond those, a run evaluates at its start and at most
+  // once per sampled frame (a frame that does not fall on a step's end).
+  // Six per rejected trial would leave one extra evaluation per rejection.
+  const ShortCase& c = Case2();
+  const SimulationResult r = Simulate(c.model, c.config.parameters, c.inputs, c.Options(1.0));
+  ASSERT_TRUE(r.summary.completed());
+  const std::int64_t rejected = r.summary.rejected_steps;
+  const auto frames = static_cast<std::int64_t>(r.trajectory.size());
+  ASSERT_GT(rejected, frames);  // the compressed ramp rejects enough to tell
+  const std::int64_t extra = r.summary.rhs_evaluations - 6 * r.summary.steps - 5 * rejected;
+  std::printf("%lld steps, %lld rejected, %lld evaluations, %lld frames: %lld beyond the steps\n",
+              static_cast<long long>(r.summary.steps), static_cast<long long>(rejected),
+              static_cast<long long>(r.summary.rhs_evaluations), static_cast<long long>(frames),
+              static_cast<long long>(extra));
+  EXPECT_GE(extra, 1);
+  EXPECT_LE(extra, 1 + frames);
+}
+
 TEST(Simulate, HoleFrictionOffMeansFrictionlessHoles) {
   // With solver.hole_friction off the driving cables slide freely whatever
   // mu and mu' say: the run equals the one with both coefficients at zero.
