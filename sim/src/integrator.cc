@@ -22,7 +22,9 @@ int RightHandSide(double t, const double y[], double dydt[], void* params) {
 // gsl_odeiv2_evolve_apply: evolve evaluates the derivative at the start of
 // every step although the stepper already computed it at the end of the
 // previous one, and the hole reports of that end-of-step evaluation are what
-// the stick-slip scan needs (6 evaluations per step instead of 7 or 8).
+// the stick-slip scan needs (6 evaluations per accepted step instead of 7 or
+// 8, and 5 per rejected one: simulator.cc evaluates the end only once the
+// error is accepted).
 class GslIntegrator : public Integrator {
  public:
   GslIntegrator(ArmDynamics* dynamics, const SolverConfig& solver)
