@@ -14,6 +14,7 @@
 #include "ccsrm/sim/protocol.h"
 #include "ccsrm/sim/simulator.h"
 #include "commands.h"
+#include "option_checks.h"
 #include "paper_run.h"
 
 namespace ccsrm::app {
@@ -85,9 +86,13 @@ void AddBenchCommand(CLI::App& root) {
   cmd->add_option("--case", a->run.case_number, "Paper case 1..4")
       ->check(CLI::Range(1, 4))
       ->capture_default_str();
+  // Checked while parsing, before the configuration is read.
   cmd->add_option("--duration", a->run.duration_s,
-                  "Simulated time [s] (default: the whole protocol)");
-  cmd->add_option("--repeat", a->repeat, "Runs; medians are reported")->capture_default_str();
+                  "Simulated time [s] (default: the whole protocol)")
+      ->check(Above(0.0, "s"));
+  cmd->add_option("--repeat", a->repeat, "Runs; medians are reported")
+      ->capture_default_str()
+      ->check(AtLeast(1));
   AddParameterOptions(cmd, &a->run);
   cmd->callback([a] { RunBench(*a); });
 }

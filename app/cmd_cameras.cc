@@ -13,6 +13,7 @@
 #include "ccsrm/cameras/reconstruction.h"
 #include "ccsrm/cameras/video_io.h"
 #include "ccsrm/cameras/virtual_rig.h"
+#include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/mocap/c3d.h"
@@ -23,6 +24,7 @@
 #include "ccsrm/sim/model.h"
 #include "commands.h"
 #include "option_checks.h"
+#include "output_kinds.h"
 
 namespace ccsrm::app {
 namespace {
@@ -50,17 +52,6 @@ cameras::CheckerboardTarget MakeBoard(const std::string& size, const std::string
   std::string reason;
   if (!board.IsValid(&reason)) ThrowInputError(square_option, "", reason);
   return board;
-}
-
-void MakeOutputDirectory(const std::string& dir) {
-  if (fs::is_directory(dir)) return;
-  const fs::path parent = fs::path(dir).lexically_normal().parent_path();
-  if (!parent.empty() && !fs::is_directory(parent)) {
-    ThrowInputError(dir, "", "parent directory '" + parent.string() + "' does not exist");
-  }
-  std::error_code error;
-  if (!fs::create_directory(dir, error))
-    ThrowInputError(dir, "", "cannot create directory: " + error.message());
 }
 
 // cv::imwrite picks the format from the extension, so the temporary keeps it.
@@ -110,6 +101,7 @@ void AddRig(CLI::App& cameras) {
   auto out = std::make_shared<std::string>();
   rig->add_option("--out", *out, "Camera file to write (OpenCV YAML)")->required();
   rig->callback([out] {
+    CheckOut(*out, CameraFileOutput(), {});
     cameras::SaveCameraRig(*out, cameras::MakeVirtualRig());
     std::printf("wrote %s (4 cameras, 1280x1024)\n", out->c_str());
   });
@@ -146,6 +138,7 @@ void AddRender(CLI::App& cameras) {
       ->capture_default_str();
   render->add_option("--out", args->out, "Output directory (videos + cameras.yaml)")->required();
   render->callback([args] {
+    CheckOut(args->out, RenderFolderOutput(), {args->in, args->rig});
     const cameras::CameraRig rig = RigFromOption(args->rig);
     const cameras::MarkerMotion motion =
         cameras::ReadMarkerMotion(args->in, {args->first, args->stride, args->frames});
@@ -194,13 +187,16 @@ void AddRenderBoard(CLI::App& cameras) {
   render->add_option("--seed", args->seed, "Seed of the poses and noise")->capture_default_str();
   render->add_option("--out", args->out, "Output directory")->required();
   render->callback([args] {
+    CheckOut(args->out, BoardImagesFolderOutput(), {args->rig});
     const cameras::CameraRig rig = RigFromOption(args->rig);
     const cameras::CheckerboardTarget board =
         MakeBoard(args->board, "--board", args->square_mm, "--square-mm");
     const cameras::CheckerboardTarget world =
         MakeBoard(args->world_board, "--world-board", args->world_square_mm, "--world-square-mm");
     const auto [R_WG, p_WG] = cameras::DefaultWorldBoardPose(world);
-    MakeOutputDirectory(args->out);
+    // The images appear together or not at all, replacing earlier ones.
+    AtomicOutputDirectory folder(args->out);
+    const fs::path images(folder.temp_path());
     for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
       const cameras::Camera& camera = rig.cameras[c];
       cameras::CheckerboardRenderOptions options;
@@ -210,15 +206,16 @@ void AddRenderBoard(CLI::App& cameras) {
         options.seed = args->seed * 7919 + 1000 * c + view;
         char name[64];
         std::snprintf(name, sizeof name, "%s_view%02d.png", camera.name.c_str(), view++);
-        WritePngAtomically((fs::path(args->out) / name).string(),
+        WritePngAtomically((images / name).string(),
                            cameras::RenderCheckerboard(camera, board, R_CG, p_CG, options));
       }
       options.seed = args->seed * 7919 + 1000 * c + 999;
-      WritePngAtomically((fs::path(args->out) / (camera.name + "_world.png")).string(),
+      WritePngAtomically((images / (camera.name + "_world.png")).string(),
                          cameras::RenderCheckerboard(camera, world, camera.R_CW * R_WG,
                                                      camera.R_CW * p_WG + camera.p_CW, options));
       std::printf("%s: %d hand-held views and the world board\n", camera.name.c_str(), view);
     }
+    folder.Commit();
     std::printf("world board corner (0, 0) at W (%.4f, %.4f, %.4f) m, its x along +z, y along +y\n",
                 p_WG.x(), p_WG.y(), p_WG.z());
   });
@@ -263,6 +260,10 @@ void AddCalibrate(CLI::App& cameras) {
                         "Camera file to update (the camera of this name is replaced or added)");
   board_cmd->add_option("--out", b->out, "Camera file to write")->required();
   board_cmd->callback([b] {
+    std::vector<std::string> inputs = b->images;
+    inputs.push_back(b->world_image);
+    inputs.push_back(b->rig);
+    CheckOut(b->out, CameraFileOutput(), inputs);
     const cameras::CheckerboardTarget board =
         MakeBoard(b->board, "--board", b->square_mm, "--square-mm");
     std::vector<cv::Mat> images;
@@ -342,6 +343,10 @@ void AddCalibrate(CLI::App& cameras) {
                         "Use only the ground markers (the arm may move)");
   markers_cmd->add_option("--out", m->out, "Camera file to write")->required();
   markers_cmd->callback([m] {
+    std::vector<std::string> inputs = m->videos;
+    inputs.push_back(m->cameras);
+    inputs.push_back(m->config);
+    CheckOut(m->out, CameraFileOutput(), inputs);
     cameras::CameraRig rig = cameras::LoadCameraRig(m->cameras);
     if (m->videos.size() != rig.cameras.size()) {
       ThrowInputError(m->cameras, "cameras",
@@ -416,6 +421,11 @@ void AddReconstruct(CLI::App& cameras) {
     for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
     if (extension != ".c3d")
       ThrowInputError(args->out, "", "unsupported output format (expected .c3d)");
+    std::vector<std::string> inputs = args->videos;
+    inputs.push_back(args->cameras);
+    inputs.push_back(args->config);
+    inputs.push_back(args->rigid_bodies);
+    CheckOut(args->out, C3dFileOutput(), inputs);
     const cameras::CameraRig rig = cameras::LoadCameraRig(args->cameras);
     cameras::ReconstructionOptions options;
     const mocap::MarkerLayout layout =

@@ -18,6 +18,7 @@
 #include "ccsrm/sim/paper_run.h"
 #include "commands.h"
 #include "option_checks.h"
+#include "output_kinds.h"
 #include "paper_run.h"
 
 namespace ccsrm::app {
@@ -31,7 +32,7 @@ constexpr int kDerivativesDisagree = 4;
 // status 2 and one line naming its option, like every other bad input.
 struct DerivativesArgs {
   sim::PaperRunOptions run;
-  std::string parameters;
+  std::optional<std::string> parameters;  // unset: every parameter
   std::string steps = "1e-2,3e-3";
   std::string threads = std::to_string(identify::DefaultThreads());
   std::string negligible;
@@ -106,7 +107,7 @@ int RunDerivatives(const DerivativesArgs& a) {
   if (sweep && !a.negligible.empty()) {
     ThrowInputError("--negligible-deg", "", "cannot be combined with --sweep");
   }
-  if (sweep && !a.parameters.empty()) {
+  if (sweep && a.parameters) {
     ThrowInputError("--parameters", "", "cannot be combined with --sweep");
   }
   std::string error;
@@ -120,7 +121,7 @@ int RunDerivatives(const DerivativesArgs& a) {
     sweep_options.progress = Progress(a.quiet);
     if (!sweep_options.IsValid(&error)) ThrowOptionError(error);
   } else {
-    if (!a.parameters.empty()) check.parameters = SplitList(a.parameters, "--parameters");
+    if (a.parameters) check.parameters = SplitList(*a.parameters, "--parameters");
     check.relative_steps.clear();
     for (const std::string& s : SplitList(a.steps, "--steps")) {
       check.relative_steps.push_back(ParseNumber(s, "--steps"));
@@ -133,7 +134,8 @@ int RunDerivatives(const DerivativesArgs& a) {
     if (!check.IsValid(&error)) ThrowOptionError(error);
   }
   if (!a.json.empty()) {
-    const AtomicOutputFile probe(a.json);
+    CheckOutputPath(a.json, "--json", DerivativesJsonOutput(),
+                    {a.run.config_path, a.run.params_path});
   }
 
   const sim::PaperRun run = sim::PreparePaperRun(a.run);

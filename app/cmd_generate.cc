@@ -27,6 +27,7 @@
 #include "ccsrm/sim/simulator.h"
 #include "ccsrm/sim_io/run_file.h"
 #include "commands.h"
+#include "output_kinds.h"
 #include "paper_run.h"
 
 namespace ccsrm::app {
@@ -170,7 +171,10 @@ int RunGenerate(const GenerateArgs& a) {
   const std::string truth_yaml_path = stem + ".truth.yaml";
   const std::string truth_h5_path = stem + ".truth.h5";
   // Check the output paths before spending minutes on the run.
-  { const AtomicOutputFile probe(a.out); }
+  const std::vector<std::string> inputs = {a.run.config_path, a.run.params_path, a.effects_path};
+  CheckOut(a.out, ExperimentFileOutput(), inputs);
+  CheckOut(truth_yaml_path, YamlFileOutput("ccsrm-truth/1", "ccsrm truth file"), inputs);
+  CheckOut(truth_h5_path, RunFileOutput(), inputs);
   if (!(a.noise_mm >= 0.0) || !std::isfinite(a.noise_mm)) {
     ThrowInputError("--noise-mm", "", "must be >= 0");
   }

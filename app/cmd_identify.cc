@@ -15,6 +15,7 @@
 #include "commands.h"
 #include "fit_inputs.h"
 #include "option_checks.h"
+#include "output_kinds.h"
 
 namespace ccsrm::app {
 namespace {
@@ -26,7 +27,7 @@ constexpr int kFitFailed = 3;
 
 struct IdentifyArgs {
   std::vector<std::string> data;
-  std::string free;
+  std::optional<std::string> free;  // unset: the default list
   std::string params;
   std::vector<std::string> set;
   int threads = identify::DefaultThreads();
@@ -49,7 +50,9 @@ int RunIdentify(const IdentifyArgs& a) {
   ApplyFitOptions(a.free, a.params, a.set, &options);
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError("identify", "", error);
-  CheckOutputFolder(a.out, a.data);
+  std::vector<std::string> inputs = a.data;
+  inputs.push_back(a.params);
+  CheckOut(a.out, FitFolderOutput(), inputs);
   std::vector<identify::Experiment> experiments =
       LoadExperiments(a.data, a.noise_deg, "experiment");
   std::string free_list;

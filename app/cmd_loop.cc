@@ -10,6 +10,7 @@
 #include "commands.h"
 #include "fit_inputs.h"
 #include "option_checks.h"
+#include "output_kinds.h"
 
 namespace ccsrm::app {
 namespace {
@@ -17,8 +18,8 @@ namespace {
 struct LoopArgs {
   std::vector<std::string> data;
   std::vector<std::string> holdout;
-  std::string candidates;
-  std::string free;
+  std::optional<std::string> candidates;  // unset: every effect
+  std::optional<std::string> free;
   std::string params;
   std::vector<std::string> set;
   int threads = identify::DefaultThreads();
@@ -35,12 +36,13 @@ int RunLoop(const LoopArgs& a) {
   options.fit.max_iterations = a.max_iterations;
   options.max_rounds = a.max_rounds;
   ApplyFitOptions(a.free, a.params, a.set, &options.fit);
-  if (!a.candidates.empty()) options.candidates = SplitList(a.candidates, "--candidates");
+  if (a.candidates) options.candidates = SplitList(*a.candidates, "--candidates");
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError("loop", "", error);
   std::vector<std::string> inputs = a.data;
   inputs.insert(inputs.end(), a.holdout.begin(), a.holdout.end());
-  CheckOutputFolder(a.out, inputs);
+  inputs.push_back(a.params);
+  CheckOut(a.out, LoopFolderOutput(), inputs);
   const std::vector<identify::Experiment> training =
       LoadExperiments(a.data, a.noise_deg, "training");
   const std::vector<identify::Experiment> holdout =

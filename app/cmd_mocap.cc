@@ -25,19 +25,12 @@
 #include "ccsrm/sim/model.h"
 #include "commands.h"
 #include "option_checks.h"
+#include "output_kinds.h"
 
 namespace ccsrm::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Never write onto an input (SPEC 11): the same path or the same file.
-void RefuseToOverwrite(const std::string& input, const std::string& output) {
-  std::error_code ec;
-  if (input == output || fs::equivalent(input, output, ec)) {
-    ThrowInputError(output, "--out", "is the input file; inputs are never modified");
-  }
-}
 
 void PrintRefinement(const std::string& static_trial, const mocap::StaticTrialRefinement& refined) {
   double largest = 0.0;
@@ -72,12 +65,10 @@ void RunProcess(const ProcessArgs& a) {
     ThrowInputError(a.cameras, "--config",
                     "videos need --config or --rigid-bodies (the markers to label)");
   }
-  for (const std::string& input :
-       {a.in, a.cameras, a.rigid_bodies, a.config, a.static_trial, a.inputs}) {
-    if (!input.empty()) RefuseToOverwrite(input, a.out);
-  }
-  for (const std::string& video : a.videos) RefuseToOverwrite(video, a.out);
-  { const AtomicOutputFile probe(a.out); }  // fail on a bad output path before working
+  std::vector<std::string> inputs = {a.in,     a.cameras,      a.rigid_bodies,
+                                     a.config, a.static_trial, a.inputs};
+  inputs.insert(inputs.end(), a.videos.begin(), a.videos.end());
+  CheckOut(a.out, ExperimentFileOutput(), inputs);  // before any work
 
   mocap::RecordingRequest request;
   request.in = a.in;
@@ -140,7 +131,7 @@ void RunExport(const ExportArgs& a) {
   std::string extension = fs::path(a.out).extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (extension != ".c3d") ThrowInputError(a.out, "--out", "unsupported format (expected .c3d)");
-  RefuseToOverwrite(a.in, a.out);
+  CheckOut(a.out, C3dFileOutput(), {a.in});
   mocap::C3dWriteOptions options;
   options.units = a.units;
   std::string error;
@@ -252,6 +243,8 @@ void AddMocapCommands(CLI::App& root) {
                     "Marker file of a static trial with the arm straight");
   rigid->add_option("--out", r->out, "Output rigid-bodies file (.yaml)")->required();
   rigid->callback([r] {
+    CheckOut(r->out, YamlFileOutput(mocap::kRigidBodiesSchema, "rigid-bodies file"),
+             {r->config, r->static_trial});
     const mocap::MarkerLayout layout = DefaultLayout(r->config, r->static_trial);
     mocap::WriteRigidBodiesFile(r->out, layout);
     std::printf("%s: %zu bodies, %zu markers\n", r->out.c_str(), layout.bodies.size(),

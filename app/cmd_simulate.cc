@@ -14,6 +14,7 @@
 #include "ccsrm/sim/simulator.h"
 #include "ccsrm/sim_io/run_file.h"
 #include "commands.h"
+#include "output_kinds.h"
 #include "paper_run.h"
 
 namespace ccsrm::app {
@@ -27,7 +28,7 @@ struct SimulateArgs {
 
 int RunSimulate(const SimulateArgs& a) {
   // Check the output path before spending minutes on the run.
-  { const AtomicOutputFile probe(a.out); }
+  CheckOut(a.out, RunFileOutput(), {a.run.config_path, a.run.params_path});
   const sim::PaperRun run = sim::PreparePaperRun(a.run);
   sim::SimulationOptions options = run.simulation;
   if (!a.quiet) {

@@ -12,10 +12,10 @@ namespace ccsrm::app {
 
 namespace fs = std::filesystem;
 
-void ApplyFitOptions(const std::string& free, const std::string& params,
+void ApplyFitOptions(const std::optional<std::string>& free, const std::string& params,
                      const std::vector<std::string>& set,
                      identify::IdentificationOptions* options) {
-  if (!free.empty()) options->free_parameters = SplitList(free, "--free");
+  if (free) options->free_parameters = SplitList(*free, "--free");
   for (const std::string& name : options->free_parameters) sim::FindParameter(name, "--free");
   if (!params.empty()) identify::ApplyParameterFile(ReadTextFile(params), params, options);
   for (const std::string& text : set) {
@@ -25,19 +25,6 @@ void ApplyFitOptions(const std::string& free, const std::string& params,
     if (!problem.empty()) ThrowInputError("--set", "", problem);
     options->values[name] = value;
   }
-}
-
-void CheckOutputFolder(const std::string& out, const std::vector<std::string>& inputs) {
-  for (const std::string& path : inputs) {
-    std::error_code ec;
-    if (fs::equivalent(path, out, ec)) {
-      ThrowInputError(out, "--out", "is an input file; inputs are never modified");
-    }
-  }
-  if (fs::exists(out) && !fs::is_directory(out)) {
-    ThrowInputError(out, "--out", "exists and is not a folder");
-  }
-  { const AtomicOutputDirectory probe(out); }  // a bad output path fails now
 }
 
 std::vector<identify::Experiment> LoadExperiments(const std::vector<std::string>& paths,

@@ -1,6 +1,7 @@
 #pragma once
 // What `ccsrm identify` and `ccsrm loop` read the same way: the fit's
 // parameter options (--free, --params, --set) and the experiment files.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,11 +12,8 @@ namespace ccsrm::app {
 
 // Applies --free (when given), --params and --set to options and checks
 // the result. Throws InputError naming the option or file.
-void ApplyFitOptions(const std::string& free, const std::string& params,
+void ApplyFitOptions(const std::optional<std::string>& free, const std::string& params,
                      const std::vector<std::string>& set, identify::IdentificationOptions* options);
-
-// Refuses an output folder that is an input, a file, or cannot be created.
-void CheckOutputFolder(const std::string& out, const std::vector<std::string>& inputs);
 
 // Loads each experiment and prints one line about it (and the mocap
 // pipeline's when it computed the angles). `role` prefixes the line

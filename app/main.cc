@@ -3,6 +3,7 @@
 #include <string>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/output_policy.h"
 #include "ccsrm/common/version.h"
 #include "commands.h"
 
@@ -29,6 +30,9 @@ int ExitOnParseError(const CLI::App& root, const CLI::ParseError& e) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Before any thread starts: Ctrl-C or a scheduler's SIGTERM removes the
+  // temporaries of unfinished outputs (docs/conventions.md, "Outputs").
+  ccsrm::RemoveTemporariesOnInterrupt();
   CLI::App root{"ccsrm: simulate, measure and identify cable-driven continuum manipulators"};
   root.set_version_flag("--version", ccsrm::kVersion);
   root.require_subcommand(1);

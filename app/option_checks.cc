@@ -11,6 +11,11 @@
 namespace ccsrm::app {
 
 std::vector<std::string> SplitList(const std::string& text, const std::string& option) {
+  // An empty list is refused rather than read as "the default": `--free ''`
+  // would otherwise fit every parameter.
+  if (text.find_first_not_of(" \t") == std::string::npos) {
+    ThrowInputError(option, "", "is empty: give at least one name");
+  }
   std::vector<std::string> items;
   std::size_t begin = 0;
   while (true) {
@@ -30,8 +35,11 @@ double ParseNumber(const std::string& text, const std::string& option) {
   errno = 0;
   char* end = nullptr;
   const double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || errno != 0 || !std::isfinite(value)) {
+  if (text.empty() || end != text.c_str() + text.size()) {
     ThrowInputError(option, "", "'" + text + "' is not a number");
+  }
+  if (errno == ERANGE || !std::isfinite(value)) {
+    ThrowInputError(option, "", "'" + text + "' is outside the range of finite doubles");
   }
   return value;
 }

@@ -11,7 +11,7 @@
 namespace ccsrm::app {
 
 // "a, b,c" -> {"a", "b", "c"}; throws InputError naming `option` for an
-// empty item.
+// empty item or an empty list.
 std::vector<std::string> SplitList(const std::string& text, const std::string& option);
 
 // A finite number, whole text; throws InputError naming `option` otherwise.

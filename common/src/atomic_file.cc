@@ -12,11 +12,19 @@
 #include <sstream>
 
 #include "ccsrm/common/error.h"
+#include "temporaries.h"
 
 namespace ccsrm {
 namespace {
 std::atomic<int> temp_counter{0};
+
+// "<target>.tmp-<pid>-<n>": the pid lets a later run tell a killed run's
+// leftovers (internal::RemoveStaleTemporaries) from a live run's.
+std::string TemporaryName(const std::string& target) {
+  return target + internal::kTemporaryInfix + std::to_string(::getpid()) + "-" +
+         std::to_string(temp_counter.fetch_add(1));
 }
+}  // namespace
 
 AtomicOutputFile::AtomicOutputFile(std::string target_path) : target_path_(std::move(target_path)) {
   if (target_path_.empty()) ThrowInputError("(output)", "", "empty output path");
@@ -28,12 +36,13 @@ AtomicOutputFile::AtomicOutputFile(std::string target_path) : target_path_(std::
   if (fs::is_directory(target_path_)) {
     ThrowInputError(target_path_, "", "output path is a directory");
   }
-  temp_path_ = target_path_ + ".tmp-" + std::to_string(::getpid()) + "-" +
-               std::to_string(temp_counter.fetch_add(1));
+  temp_path_ = TemporaryName(target_path_);
+  internal::RegisterTemporary(temp_path_);
 }
 
 AtomicOutputFile::~AtomicOutputFile() {
   if (!committed_) std::remove(temp_path_.c_str());
+  internal::UnregisterTemporary(temp_path_);
 }
 
 void AtomicOutputFile::Commit() {
@@ -43,6 +52,7 @@ void AtomicOutputFile::Commit() {
     ThrowInputError(target_path_, "", "cannot rename temporary output into place: " + reason);
   }
   committed_ = true;
+  internal::UnregisterTemporary(temp_path_);
 }
 
 namespace {
@@ -72,8 +82,8 @@ AtomicOutputDirectory::AtomicOutputDirectory(std::string target_path)
   if (fs::exists(target, ec) && !fs::is_directory(target, ec)) {
     ThrowInputError(target_path_, "", "exists and is not a folder");
   }
-  temp_path_ = target_path_ + ".tmp-" + std::to_string(::getpid()) + "-" +
-               std::to_string(temp_counter.fetch_add(1));
+  temp_path_ = TemporaryName(target_path_);
+  internal::RegisterTemporary(temp_path_);
   if (!fs::create_directory(temp_path_, ec) || ec) {
     ThrowInputError(target_path_, "",
                     "cannot create temporary folder '" + temp_path_ + "': " + ec.message());
@@ -81,9 +91,11 @@ AtomicOutputDirectory::AtomicOutputDirectory(std::string target_path)
 }
 
 AtomicOutputDirectory::~AtomicOutputDirectory() {
-  if (committed_) return;
-  std::error_code ignored;
-  std::filesystem::remove_all(temp_path_, ignored);
+  if (!committed_) {
+    std::error_code ignored;
+    std::filesystem::remove_all(temp_path_, ignored);
+  }
+  internal::UnregisterTemporary(temp_path_);
 }
 
 void AtomicOutputDirectory::Commit() {
@@ -96,6 +108,7 @@ void AtomicOutputDirectory::Commit() {
           std::string("cannot rename temporary folder into place: ") + std::strerror(errno));
     }
     committed_ = true;
+    internal::UnregisterTemporary(temp_path_);
     return;
   }
   // Swap the complete new folder with the old one in one step; the
@@ -108,6 +121,7 @@ void AtomicOutputDirectory::Commit() {
     }
     // A file system without RENAME_EXCHANGE: move the old folder aside,
     // move the new one in, and put the old one back if that fails.
+    // (Not registered for interrupts: for a moment it is the only copy.)
     const std::string aside = temp_path_ + "-old";
     if (std::rename(target_path_.c_str(), aside.c_str()) != 0) {
       ThrowInputError(
@@ -123,8 +137,11 @@ void AtomicOutputDirectory::Commit() {
     fs::remove_all(aside, ec);
     return;
   }
+  // The temporary name now holds the old content: it stays registered (an
+  // interrupt removes it just the same) until it is gone.
   committed_ = true;
   fs::remove_all(temp_path_, ec);
+  internal::UnregisterTemporary(temp_path_);
 }
 
 void WriteTextFileAtomically(const std::string& path, const std::string& text) {
@@ -140,6 +157,10 @@ void WriteTextFileAtomically(const std::string& path, const std::string& text) {
 }
 
 std::string ReadTextFile(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    ThrowInputError(path, "", "is a folder, expected a file");
+  }
   std::ifstream stream(path, std::ios::binary);
   if (!stream) ThrowInputError(path, "", "cannot open for reading");
   std::ostringstream buffer;

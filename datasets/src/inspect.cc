@@ -208,4 +208,14 @@ nlohmann::json ToJson(const FileSummary& summary) {
   return json;
 }
 
+std::string ReadSchemaAttribute(const std::string& path) {
+  try {
+    internal::Hdf5Session session;
+    const internal::FileReader reader(path);
+    return reader.HasRootAttribute("schema") ? reader.ReadStringAttribute("schema") : "";
+  } catch (const InputError&) {
+    return "";
+  }
+}
+
 }  // namespace ccsrm::datasets

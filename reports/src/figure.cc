@@ -1,5 +1,6 @@
 #include "ccsrm/reports/figure.h"
 
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -302,6 +303,11 @@ int RunInFolder(const std::string& program, const std::string& script, const std
     return -1;
   }
   if (pid == 0) {
+    // The program blocks SIGINT and SIGTERM for its interrupt watcher
+    // (common/output_policy.h); gnuplot gets them as usual.
+    sigset_t none;
+    sigemptyset(&none);
+    ::sigprocmask(SIG_SETMASK, &none, nullptr);
     ::dup2(pipe_fds[1], STDOUT_FILENO);
     ::dup2(pipe_fds[1], STDERR_FILENO);
     ::close(pipe_fds[0]);

@@ -12,6 +12,7 @@
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/clock.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/output_policy.h"
 #include "ccsrm/datasets/inspect.h"
 #include "fit_folder.h"
 #include "loop_folder.h"
@@ -21,8 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// An existing output folder is replaced only when it is empty or an earlier
-// report: `--out` pointing at a folder of other files must not wipe them.
 // "report/" and "report" name the same folder.
 fs::path FolderPath(const std::string& folder) {
   fs::path path = fs::path(folder).lexically_normal();
@@ -30,40 +29,18 @@ fs::path FolderPath(const std::string& folder) {
   return path;
 }
 
-void CheckOutputFolder(const std::string& folder) {
-  std::error_code ec;
-  const fs::path parent = FolderPath(folder).parent_path();
-  if (!parent.empty() && !fs::is_directory(parent, ec)) {
-    ThrowInputError(folder, "", "output directory '" + parent.string() + "' does not exist");
-  }
-  if (!fs::exists(folder, ec)) return;
-  if (!fs::is_directory(folder, ec)) ThrowInputError(folder, "", "exists and is not a folder");
-  if (fs::is_empty(folder, ec)) return;
-  const fs::path summary = fs::path(folder) / "summary.json";
-  bool is_report = false;
-  if (fs::is_regular_file(summary, ec)) {
-    std::ifstream in(summary);
-    const nlohmann::json json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-    is_report = json.is_object() && json.value("schema", "") == kReportSchema;
-  }
-  if (!is_report) {
-    ThrowInputError(folder, "",
-                    std::string("exists and is not a ccsrm report (no summary.json with schema ") +
-                        kReportSchema + "); refusing to replace it: choose a new folder");
-  }
-}
-
-// True when `path` lies inside `folder` (both may not exist yet).
-bool IsInside(const std::string& path, const std::string& folder) {
-  std::error_code ec;
-  const fs::path p = fs::weakly_canonical(path, ec);
-  const fs::path f = fs::weakly_canonical(folder, ec);
-  auto pi = p.begin();
-  for (auto fi = f.begin(); fi != f.end(); ++fi, ++pi) {
-    if (fi->empty()) continue;  // a trailing separator
-    if (pi == p.end() || *pi != *fi) return false;
-  }
-  return true;
+// The report folder under the one output policy (common/output_policy.h):
+// an existing folder is replaced only when it is empty or an earlier report,
+// and never when it is or holds the input.
+void CheckOutputFolder(const std::string& folder, const std::string& input) {
+  const OutputKind report{std::string("ccsrm report folder (summary.json, ") + kReportSchema + ")",
+                          /*folder=*/true, [](const std::string& path) {
+                            std::ifstream in(fs::path(path) / "summary.json");
+                            const nlohmann::json json =
+                                nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+                            return json.is_object() && json.value("schema", "") == kReportSchema;
+                          }};
+  CheckOutputPath(folder, "--out", report, {input});
 }
 
 std::string Count(int n, const std::string& noun) {
@@ -118,7 +95,7 @@ std::string ReportSummary::FullReport() const {
 void WriteReport(Document* document, const std::string& folder, const ReportOptions& options) {
   std::string why;
   if (!options.IsValid(&why)) ThrowInputError("report options", "", why);
-  CheckOutputFolder(folder);
+  CheckOutputFolder(folder, "");
   FindGnuplot(options.plot);
   if (document->created.empty()) document->created = UtcTimestamp();
 
@@ -163,12 +140,7 @@ ReportSummary MakeReport(const std::string& input, const std::string& output_fol
                     "or ccsrm-dataset/1 file, or a folder written by ccsrm identify or ccsrm "
                     "loop");
   }
-  if (IsInside(input, output_folder)) {
-    ThrowInputError(output_folder, "",
-                    "contains the input " + input +
-                        ", which replacing the folder would delete: choose another output folder");
-  }
-  CheckOutputFolder(output_folder);
+  CheckOutputFolder(output_folder, input);
   Document document;
   if (folder) {
     FindGnuplot(options.plot);

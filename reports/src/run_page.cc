@@ -50,8 +50,19 @@ std::vector<Instant> ChooseInstants(const std::vector<double>& time, const ArmFa
   const double first = time.front(), last = time.back();
   std::vector<std::pair<std::string, double>> wanted;
   if (!options.instants_s.empty()) {
-    for (double t : options.instants_s)
+    // A time outside the run would be shown at its nearest end, labelled
+    // with a time it is not: refused instead. Half a frame either side is
+    // still that frame.
+    const double half_frame = time.size() > 1 ? 0.5 * (last - first) / (time.size() - 1) : 0.0;
+    for (double t : options.instants_s) {
+      if (t < first - half_frame || t > last + half_frame) {
+        ThrowInputError("--instants", "",
+                        internal::FormatSeconds(t) + " s is outside the run (" +
+                            internal::FormatSeconds(first) + " to " +
+                            internal::FormatSeconds(last) + " s)");
+      }
       wanted.push_back({"t = " + internal::FormatSeconds(t) + " s", t});
+    }
   } else {
     if (paper_case && facts.protocol) {
       const internal::ProtocolPhases& p = *facts.protocol;

@@ -263,7 +263,7 @@ TEST(ReportCli, BadInputGetsOneLineAndExitStatus2) {
                      "is not a ccsrm report");
   EXPECT_EQ(ReadTextFile((dir / "photos" / "cat.jpg").string()), "meow");
   ExpectOneLineError(RunCcsrm("report --in " + Made().run + " --out " + Made().dir.string()),
-                     "contains the input");
+                     "holds the input");
   EXPECT_NE(RunCcsrm("report --in " + Made().run).status, 0);  // --out is required
   EXPECT_EQ(RunCcsrm("report --help").status, 0);
 }

@@ -12,6 +12,7 @@
 
 #include "ccsrm/cameras/video_io.h"
 #include "ccsrm/cameras/virtual_rig.h"
+#include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/datasets/inspect.h"
@@ -122,16 +123,10 @@ RenderSummary RenderVideos(const CameraRig& rig, const MarkerMotion& motion,
   ValidateCameraRig(rig, "(camera rig)");
   if (motion.p_WM.empty()) ThrowInputError(out_dir, "", "no frame to render");
   namespace fs = std::filesystem;
-  std::error_code error;
-  if (!fs::is_directory(out_dir)) {
-    const fs::path parent = fs::path(out_dir).lexically_normal().parent_path();
-    if (!parent.empty() && !fs::is_directory(parent)) {
-      ThrowInputError(out_dir, "", "parent directory '" + parent.string() + "' does not exist");
-    }
-    if (!fs::create_directory(out_dir, error)) {
-      ThrowInputError(out_dir, "", "cannot create directory: " + error.message());
-    }
-  }
+  // The folder appears complete or not at all (an earlier one is replaced
+  // whole): the videos are written into a temporary folder beside it.
+  AtomicOutputDirectory folder(out_dir);
+  const fs::path temp(folder.temp_path());
   const double rate = motion.rate_hz > 0.0 ? motion.rate_hz : rig.frame_rate_hz;
   RenderSummary summary;
   summary.frames = motion.p_WM.size();
@@ -140,9 +135,10 @@ RenderSummary RenderVideos(const CameraRig& rig, const MarkerMotion& motion,
   summary.dropped_frames.assign(cameras, 0);
   std::vector<VideoFileWriter> writers;
   for (const Camera& camera : rig.cameras) {
-    const std::string path = (fs::path(out_dir) / (camera.name + ".avi")).string();
-    writers.emplace_back(path, rate, camera.image_width_px, camera.image_height_px);
-    summary.video_paths.push_back(path);
+    const std::string name = camera.name + ".avi";
+    writers.emplace_back((temp / name).string(), rate, camera.image_width_px,
+                         camera.image_height_px);
+    summary.video_paths.push_back((fs::path(out_dir) / name).string());
   }
   std::size_t samples = 0;
   std::size_t seen_by_two = 0;
@@ -183,8 +179,9 @@ RenderSummary RenderVideos(const CameraRig& rig, const MarkerMotion& motion,
   for (VideoFileWriter& writer : writers) writer.Commit();
   CameraRig written = rig;
   written.frame_rate_hz = rate;
+  SaveCameraRig((temp / "cameras.yaml").string(), written);
+  folder.Commit();
   summary.camera_file = (fs::path(out_dir) / "cameras.yaml").string();
-  SaveCameraRig(summary.camera_file, written);
   return summary;
 }
 

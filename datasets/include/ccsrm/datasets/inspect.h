@@ -72,4 +72,9 @@ std::string ToText(const FileSummary& summary);
 //  "datasets": [{"path", "shape", "units", "type"}]}
 nlohmann::json ToJson(const FileSummary& summary);
 
+// The root `schema` attribute of an HDF5 file ("ccsrm-run/1"), or "" when
+// the path is not a readable HDF5 file or has none. Never throws: the output
+// policy uses it to recognise an earlier output (common/output_policy.h).
+std::string ReadSchemaAttribute(const std::string& path);
+
 }  // namespace ccsrm::datasets
