@@ -1,0 +1,441 @@
+// The error policy as a table (docs/conventions.md): bad inputs by class,
+// each run through the ccsrm program as a user would. For every row: exit
+// status 2, one line on stderr naming the file (or option) and the field,
+// and the scratch folder byte for byte as it was: no output left, no input
+// changed. The rows are the documentation of what is refused, and where.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "ccsrm/common/atomic_file.h"
+#include "run_ccsrm.h"
+
+namespace {
+namespace fs = std::filesystem;
+using ccsrm::testing::RunCcsrm;
+using ::testing::HasSubstr;
+using Outcome = ccsrm::testing::CommandOutcome;
+
+std::string Paper() { return std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml"; }
+
+// Every entry under `dir`: relative path -> size and FNV-1a checksum of its
+// bytes ("folder" for a folder), so that a changed, added or removed file
+// shows by name.
+std::map<std::string, std::string> Snapshot(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const fs::directory_entry& e : fs::recursive_directory_iterator(dir)) {
+    const std::string rel = fs::relative(e.path(), dir).string();
+    if (!e.is_regular_file()) {
+      files[rel] = "folder";
+      continue;
+    }
+    const std::string bytes = ccsrm::ReadTextFile(e.path().string());
+    std::uint64_t hash = 1469598103934665603ull;
+    for (unsigned char c : bytes) hash = (hash ^ c) * 1099511628211ull;
+    files[rel] = std::to_string(bytes.size()) + " bytes, fnv " + std::to_string(hash);
+  }
+  return files;
+}
+
+// The entries added, removed or changed between two snapshots, by name.
+std::string Differences(const std::map<std::string, std::string>& before,
+                        const std::map<std::string, std::string>& after) {
+  std::string out;
+  for (const auto& [name, state] : after) {
+    const auto it = before.find(name);
+    if (it == before.end())
+      out += " added " + name + ";";
+    else if (it->second != state)
+      out += " changed " + name + ";";
+  }
+  for (const auto& [name, state] : before) {
+    if (after.count(name) == 0) out += " removed " + name + ";";
+  }
+  return out;
+}
+
+void Write(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+// Debian's Python, with python3-h5py (scripts/install-deps.sh).
+constexpr const char* kPython = "/usr/bin/python3";
+
+bool HaveH5py() {
+  return std::system((std::string(kPython) + " -c 'import h5py' >/dev/null 2>&1").c_str()) == 0;
+}
+
+// Copies `from` to `to` and edits it in place with h5py: `python` runs with
+// `f` the open file and put(path, array) replacing a dataset (units kept).
+void MutateHdf5(const fs::path& from, const fs::path& to, const std::string& python) {
+  fs::copy_file(from, to, fs::copy_options::overwrite_existing);
+  const fs::path script = to.string() + ".py";
+  Write(script,
+        "import h5py, numpy as np\n"
+        "f = h5py.File('" +
+            to.string() +
+            "', 'r+')\n"
+            "def put(path, data):\n"
+            "    units = f[path].attrs['units']\n"
+            "    del f[path]\n"
+            "    f[path] = data\n"
+            "    f[path].attrs['units'] = units\n" +
+            python + "\nf.close()\n");
+  ASSERT_EQ(std::system((std::string(kPython) + " " + script.string()).c_str()), 0) << python;
+  fs::remove(script);
+}
+
+// A paper.yaml whose first line matching `pattern` is replaced by
+// `replacement` ("$&" is the line itself).
+std::string EditedPaper(const std::string& pattern, const std::string& replacement) {
+  const std::string text = ccsrm::ReadTextFile(Paper());
+  return std::regex_replace(text, std::regex(pattern), replacement,
+                            std::regex_constants::format_first_only);
+}
+
+class BadInputTable : public ::testing::Test {
+ protected:
+  // The inputs of every row, made once: configurations, parameter files, a
+  // short generated experiment, its processed angles and broken copies.
+  static void SetUpTestSuite() {
+    if (!HaveH5py()) return;  // each test skips, saying why
+    dir_ = ccsrm::testing::ScratchDirectory("bad_input_table");
+    const fs::path& d = dir_;
+    fs::copy_file(Paper(), d / "c.yaml");
+    Write(d / "dup.yaml", EditedPaper("  *link_mass_kg: .*", "$&\n$&"));
+    Write(d / "dupsolver.yaml",
+          ccsrm::ReadTextFile(Paper()) + "solver:\n  relative_tolerance: 1.0e-6\n");
+    Write(d / "stiff.yaml", EditedPaper("youngs_modulus_pa: .*", "youngs_modulus_pa: 1e300"));
+    Write(d / "typo.yaml", EditedPaper("link_mass_kg", "link_mas_kg"));
+    Write(d / "syntax.yaml", "schema: ccsrm-config/1\narm: [unclosed\n");
+    fs::create_directory(d / "confdir");
+    Write(d / "p.yaml", "mu: 0.2\n");
+    Write(d / "pbounds.yaml", "mu: {value: 0.5, free: true, bounds: [0.1, 0.3]}\n");
+    Write(d / "prange.yaml", "mu: {value: 5, free: true}\n");
+    Write(d / "pdup.yaml", "mu: 0.2\nmu_s: 0.3\nmu: 0.25\n");
+    Write(d / "notes.h5", "not an HDF5 file\n");
+    Write(d / "notes.c3d", "my notes, not a C3D file\n");
+    fs::create_directory(d / "mine");
+    Write(d / "mine" / "precious.txt", "the user's own file\n");
+
+    // Made in a work folder, then moved in: the rows compare the scratch
+    // folder with itself, and these are its inputs.
+    const fs::path w = ccsrm::testing::ScratchDirectory("bad_input_table_work");
+    Outcome o =
+        RunCcsrm("generate --config " + Paper() +
+                 " --case 1 --duration 0.3 --quiet --seed 3 --out " + (w / "exp.h5").string());
+    ASSERT_EQ(o.status, 0) << o.err;
+    o = RunCcsrm("mocap process --quiet --in " + (w / "exp.h5").string() + " --out " +
+                 (w / "processed.h5").string());
+    ASSERT_EQ(o.status, 0) << o.err;
+    o = RunCcsrm("simulate --config " + Paper() + " --case 1 --duration 0.2 --quiet --out " +
+                 (w / "run.h5").string());
+    ASSERT_EQ(o.status, 0) << o.err;
+    for (const char* name : {"exp.h5", "processed.h5", "run.h5"}) fs::rename(w / name, d / name);
+    const fs::path processed = d / "processed.h5";
+    MutateHdf5(processed, d / "five.h5",
+               "put('/input/length_change', f['/input/length_change'][:, :5])");
+    MutateHdf5(processed, d / "badyaml.h5", "f.attrs['config_yaml'] = 'arm: [unclosed'");
+    MutateHdf5(processed, d / "huge.h5",
+               "put('/measured/joint_angles', f['/measured/joint_angles'][...] * 1e30)");
+    MutateHdf5(processed, d / "cut5.h5",
+               "put('/measured/joint_angles', f['/measured/joint_angles'][:, :5, :])");
+    // One mocap frame: every array over the frames cut to its first.
+    MutateHdf5(processed, d / "one.h5",
+               "F = f['/mocap/time'].shape[0]\n"
+               "paths = []\n"
+               "f.visititems(lambda n, o: paths.append(n) if isinstance(o, h5py.Dataset) and "
+               "(n.startswith('mocap') or n.startswith('measured')) and o.ndim >= 1 and "
+               "o.shape[0] == F else None)\n"
+               "for n in paths: put('/' + n, f[n][:1])");
+    MutateHdf5(d / "exp.h5", d / "nan.h5",
+               "put('/mocap/markers', np.full(f['/mocap/markers'].shape, np.nan))");
+    MutateHdf5(d / "exp.h5", d / "inf.h5",
+               "put('/mocap/markers', np.full(f['/mocap/markers'].shape, np.inf))");
+  }
+
+  void SetUp() override {
+    if (!HaveH5py()) {
+      GTEST_SKIP() << kPython << " cannot import h5py, which makes the broken HDF5 files "
+                   << "(install python3-h5py: scripts/install-deps.sh)";
+    }
+  }
+
+  static fs::path dir_;
+};
+fs::path BadInputTable::dir_;
+
+struct BadInput {
+  std::string input_class;         // configs, overrides, hdf5, markers, outputs
+  std::string args;                // "{d}" is the scratch folder
+  std::vector<std::string> names;  // what the one line must name ("{d}" too)
+};
+
+std::string Expand(std::string text, const fs::path& dir) {
+  for (std::size_t at; (at = text.find("{d}")) != std::string::npos;) {
+    text.replace(at, 3, dir.string());
+  }
+  return text;
+}
+
+// The table. Where a row comes from the issue that found it (issue 33), its
+// item number is in the comment.
+const std::vector<BadInput>& Rows() {
+  static const std::vector<BadInput> rows = {
+      // Configurations: refused by `config check` with the rule `simulate` hits.
+      {"configs", "config check {d}/dup.yaml", {"{d}/dup.yaml", "link_mass_kg", "duplicate"}},  // 6
+      {"configs",
+       "config check {d}/dupsolver.yaml",
+       {"{d}/dupsolver.yaml", "solver", "duplicate"}},                                      // 6
+      {"configs", "config check {d}/stiff.yaml", {"{d}/stiff.yaml", "youngs_modulus_pa"}},  // 6
+      {"configs",
+       "simulate --config {d}/stiff.yaml --duration 0.1 --out {d}/run2.h5",
+       {"{d}/stiff.yaml", "youngs_modulus_pa"}},  // 6
+      {"configs",
+       "simulate --config {d}/dup.yaml --duration 0.1 --out {d}/run2.h5",
+       {"{d}/dup.yaml", "duplicate"}},
+      {"configs", "config check {d}/confdir", {"{d}/confdir", "folder"}},  // 9
+      {"configs", "config check {d}/typo.yaml", {"{d}/typo.yaml", "link_mas_kg"}},
+      {"configs", "config check {d}/syntax.yaml", {"{d}/syntax.yaml", "line"}},
+      {"configs", "config check {d}/missing.yaml", {"{d}/missing.yaml"}},
+      // Command-line values and parameter files.
+      {"overrides",
+       "simulate --config {d}/c.yaml --set mu=1e-400 --duration 0.1 --out {d}/run2.h5",
+       {"--set", "1e-400"}},  // 9
+      {"overrides",
+       "simulate --config {d}/c.yaml --set mu=1e400 --duration 0.1 --out {d}/run2.h5",
+       {"--set", "1e400"}},
+      {"overrides",
+       "simulate --config {d}/c.yaml --set mu=-1 --duration 0.1 --out {d}/run2.h5",
+       {"--set", "mu"}},
+      {"overrides",
+       "identify --data {d}/processed.h5 --free '' --out {d}/fit",
+       {"--free", "empty"}},  // 3
+      {"overrides",
+       "identify --data {d}/processed.h5 --free mu, --out {d}/fit",
+       {"--free", "empty"}},
+      {"overrides",
+       "loop --data {d}/processed.h5 --candidates '' --out {d}/loop",
+       {"--candidates", "empty"}},  // 3
+      {"overrides",
+       "derivatives --config {d}/c.yaml --parameters '' --duration 0.1",
+       {"--parameters", "empty"}},
+      {"overrides",
+       "identify --data {d}/processed.h5 --params {d}/pbounds.yaml --out {d}/fit",
+       {"{d}/pbounds.yaml", "mu"}},  // 9
+      {"overrides",
+       "identify --data {d}/processed.h5 --params {d}/prange.yaml --out {d}/fit",
+       {"{d}/prange.yaml", "mu"}},
+      {"overrides",
+       "identify --data {d}/processed.h5 --params {d}/pdup.yaml --out {d}/fit",
+       {"{d}/pdup.yaml", "mu", "duplicate"}},
+      {"overrides",
+       "report --in {d}/run.h5 --instants -5 --out {d}/report",
+       {"--instants", "-5"}},  // 8
+      {"overrides", "report --in {d}/run.h5 --instants 1e4 --out {d}/report", {"--instants"}},
+      // From the test's working folder, outside the repository, where the
+      // default configuration is not found: the value is refused first.
+      {"overrides", "bench --duration 0", {"--duration"}},  // 9
+      {"overrides",
+       "simulate --config {d}/c.yaml --amplitude 100 --duration 0.1 --out {d}/run2.h5",
+       {"--amplitude"}},
+      // HDF5 files: an experiment is checked against its own config_yaml at
+      // every door (inspect, process, identify).
+      {"hdf5",
+       "identify --data {d}/five.h5 --out {d}/fit",
+       {"{d}/five.h5", "/input/length_change"}},                                         // 5
+      {"hdf5", "dataset inspect {d}/five.h5", {"{d}/five.h5", "/input/length_change"}},  // 5
+      {"hdf5", "dataset inspect {d}/badyaml.h5", {"{d}/badyaml.h5", "config_yaml"}},     // 5
+      {"hdf5", "identify --data {d}/badyaml.h5 --out {d}/fit", {"{d}/badyaml.h5", "config_yaml"}},
+      {"hdf5",
+       "identify --data {d}/huge.h5 --out {d}/fit",
+       {"{d}/huge.h5", "/measured/joint_angles"}},                                          // 4
+      {"hdf5", "dataset inspect {d}/huge.h5", {"{d}/huge.h5", "/measured/joint_angles"}},   // 4
+      {"hdf5", "identify --data {d}/one.h5 --out {d}/fit", {"{d}/one.h5", "/mocap/time"}},  // 9
+      {"hdf5",
+       "identify --data {d}/cut5.h5 --out {d}/fit",
+       {"{d}/cut5.h5", "/measured/joint_angles"}},  // 9
+      {"hdf5", "dataset inspect {d}/cut5.h5", {"{d}/cut5.h5", "/measured/joint_angles"}},
+      {"hdf5", "dataset inspect {d}/notes.h5", {"{d}/notes.h5", "HDF5"}},
+      {"hdf5",
+       "mocap process --in {d}/exp.h5 --inputs {d}/five.h5 --out {d}/x.h5",
+       {"{d}/five.h5", "/input/length_change"}},  // 5
+      // Marker data.
+      {"markers",
+       "mocap process --in {d}/nan.h5 --out {d}/x.h5",
+       {"{d}/nan.h5", "/mocap/markers"}},  // 4
+      {"markers",
+       "mocap process --in {d}/inf.h5 --out {d}/x.h5",
+       {"{d}/inf.h5", "/mocap/markers"}},  // 4
+      {"markers", "mocap inspect {d}/notes.c3d", {"{d}/notes.c3d"}},
+      {"markers", "mocap process --in {d}/missing.c3d --out {d}/x.h5", {"{d}/missing.c3d"}},
+      // Output paths: nothing of the user's is replaced, no input written.
+      {"outputs",
+       "identify --data {d}/processed.h5 --free mu --out {d}/mine",
+       {"{d}/mine", "--out", "not a ccsrm fit folder"}},  // 1
+      {"outputs",
+       "loop --data {d}/processed.h5 --out {d}/mine",
+       {"{d}/mine", "--out", "not a ccsrm loop folder"}},  // 1
+      {"outputs",
+       "report --in {d}/run.h5 --out {d}/mine",
+       {"{d}/mine", "--out", "not a ccsrm report"}},
+      {"outputs",
+       "simulate --config {d}/c.yaml --out {d}/c.yaml",
+       {"{d}/c.yaml", "--out", "input"}},  // 2
+      {"outputs",
+       "simulate --config {d}/c.yaml --params {d}/p.yaml --out {d}/p.yaml",
+       {"{d}/p.yaml", "--out", "input"}},  // 2
+      {"outputs",
+       "generate --config {d}/c.yaml --out {d}/c.yaml",
+       {"{d}/c.yaml", "--out", "input"}},
+      {"outputs",
+       "mocap process --in {d}/exp.h5 --out {d}/exp.h5",
+       {"{d}/exp.h5", "--out", "input"}},
+      {"outputs",
+       "identify --data {d}/processed.h5 --out {d}",
+       {"{d}", "--out", "holds the input"}},
+      {"outputs", "report --in {d}/run.h5 --out {d}/run.h5", {"{d}/run.h5", "--out"}},
+      {"outputs",
+       "simulate --config {d}/c.yaml --out {d}/notes.h5",
+       {"{d}/notes.h5", "not a ccsrm run file"}},
+      {"outputs",
+       "simulate --config {d}/c.yaml --out {d}/processed.h5",
+       {"{d}/processed.h5", "not a ccsrm run file"}},
+      {"outputs", "simulate --config {d}/c.yaml --out {d}/mine", {"{d}/mine", "folder"}},
+      {"outputs",
+       "simulate --config {d}/c.yaml --out {d}/nowhere/run.h5",
+       {"{d}/nowhere/run.h5", "does not exist"}},
+      {"outputs",
+       "mocap export --in {d}/exp.h5 --out {d}/notes.c3d",
+       {"{d}/notes.c3d", "not a C3D file"}},
+      {"outputs",
+       "derivatives --config {d}/c.yaml --duration 0.1 --json {d}/c.yaml",
+       {"{d}/c.yaml", "--json"}},
+      {"outputs", "cameras rig --out {d}/c.yaml", {"{d}/c.yaml", "not a camera file"}},
+      {"outputs",
+       "mocap rigid-bodies --config {d}/c.yaml --out {d}/p.yaml",
+       {"{d}/p.yaml", "not a rigid-bodies file"}},
+  };
+  return rows;
+}
+
+TEST_F(BadInputTable, EveryRowExitsTwoWithOneLineAndLeavesTheFolderAsItWas) {
+  std::map<std::string, int> per_class;
+  const auto start = std::chrono::steady_clock::now();
+  for (const BadInput& row : Rows()) {
+    const std::string args = Expand(row.args, dir_);
+    SCOPED_TRACE(row.input_class + ": ccsrm " + args);
+    const auto before = Snapshot(dir_);
+    const Outcome o = RunCcsrm(args);
+    EXPECT_EQ(o.status, 2) << o.all();
+    EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
+    EXPECT_EQ(o.err.rfind("ccsrm: ", 0), 0u) << o.err;
+    for (const std::string& name : row.names) {
+      EXPECT_THAT(o.err, HasSubstr(Expand(name, dir_)));
+    }
+    const auto after = Snapshot(dir_);
+    EXPECT_EQ(Differences(before, after), "") << "the folder changed";
+    for (const auto& [name, state] : after) {  // so that the next rows start alike
+      if (before.count(name) == 0) fs::remove_all(dir_ / name);
+    }
+    ++per_class[row.input_class];
+  }
+  std::string counts;
+  for (const auto& [name, n] : per_class) counts += " " + name + " " + std::to_string(n);
+  std::printf("bad-input table: %zu rows (%s ), %.1f s\n", Rows().size(), counts.c_str(),
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+}
+
+// The other half of the policy: a command replaces its own earlier output,
+// and removes what a killed run left beside it.
+TEST_F(BadInputTable, OwnOutputsAreReplacedAndAKilledRunsTemporariesRemoved) {
+  const fs::path d = ccsrm::testing::ScratchDirectory("bad_input_table_own");
+  const std::string run = (d / "run.h5").string();
+  const std::string simulate =
+      "simulate --config " + Paper() + " --case 1 --duration 0.1 --quiet --out " + run;
+  ASSERT_EQ(RunCcsrm(simulate).status, 0);
+  // A run killed by SIGKILL while writing left this (its pid is above any
+  // Linux pid_max, so no process has it).
+  const std::string stale = run + ".tmp-2147483646-0";
+  Write(stale, "half a run");
+  const Outcome again = RunCcsrm(simulate);
+  EXPECT_EQ(again.status, 0) << again.err;
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_EQ(std::distance(fs::directory_iterator(d), fs::directory_iterator()), 1);
+}
+
+// `ccsrm <args>` started with exec, interrupted with `signal_number`
+// `delay` after its first progress line on stderr (so that the program is
+// at work, past its start); returns the wait status.
+int RunAndInterrupt(const std::string& args, std::chrono::milliseconds delay, int signal_number,
+                    std::string* err) {
+  const std::string err_path =
+      (fs::temp_directory_path() / ("ccsrm_interrupt_" + std::to_string(::getpid()) + ".err"))
+          .string();
+  const std::string command =
+      "exec " + std::string(CCSRM_PROGRAM) + " " + args + " >/dev/null 2>" + err_path;
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  const auto started = [&err_path] {
+    std::error_code ec;
+    const std::uintmax_t size = fs::file_size(err_path, ec);
+    return !ec && size > 0;
+  };
+  for (int i = 0; i < 1000 && !started(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  std::this_thread::sleep_for(delay);
+  ::kill(pid, signal_number);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  *err = ccsrm::ReadTextFile(err_path);
+  fs::remove(err_path);
+  return status;
+}
+
+// Interrupts at several moments of a run and of a fit: whatever the moment,
+// the process ends by the signal and the output folder holds no temporary.
+TEST_F(BadInputTable, InterruptsLeaveNoTemporaries) {
+  const fs::path d = ccsrm::testing::ScratchDirectory("bad_input_table_interrupt");
+  const std::vector<std::pair<std::string, int>> commands = {
+      {"simulate --config " + Paper() + " --case 2 --duration 6 --out " + (d / "run.h5").string(),
+       SIGINT},
+      {"identify --data " + (dir_ / "processed.h5").string() + " --free mu --threads 2 --out " +
+           (d / "fit").string(),
+       SIGTERM},
+  };
+  for (const auto& [args, signal_number] : commands) {
+    for (const int ms : {300, 900}) {
+      SCOPED_TRACE(args + " interrupted after " + std::to_string(ms) + " ms");
+      std::string err;
+      const int status = RunAndInterrupt(args, std::chrono::milliseconds(ms), signal_number, &err);
+      if (WIFSIGNALED(status)) {
+        EXPECT_EQ(WTERMSIG(status), signal_number);
+        EXPECT_THAT(err, HasSubstr("ccsrm: interrupted")) << err;
+      } else {
+        // Finished before the signal: then it wrote its output whole.
+        EXPECT_EQ(WEXITSTATUS(status), 0) << err;
+      }
+      for (const fs::directory_entry& e : fs::directory_iterator(d)) {
+        EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+      }
+    }
+  }
+}
+
+}  // namespace
