@@ -2,8 +2,10 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <variant>
 
 #include "ccsrm/datasets/inspect.h"
+#include "ccsrm/sim_io/experiment_check.h"
 #include "commands.h"
 
 namespace ccsrm::app {
@@ -14,8 +16,8 @@ void AddDatasetCommands(CLI::App& root) {
   dataset->require_subcommand(1);
   CLI::App* inspect = dataset->add_subcommand(
       "inspect",
-      "Validate a ccsrm-run/1 or ccsrm-dataset/1 file and print its schema, sizes, "
-      "time span and attributes");
+      "Validate a ccsrm-run/1 or ccsrm-dataset/1 file (an experiment also against its own "
+      "config_yaml) and print its schema, sizes, time span and attributes");
   struct Args {
     std::string path;
     bool json = false;
@@ -24,7 +26,13 @@ void AddDatasetCommands(CLI::App& root) {
   inspect->add_option("FILE", args->path, "HDF5 file")->required();
   inspect->add_flag("--json", args->json, "Print one JSON object instead of text");
   inspect->callback([args] {
-    const datasets::FileSummary summary = datasets::InspectFile(args->path);
+    // Read once; an experiment is also checked against its own config_yaml
+    // and the joints' range, as identification and mocap process check it.
+    const datasets::AnyFile file = datasets::ReadAnyFile(args->path);
+    if (const auto* experiment = std::get_if<datasets::ExperimentFile>(&file)) {
+      sim_io::CheckExperimentAgainstConfig(*experiment, args->path);
+    }
+    const datasets::FileSummary summary = datasets::Summarise(file, args->path);
     if (args->json) {
       std::printf("%s\n", datasets::ToJson(summary).dump(2).c_str());
     } else {

@@ -23,6 +23,7 @@
 #include "ccsrm/mocap/rigid_bodies.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
+#include "ccsrm/sim_io/experiment_check.h"
 #include "commands.h"
 #include "option_checks.h"
 #include "output_kinds.h"
@@ -97,6 +98,8 @@ void RunProcess(const ProcessArgs& a) {
 
   if (processed.static_trial) PrintRefinement(a.static_trial, *processed.static_trial);
   std::printf("%s", processed.reconstruction_report.c_str());
+  // The experiment checked against its own config_yaml before it is written.
+  sim_io::CheckExperimentAgainstConfig(processed.experiment, a.in.empty() ? a.cameras : a.in);
   datasets::WriteExperimentFile(a.out, processed.experiment);
   const mocap::ProcessingResult& result = processed.result;
   if (a.quiet) {

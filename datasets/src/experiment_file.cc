@@ -161,12 +161,25 @@ void ValidateExperimentFile(const ExperimentFile& experiment, const std::string&
   if (experiment.measured_joint_twist) {
     const auto twist = ExpectShape(file, "/measured/joint_twist", *experiment.measured_joint_twist,
                                    {f, Free("J")});
-    if (experiment.measured_joint_angles &&
-        experiment.measured_joint_angles->shape[1] != twist[1]) {
-      ThrowInputError(file, "/measured/joint_twist",
-                      "expected J=" + std::to_string(experiment.measured_joint_angles->shape[1]) +
-                          " joints (from /measured/joint_angles), found " +
-                          std::to_string(twist[1]));
+    const auto& angles = experiment.measured_joint_angles;
+    if (angles && angles->shape[1] != twist[1]) {
+      // One of the two was cut or belongs to another arm. The link poses
+      // written beside them (L = J: joint i joins link i-1 and link i) tell
+      // which; without them the angles, what every consumer reads, are named.
+      const auto& pose = experiment.measured_link_pose;
+      if (pose && pose->shape[1] == angles->shape[1]) {
+        ThrowInputError(file, "/measured/joint_twist",
+                        "expected J=" + std::to_string(angles->shape[1]) +
+                            " joints (from /measured/joint_angles and /measured/link_pose), "
+                            "found " +
+                            std::to_string(twist[1]));
+      }
+      std::string others = "/measured/joint_twist has " + std::to_string(twist[1]);
+      if (pose)
+        others += " and /measured/link_pose has " + std::to_string(pose->shape[1]) + " links";
+      ThrowInputError(file, "/measured/joint_angles",
+                      "has J=" + std::to_string(angles->shape[1]) + " joints, but " + others +
+                          ": the measured records must cover the same joints");
     }
   }
 }

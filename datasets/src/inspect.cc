@@ -125,10 +125,11 @@ FileKind KindOf(const AnyFile& file) {
   return std::holds_alternative<RunFile>(file) ? FileKind::kRun : FileKind::kExperiment;
 }
 
-FileSummary InspectFile(const std::string& path) {
+FileSummary InspectFile(const std::string& path) { return Summarise(ReadAnyFile(path), path); }
+
+FileSummary Summarise(const AnyFile& file, const std::string& path) {
   FileSummary summary;
   summary.file = path;
-  const AnyFile file = ReadAnyFile(path);
   summary.kind = KindOf(file);
   if (const RunFile* run = std::get_if<RunFile>(&file)) {
     summary.schema = kRunSchema;

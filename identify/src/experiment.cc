@@ -9,6 +9,7 @@
 #include "ccsrm/identify/sensitivity.h"
 #include "ccsrm/mocap/recording.h"
 #include "ccsrm/mocap/signal.h"
+#include "ccsrm/sim_io/experiment_check.h"
 
 namespace ccsrm::identify {
 namespace {
@@ -60,41 +61,39 @@ bool ExperimentLoadOptions::IsValid(std::string* error) const {
 
 Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::string& path,
                           const ExperimentLoadOptions& options) {
-  // Without measured angles, the mocap pipeline first, with default settings.
+  std::string error;
+  if (!options.IsValid(&error)) ThrowInputError(path, "noise", error);
+  // The check of every door (config_yaml, cable columns, the measured
+  // angles' shape and range) before any work. Without measured angles the
+  // mocap pipeline runs, with default settings, and its output is checked
+  // too: its angles follow the rigid bodies, which need not cover the arm.
+  std::optional<sim_io::ExperimentArm> arm = sim_io::CheckExperimentAgainstConfig(recorded, path);
   std::optional<mocap::ProcessedRecording> processed;
   if (!recorded.measured_joint_angles) {
     processed = mocap::AddMeasuredJointAngles(recorded, path);
+    arm = sim_io::CheckExperimentAgainstConfig(processed->experiment, path);
   }
   const datasets::ExperimentFile& file = processed ? processed->experiment : recorded;
-  std::string error;
-  if (!options.IsValid(&error)) ThrowInputError(path, "noise", error);
 
   Experiment e;
   e.path = path;
   e.name = !file.name.empty() ? file.name : std::filesystem::path(path).stem().string();
-  if (file.config_yaml.empty()) {
+  if (!arm) {
     ThrowInputError(path, "attribute 'config_yaml'",
                     "is empty: identification needs the arm's nominal configuration");
   }
-  e.config = sim::ParseConfig(file.config_yaml, path + ": attribute 'config_yaml'");
-  auto model = std::make_shared<sim::ArmModel>(e.config.arm);
+  e.config = std::move(arm->config);
+  std::shared_ptr<const sim::ArmModel> model = std::move(arm->model);
   e.joints = model->num_joints();
 
-  // Inputs: the arm is simulated from its own recorded inputs.
+  // Inputs: the arm is simulated from its own recorded inputs (the check
+  // allows none: a recording without an actuator record).
   const std::size_t n = file.input_time.rows();
-  const std::size_t cables =
-      file.input_length_change.rank() == 2 ? file.input_length_change.shape[1] : std::size_t{0};
+  const std::size_t cables = file.input_length_change.shape[1];
   if (cables == 0) {
     ThrowInputError(path, "/input/length_change",
                     "has no cable columns: the experiment records no inputs, and "
                     "identification simulates each experiment from its own inputs");
-  }
-  if (static_cast<int>(cables) != model->num_cables()) {
-    ThrowInputError(path, "/input/length_change",
-                    "has " + std::to_string(cables) +
-                        " cable columns, the arm of its "
-                        "config_yaml has " +
-                        std::to_string(model->num_cables()) + " driving cables");
   }
   if (n < 2) {
     ThrowInputError(path, "/input/time",
@@ -119,13 +118,7 @@ Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::s
     e.angles_from_pipeline = true;
     e.pipeline_report = processed->result.summary.BriefReport();
   }
-  const datasets::Array& measured = *file.measured_joint_angles;
-  if (measured.rank() != 3 || measured.shape[0] != file.mocap_time.rows() ||
-      measured.shape[1] != static_cast<std::size_t>(e.joints) || measured.shape[2] != 2) {
-    ThrowInputError(path, "/measured/joint_angles",
-                    "must be F x " + std::to_string(e.joints) +
-                        " x 2 (F the frames of /mocap/time, the joints of its config_yaml)");
-  }
+  const datasets::Array& measured = *file.measured_joint_angles;  // F × J × 2 (checked)
   std::size_t first = 0;
   while (first < file.mocap_time.rows() && file.mocap_time.at(first) < e.start_time_s) ++first;
   const std::size_t frames = file.mocap_time.rows() - first;

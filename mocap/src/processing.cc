@@ -60,6 +60,19 @@ std::vector<std::size_t> BodyOffsets(const MarkerLayout& layout) {
   return offsets;
 }
 
+// Where the markers and their times sit in `table`'s file, for messages: the
+// HDF5 paths of our own files, the format's own words otherwise.
+std::string MarkerField(const MarkerTable& table) {
+  if (table.format == "ccsrm-dataset") return "/mocap/markers";
+  if (table.format == "ccsrm-run") return "/markers";
+  return "marker data";
+}
+std::string TimeField(const MarkerTable& table) {
+  if (table.format == "ccsrm-dataset") return "/mocap/time";
+  if (table.format == "ccsrm-run") return "/time";
+  return "frames";
+}
+
 std::vector<double> TimeBase(const MarkerTable& table, const std::vector<double>& time,
                              const std::string& source, double* rate_hz) {
   const std::size_t frames = table.frames();
@@ -292,9 +305,21 @@ ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<doub
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError(source, "processing options", error);
   ValidateMarkerLayout(layout, source);
-  if (!table.IsConsistent(&error)) ThrowInputError(source, "", error);
   const std::size_t F = table.frames();
-  if (F == 0) ThrowInputError(source, "", "no frames to process");
+  if (F < 2) {
+    // Before the table's own check, which would only find no frame rate.
+    ThrowInputError(source, TimeField(table),
+                    "has " + std::to_string(F) +
+                        " frame(s): processing needs at least 2 (a frame rate for the time "
+                        "base and the low-pass filter)");
+  }
+  if (!table.IsConsistent(&error)) ThrowInputError(source, "", error);
+  if (std::none_of(table.positions_m.begin(), table.positions_m.end(),
+                   [](double v) { return std::isfinite(v); })) {
+    ThrowInputError(source, MarkerField(table),
+                    "has no finite sample (every position NaN or infinite): no marker was ever "
+                    "seen, so there is no pose to fit");
+  }
 
   ProcessingResult result;
   ProcessingSummary& summary = result.summary;

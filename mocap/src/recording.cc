@@ -139,9 +139,13 @@ ResolvedLayout ResolveLayout(const RecordingRequest& request, const Recording& r
   return out;
 }
 
-// /input/time and /input/length_change of a run or experiment file.
-void CopyInputs(const std::string& path, datasets::ExperimentFile* experiment) {
+// /input/time and /input/length_change of a run or experiment file. With an
+// arm known (`model` not null, described by `arm_source`), its cable columns
+// must be the arm's driving cables: refused here, where the file is read.
+void CopyInputs(const std::string& path, const sim::ArmModel* model, const std::string& arm_source,
+                datasets::ExperimentFile* experiment) {
   const datasets::AnyFile file = datasets::ReadAnyFile(path);
+  std::string field = "/input/length_change";
   if (const auto* source = std::get_if<datasets::ExperimentFile>(&file)) {
     experiment->input_time = source->input_time;
     experiment->input_length_change = source->input_length_change;
@@ -149,6 +153,13 @@ void CopyInputs(const std::string& path, datasets::ExperimentFile* experiment) {
     const datasets::RunFile& run = std::get<datasets::RunFile>(file);
     experiment->input_time = run.time;
     experiment->input_length_change = run.input_length_change;
+    field = "/input_length_change";
+  }
+  const std::size_t cables = experiment->input_length_change.shape[1];
+  if (model != nullptr && cables != static_cast<std::size_t>(model->num_cables())) {
+    ThrowInputError(path, field,
+                    "has " + std::to_string(cables) + " cable columns, the arm of " + arm_source +
+                        " has " + std::to_string(model->num_cables()) + " driving cables");
   }
 }
 
@@ -187,7 +198,9 @@ ProcessedRecording Process(const RecordingRequest& request, Recording recording)
   }
   if (!request.inputs.empty() &&
       !(recording.has_file_inputs && !request.in.empty() && SameFile(request.inputs, request.in))) {
-    CopyInputs(request.inputs, &experiment);
+    const std::string arm_source =
+        !request.config.empty() ? request.config : recording.source + " (its config_yaml)";
+    CopyInputs(request.inputs, layout.model.get(), arm_source, &experiment);
   }
   experiment.rigid_bodies = ToExperimentRigidBodies(layout.layout);
   experiment.mocap_quality.clear();

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include "c3d_test_files.h"
@@ -399,8 +400,6 @@ TEST(MocapExport, RefusesOtherFormatsAndItsOwnInput) {
   EXPECT_FALSE(fs::exists(dir / "x.trc"));
 }
 
-}  // namespace
-
 TEST(Generate, ListEffectsGivesEveryEffectWithUnitsBoundsAndRealisticMagnitude) {
   const Outcome o = RunCcsrm("generate --list-effects --json");
   ASSERT_EQ(o.status, 0) << o.err;
@@ -493,3 +492,133 @@ TEST(Generate, ExperimentRecordsTheCommandWhileTheTruthRunHasTheDelayedInputs) {
     EXPECT_NEAR(truth.input_length_change.at(30, c), nominal.input_length_change.at(20, c), 1e-9);
   }
 }
+
+// --- Issue 33: every door checks an experiment against its own config_yaml ---
+
+// The generated experiment, changed by `change` and written to <dir>/<name>.h5
+// (what a user's script or another tool could write: it passes
+// ValidateExperimentFile, which knows nothing of the arm).
+std::string Variant(const fs::path& dir, const std::string& name,
+                    const std::function<void(ccsrm::datasets::ExperimentFile*)>& change) {
+  ccsrm::datasets::ExperimentFile e =
+      ccsrm::datasets::ReadExperimentFile((Generated() / "exp.h5").string());
+  change(&e);
+  const std::string path = (dir / (name + ".h5")).string();
+  ccsrm::datasets::WriteExperimentFile(path, e);
+  return path;
+}
+
+// Inputs for 5 cables on the 6-cable arm: refused by inspect, and by mocap
+// process whether they come with the experiment or through --inputs, before
+// anything is written.
+TEST(ExperimentCheck, InputsForAnotherNumberOfCablesAreRefusedAtEveryDoor) {
+  const fs::path dir = FreshDir("five_cables");
+  const std::string five = Variant(dir, "five", [](ccsrm::datasets::ExperimentFile* e) {
+    ccsrm::datasets::Array cut({e->input_time.rows(), 5});
+    for (std::size_t i = 0; i < cut.rows(); ++i) {
+      for (std::size_t c = 0; c < 5; ++c) cut.at(i, c) = e->input_length_change.at(i, c);
+    }
+    e->input_length_change = cut;
+  });
+  const std::string want = five +
+                           ": /input/length_change: has 5 cable columns, the arm of its "
+                           "config_yaml has 6 driving cables";
+  const Outcome inspect = RunCcsrm("dataset inspect " + five);
+  EXPECT_EQ(inspect.status, 2);
+  EXPECT_EQ(inspect.err, "ccsrm: " + want + "\n");
+
+  const std::string out = (dir / "out.h5").string();
+  const Outcome own = RunCcsrm("mocap process --quiet --in " + five + " --out " + out);
+  EXPECT_EQ(own.status, 2);
+  EXPECT_EQ(own.err, "ccsrm: " + want + "\n");
+  EXPECT_FALSE(fs::exists(out));
+
+  const std::string exp = (Generated() / "exp.h5").string();
+  const Outcome inputs =
+      RunCcsrm("mocap process --quiet --in " + exp + " --inputs " + five + " --out " + out);
+  EXPECT_EQ(inputs.status, 2);
+  EXPECT_EQ(inputs.err, "ccsrm: " + five +
+                            ": /input/length_change: has 5 cable columns, the arm of " + exp +
+                            " (its config_yaml) has 6 driving cables\n");
+  EXPECT_FALSE(fs::exists(out));
+  const Outcome with_config = RunCcsrm("mocap process --quiet --in " + exp + " --config " +
+                                       Paper() + " --inputs " + five + " --out " + out);
+  EXPECT_EQ(with_config.status, 2);
+  EXPECT_THAT(with_config.err, HasSubstr("the arm of " + Paper() + " has 6 driving cables"));
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// A config_yaml that does not parse, and angles no universal joint can take,
+// are refused by inspect (and by identify: tests/identify).
+TEST(ExperimentCheck, InspectRefusesABadConfigYamlAndAnglesOutOfRange) {
+  const fs::path dir = FreshDir("inspect_check");
+  const std::string bad_yaml = Variant(dir, "bad_yaml", [](ccsrm::datasets::ExperimentFile* e) {
+    e->config_yaml = "arm: [unclosed";
+  });
+  const Outcome yaml = RunCcsrm("dataset inspect " + bad_yaml);
+  EXPECT_EQ(yaml.status, 2);
+  EXPECT_EQ(ccsrm::testing::CountLines(yaml.err), 1) << yaml.err;
+  EXPECT_THAT(yaml.err, HasSubstr("ccsrm: " + bad_yaml + ": attribute 'config_yaml'"));
+
+  const std::string processed = (dir / "processed.h5").string();
+  ASSERT_EQ(RunCcsrm("mocap process --quiet --in " + (Generated() / "exp.h5").string() + " --out " +
+                     processed)
+                .status,
+            0);
+  ccsrm::datasets::ExperimentFile e = ccsrm::datasets::ReadExperimentFile(processed);
+  ASSERT_TRUE(e.measured_joint_angles.has_value());
+  for (double& v : e.measured_joint_angles->values) v *= 1e30;
+  const std::string huge = (dir / "huge.h5").string();
+  ccsrm::datasets::WriteExperimentFile(huge, e);
+  const Outcome angles = RunCcsrm("dataset inspect " + huge);
+  EXPECT_EQ(angles.status, 2);
+  EXPECT_EQ(ccsrm::testing::CountLines(angles.err), 1) << angles.err;
+  EXPECT_THAT(angles.err, HasSubstr("ccsrm: " + huge + ": /measured/joint_angles: frame index "));
+  EXPECT_THAT(angles.err, HasSubstr("outside the universal joint's range"));
+}
+
+// Markers never seen (all NaN, all infinite) and a one-frame recording are
+// refused by mocap process where it reads them, naming the file and the
+// dataset, instead of an experiment with no finite angle.
+TEST(ExperimentCheck, MarkersNeverSeenAndASingleFrameAreRefused) {
+  const fs::path dir = FreshDir("unseen");
+  const std::string out = (dir / "out.h5").string();
+  for (const double value : {std::nan(""), HUGE_VAL}) {
+    const std::string unseen = Variant(dir, "unseen", [value](ccsrm::datasets::ExperimentFile* e) {
+      for (double& v : e->mocap_markers.values) v = value;
+    });
+    const Outcome o = RunCcsrm("mocap process --quiet --in " + unseen + " --out " + out);
+    EXPECT_EQ(o.status, 2) << value;
+    EXPECT_EQ(o.err, "ccsrm: " + unseen +
+                         ": /mocap/markers: has no finite sample (every position NaN or "
+                         "infinite): no marker was ever seen, so there is no pose to fit\n");
+    EXPECT_FALSE(fs::exists(out));
+    const Outcome inspect = RunCcsrm("dataset inspect " + unseen);
+    EXPECT_EQ(inspect.status, 2);
+    EXPECT_THAT(inspect.err, HasSubstr(unseen + ": /mocap/markers: has no finite sample"));
+  }
+
+  const std::string one = Variant(dir, "one", [](ccsrm::datasets::ExperimentFile* e) {
+    const std::size_t m = e->marker_names.size();
+    e->mocap_time = ccsrm::datasets::Array({1}, e->mocap_time.at(0));
+    ccsrm::datasets::Array markers({1, m, 3});
+    std::copy(e->mocap_markers.values.begin(), e->mocap_markers.values.begin() + m * 3,
+              markers.values.begin());
+    e->mocap_markers = markers;
+    e->measured_joint_angles.reset();
+    e->measured_link_pose.reset();
+    e->measured_joint_twist.reset();
+    e->mocap_quality.clear();
+    e->mocap_quality_units.clear();
+  });
+  const Outcome o = RunCcsrm("mocap process --quiet --in " + one + " --out " + out);
+  EXPECT_EQ(o.status, 2);
+  EXPECT_EQ(o.err, "ccsrm: " + one +
+                       ": /mocap/time: has 1 frame(s): processing needs at least 2 (a frame "
+                       "rate for the time base and the low-pass filter)\n");
+  const Outcome inspect = RunCcsrm("dataset inspect " + one);
+  EXPECT_EQ(inspect.status, 2);
+  EXPECT_THAT(inspect.err, HasSubstr(one + ": /mocap/time: has 1 frame: needs at least 2"));
+}
+
+}  // namespace

@@ -175,6 +175,29 @@ TEST(ExperimentFileRoundTrip, MeasuredLinkPoseAndTwistExtensionsRoundTrip) {
               AllOf(StartsWith(path + ": /measured/joint_twist: "), HasSubstr("expected J=2")));
 }
 
+// Issue 33: joint angles cut to fewer joints than the twist and the link poses
+// they were written with are the odd one out, and the message names them.
+TEST(ExperimentFileRead, AnglesCutToFewerJointsAreBlamedNotTheTwist) {
+  const fs::path dir = FreshDir("exp_cut_angles");
+  const std::string path = (dir / "exp.h5").string();
+  ExperimentFile experiment = MakeExperimentFile();
+  const std::size_t f = experiment.mocap_time.rows();
+  experiment.measured_joint_angles = Ramp({f, 3, 2}, 0.0);
+  experiment.measured_link_pose = Ramp({f, 3, 7}, 0.01);
+  experiment.measured_joint_twist = Ramp({f, 3}, 1e-4);
+  WriteExperimentFile(path, experiment);
+  ReplaceDataset(path, "/measured/joint_angles", Ramp({f, 2, 2}, 0.0), std::string("rad"));
+  EXPECT_THAT(InputErrorMessage([&] { ReadExperimentFile(path); }),
+              AllOf(StartsWith(path + ": /measured/joint_angles: has J=2 joints"),
+                    HasSubstr("/measured/joint_twist has 3"),
+                    HasSubstr("/measured/link_pose has 3 links")));
+  // Without link poses to tell, the angles are still the ones named.
+  experiment.measured_link_pose.reset();
+  experiment.measured_joint_angles = Ramp({f, 2, 2}, 0.0);
+  EXPECT_THAT(InputErrorMessage([&] { WriteExperimentFile(path, experiment); }),
+              StartsWith(path + ": /measured/joint_angles: has J=2 joints"));
+}
+
 // --- Rejection of bad files ------------------------------------------------------
 
 TEST(ExperimentFileRead, RejectsMissingMarkers) {

@@ -85,6 +85,43 @@ TEST(ExperimentLoading, RefusesInputsForAnotherArm) {
   }
 }
 
+// Issue 33: angles no universal joint can take (|θx| <= π, |θy| <= π/2 is
+// the range of the X–Y Cardan pair) are refused when the experiment is
+// loaded, not fitted to a "converged" RMS of 1e30 degrees; so are angles of
+// which none is finite.
+TEST(ExperimentLoading, RefusesMeasuredAnglesOutsideAUniversalJointsRange) {
+  const datasets::ExperimentFile recorded = Record(Nominal().parameters, 0.03, 1);
+  datasets::ExperimentFile file = recorded;
+  for (double& v : file.measured_joint_angles->values) v *= 1e30;
+  try {
+    MakeExperiment(file, "x.h5", {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("x.h5: /measured/joint_angles: frame index 0 (t = 0 s), "
+                                    "joint 1, θx = "));
+    EXPECT_THAT(e.what(), HasSubstr("outside the universal joint's range |θx| <= π"));
+  }
+  // Just past π/2 on θy is refused too; NaN (lost) is not a range error.
+  file = recorded;
+  file.measured_joint_angles->values[0] = std::nan("");
+  file.measured_joint_angles->values[2 * 3 + 1] = M_PI / 2 + 1e-9;
+  try {
+    MakeExperiment(file, "x.h5", {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("x.h5: /measured/joint_angles: frame index 0 (t = 0 s), "
+                                    "joint 4, θy = 1.5708 rad"));
+  }
+  file = recorded;
+  for (double& v : file.measured_joint_angles->values) v = std::nan("");
+  try {
+    MakeExperiment(file, "x.h5", {});
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("x.h5: /measured/joint_angles: has no finite value"));
+  }
+}
+
 TEST(IdentificationOptions, NameTheFieldOfEveryProblem) {
   std::string error;
   IdentificationOptions o;

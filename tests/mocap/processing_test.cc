@@ -326,5 +326,30 @@ TEST(ProcessMarkers, RejectsBadOptionsTimeBasesAndTablesWithoutLayoutMarkers) {
             std::string::npos);
 }
 
+// Issue 33: markers that were never seen (all NaN, or all infinite in an
+// HDF5 file) and a single frame are refused at this door, naming the file and
+// the field, instead of giving an experiment with no finite angle.
+TEST(ProcessMarkers, RefusesMarkersNeverSeenAndASingleFrame) {
+  using testing::InputErrorOf;
+  const MarkerLayout layout = DefaultMarkerLayout(PaperModel());
+  MarkerTable unseen = Record(layout, 10);
+  for (double& v : unseen.positions_m) v = kNaN;
+  EXPECT_EQ(InputErrorOf([&] { ProcessMarkers(unseen, {}, layout, Unfiltered(), "f.c3d"); }),
+            "f.c3d: marker data: has no finite sample (every position NaN or infinite): no "
+            "marker was ever seen, so there is no pose to fit");
+  unseen.format = "ccsrm-dataset";
+  EXPECT_EQ(InputErrorOf([&] {
+              ProcessMarkers(unseen, {}, layout, Unfiltered(), "e.h5");
+            }).rfind("e.h5: /mocap/markers: has no finite sample", 0),
+            0u);
+
+  MarkerTable one = Record(layout, 1);
+  one.rate_hz = 0.0;  // what a one-frame HDF5 file gives: no rate to derive
+  one.format = "ccsrm-dataset";
+  EXPECT_EQ(InputErrorOf([&] { ProcessMarkers(one, {0.5}, layout, Unfiltered(), "e.h5"); }),
+            "e.h5: /mocap/time: has 1 frame(s): processing needs at least 2 (a frame rate for "
+            "the time base and the low-pass filter)");
+}
+
 }  // namespace
 }  // namespace ccsrm::mocap

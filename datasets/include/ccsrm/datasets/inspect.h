@@ -64,6 +64,10 @@ FileKind KindOf(const AnyFile& file);
 // Throws InputError (one line naming the file) for a missing or bad file.
 FileSummary InspectFile(const std::string& path);
 
+// The summary of a file already read (by ReadAnyFile), for a caller that
+// checks it further before listing it; `path` is the file it was read from.
+FileSummary Summarise(const AnyFile& file, const std::string& path);
+
 // A readable listing with aligned columns, ending in a newline.
 std::string ToText(const FileSummary& summary);
 

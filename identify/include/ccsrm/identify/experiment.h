@@ -88,9 +88,11 @@ struct Experiment {
 // settings (mocap::AddMeasuredJointAngles); angles_from_pipeline says so.
 // Throws InputError
 // "<path>: <field>: <problem>" for an experiment that cannot be identified:
-// no inputs, inputs for another number of cables than the arm has, no
-// config_yaml, no mocap frame at or after the first input sample, measured
-// angles of another number of joints, or no finite measured angle.
+// what sim_io::CheckExperimentAgainstConfig refuses (a config_yaml that does
+// not parse, inputs for another number of cables than the arm has, measured
+// angles of another number of joints, none finite, or outside a universal
+// joint's range), no inputs, no config_yaml, no mocap frame at or after the
+// first input sample, or no finite measured angle after it.
 Experiment MakeExperiment(const datasets::ExperimentFile& file, const std::string& path,
                           const ExperimentLoadOptions& options);
 

@@ -173,9 +173,10 @@ Eigen::Isometry3d FitRigidTransform(const std::vector<Eigen::Vector3d>& from,
 // empty = frame i at i / table.rate_hz). `chain` (may be null: every link is
 // then fitted on its own) gives the joint positions for the joint-constrained
 // fit; it must cover every link of the layout. `source` names the input in
-// errors. Throws InputError for invalid options, a bad time base, a layout
-// that does not validate, a chain shorter than the layout's links, or no
-// layout marker in the table. Lost frames and missing markers are numerical
+// errors. Throws InputError for fewer than 2 frames, a table without any
+// finite marker sample (all NaN or infinite), invalid options, a bad time
+// base, a layout that does not validate, a chain shorter than the layout's
+// links, or no layout marker in the table. Lost frames and missing markers are numerical
 // outcomes: NaN in the result, counted in the summary.
 ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<double>& time,
                                 const MarkerLayout& layout, const ProcessingOptions& options,

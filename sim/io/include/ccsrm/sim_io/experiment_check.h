@@ -1,0 +1,43 @@
+#pragma once
+// The one check of an experiment against what the rest of the pipeline needs
+// (the arm of its own config_yaml, the physical range of a universal joint),
+// applied at every door an experiment comes through: `ccsrm dataset
+// inspect`, `ccsrm mocap process` before it writes, and identification when
+// it loads one. It lives with the file converters because it needs both the
+// experiment schema (datasets) and the arm (sim).
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "ccsrm/datasets/experiment_file.h"
+#include "ccsrm/sim/config.h"
+#include "ccsrm/sim/model.h"
+
+namespace ccsrm::sim_io {
+
+// The arm an experiment's config_yaml describes, parsed once.
+struct ExperimentArm {
+  sim::Config config;
+  std::shared_ptr<const sim::ArmModel> model;
+};
+
+// Checks that `experiment` is a consistent ccsrm-dataset/1 record
+// (datasets::ValidateExperimentFile) and that it holds what simulation, mocap
+// processing and identification will need:
+//  - /mocap/time has at least 2 frames (a frame rate, a motion);
+//  - /mocap/markers, when it holds any value, holds a finite one;
+//  - config_yaml, when not empty, parses (sim::ParseConfig), and then
+//    /input/length_change has either no cable column (no actuator record) or
+//    one per driving cable of that arm, and /measured/joint_angles (when
+//    present) is F × J × 2 with J the arm's joints;
+//  - /measured/joint_angles (when present) holds at least one finite value,
+//    and every value is NaN (lost) or within the mathematical range of the
+//    X–Y Cardan pair of a universal joint: |θx| <= π, |θy| <= π/2 rad.
+// `file` names the experiment in messages. Returns the arm, or nullopt when
+// config_yaml is empty (nothing to check the shapes against; a caller that
+// needs the arm says so). Throws InputError "<file>: <path>: <problem>" on
+// the first problem.
+std::optional<ExperimentArm> CheckExperimentAgainstConfig(
+    const datasets::ExperimentFile& experiment, const std::string& file);
+
+}  // namespace ccsrm::sim_io
