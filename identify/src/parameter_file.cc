@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/yaml_document.h"
 #include "ccsrm/identify/identification.h"
 
 namespace ccsrm::identify {
@@ -22,12 +23,7 @@ double Number(const YAML::Node& node, const std::string& file, const std::string
 
 void ApplyParameterFile(const std::string& yaml_text, const std::string& file,
                         IdentificationOptions* options) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    ThrowInputError(file, "line " + std::to_string(e.mark.line + 1), "not valid YAML: " + e.msg);
-  }
+  YAML::Node root = ParseYamlDocument(yaml_text, file);
   std::string prefix;
   if (root.IsMap() && root["parameters"]) {  // a truth file of ccsrm generate
     root = root["parameters"];

@@ -11,6 +11,7 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/yaml_document.h"
 #include "ccsrm/sim/effects.h"
 #include "effects/effects_yaml.h"
 
@@ -427,13 +428,7 @@ int ArmConfig::segment_of_link(int link) const {
 }
 
 Config ParseConfig(const std::string& yaml_text, const std::string& source_name) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    ThrowInputError(source_name, "line " + std::to_string(e.mark.line + 1),
-                    "YAML syntax error: " + e.msg);
-  }
+  const YAML::Node root = ParseYamlDocument(yaml_text, source_name);
   if (!root.IsMap()) ThrowInputError(source_name, "", "expected a YAML mapping at the top level");
 
   LineMap lines;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/yaml_document.h"
 #include "ccsrm/sim/effects.h"
 #include "effects/effect.h"
 #include "effects/effects_yaml.h"
@@ -229,12 +230,7 @@ std::pair<std::string, double> ParseParameterAssignment(const std::string& text,
 std::vector<std::pair<std::string, double>> ApplyParameterYaml(const std::string& yaml_text,
                                                                const std::string& file,
                                                                ArmParameters* parameters) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    ThrowInputError(file, "line " + std::to_string(e.mark.line + 1), "not valid YAML: " + e.msg);
-  }
+  YAML::Node root = ParseYamlDocument(yaml_text, file);
   // A truth file (`ccsrm generate`) keeps the values under `parameters:`
   // beside its other records; a plain file is the mapping itself.
   std::string prefix;

@@ -150,6 +150,16 @@ TEST(ParameterFile, NamesLineAndKeyOfABadEntryAndChangesNothing) {
   }
 }
 
+TEST(ParameterFile, DuplicateKeyNamesBothLines) {
+  IdentificationOptions o;
+  try {
+    ApplyParameterFile("mu: 0.2\nT_p:\n  value: 60\n  value: 70\n", "p.yaml", &o);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "p.yaml: line 4, key 'T_p.value': duplicate key (first at line 3)");
+  }
+}
+
 TEST(Identification, RefusesAStartOutsideItsBoundsBeforeAnyRun) {
   auto backend = std::make_shared<CountingBackend>();
   IdentificationOptions o;

@@ -169,6 +169,24 @@ TEST(Config, KeysAddedLaterMayBeLeftOutAndMeanThePapersLaw) {
                                        "connecting_cables.stribeck_velocity_mps"));
 }
 
+TEST(Config, DuplicateKeyNamesBothLines) {
+  // yaml-cpp keeps the first of two equal keys: the second mass would be
+  // ignored without a word.
+  const std::string first = "      link_mass_kg: 0.095\n";
+  std::string text = PaperText();
+  const std::string hole = "      hole_circle_radius_m: 0.021\n";
+  text.insert(text.find(hole) + hole.size(), "      link_mass_kg: 0.2\n");
+  EXPECT_EQ(ErrorOf(text),
+            "bad.yaml: line " + std::to_string(LineOf(text, hole) + 1) +
+                ", key 'arm.segments[0].link_mass_kg': duplicate key (first at line " +
+                std::to_string(LineOf(text, first)) + ")");
+  // A second section at the top level.
+  std::string sections = PaperText() + "solver:\n  relative_tolerance: 1e-3\n";
+  EXPECT_THAT(ErrorOf(sections),
+              HasSubstr("key 'solver': duplicate key (first at line " +
+                        std::to_string(LineOf(sections, "\nsolver:") + 1) + ")"));
+}
+
 TEST(Config, ValidateRejectsConfigBuiltInCode) {
   Config c = LoadConfig(kPaperConfig);
   c.arm.segments[0].link_length_m = 0.0;

@@ -127,5 +127,16 @@ TEST(Parameters, YamlFileFlatOrTruthStyleWithLineAndKeyInErrors) {
               HasSubstr("p.yaml: expected a mapping"));
 }
 
+TEST(Parameters, YamlFileWithADuplicateKeyNamesBothLines) {
+  // yaml-cpp keeps the first 'mu' and would drop the second without a word.
+  ArmParameters c = Paper().parameters;
+  EXPECT_EQ(ErrorOf([&] { ApplyParameterYaml("mu: 0.1\nc_sc: 0.2\nmu: 0.3\n", "p.yaml", &c); }),
+            "p.yaml: line 3, key 'mu': duplicate key (first at line 1)");
+  EXPECT_EQ(
+      ErrorOf([&] { ApplyParameterYaml("parameters:\n  T_p: 40\n  T_p: 45\n", "t.yaml", &c); }),
+      "t.yaml: line 3, key 'parameters.T_p': duplicate key (first at line 2)");
+  EXPECT_EQ(c.mu, Paper().parameters.mu);  // unchanged
+}
+
 }  // namespace
 }  // namespace ccsrm::sim

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/yaml_document.h"
 #include "ccsrm/sim/kinematics.h"
 #include "effect.h"
 #include "effects_yaml.h"
@@ -164,12 +165,7 @@ std::string ApplyEffectSpec(const std::string& text, const std::string& where,
 
 void ApplyEffectsYaml(const std::string& yaml_text, const std::string& file,
                       ArmParameters* parameters) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    ThrowInputError(file, "line " + std::to_string(e.mark.line + 1), "not valid YAML: " + e.msg);
-  }
+  YAML::Node root = ParseYamlDocument(yaml_text, file);
   std::string prefix;
   if (root.IsMap() && root["effects"]) {
     root = root["effects"];
