@@ -5,6 +5,7 @@
 #include <string>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/number_text.h"
 
 namespace ccsrm {
 namespace {
@@ -60,6 +61,17 @@ YAML::Node ParseYamlDocument(const std::string& text, const std::string& file) {
   }
   DuplicateKeyCheck(file).Walk(root, "");
   return root;
+}
+
+double ReadYamlNumber(const YAML::Node& node, const std::string& file, const std::string& where) {
+  if (!node.IsScalar()) ThrowInputError(file, where, "expected a number");
+  double value = 0.0;
+  const std::string problem = ParseNumberText(node.Scalar(), &value);
+  if (problem == kNotANumber) {
+    ThrowInputError(file, where, "expected a number, found '" + node.Scalar() + "'");
+  }
+  if (!problem.empty()) ThrowInputError(file, where, "'" + node.Scalar() + "' " + problem);
+  return value;
 }
 
 }  // namespace ccsrm

@@ -11,12 +11,7 @@ namespace ccsrm::identify {
 namespace {
 
 double Number(const YAML::Node& node, const std::string& file, const std::string& where) {
-  try {
-    if (!node.IsScalar()) throw YAML::Exception(node.Mark(), "not a scalar");
-    return node.as<double>();
-  } catch (const YAML::Exception&) {
-    ThrowInputError(file, where, "expected a number");
-  }
+  return ReadYamlNumber(node, file, where);
 }
 
 }  // namespace

@@ -231,14 +231,8 @@ class MapReader {
   }
 
   double AsNumber(const YAML::Node& node, const std::string& key) const {
-    if (!node.IsScalar()) Fail(key, node, "expected a number");
-    double value = 0.0;
-    std::istringstream in(node.Scalar());
-    in.imbue(std::locale::classic());
-    in >> value;
-    if (in.fail() || !in.eof()) Fail(key, node, "expected a number, found '" + node.Scalar() + "'");
-    if (!std::isfinite(value)) Fail(key, node, "must be finite");
-    return value;
+    return ReadYamlNumber(node, file_,
+                          "line " + std::to_string(node.Mark().line + 1) + ", key '" + key + "'");
   }
 
   std::string Allowed() const {

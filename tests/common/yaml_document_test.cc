@@ -6,6 +6,7 @@
 #include <string>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/number_text.h"
 
 namespace ccsrm {
 namespace {
@@ -75,6 +76,44 @@ TEST(ParseYamlDocument, ReportsASyntaxErrorWithItsLine) {
 TEST(ParseYamlDocument, AcceptsEmptyAndScalarDocuments) {
   EXPECT_TRUE(ParseYamlDocument("", "f.yaml").IsNull());
   EXPECT_EQ(ParseYamlDocument("42", "f.yaml").as<int>(), 42);
+}
+
+TEST(ParseNumberText, ReadsFiniteDoublesAndNamesWhatElseIsWrong) {
+  double value = -1.0;
+  EXPECT_EQ(ParseNumberText("2.6e10", &value), "");
+  EXPECT_EQ(value, 2.6e10);
+  EXPECT_EQ(ParseNumberText("0", &value), "");
+  EXPECT_EQ(value, 0.0);
+  EXPECT_EQ(ParseNumberText("1e-300", &value), "");  // small but a normal double
+  EXPECT_EQ(ParseNumberText("0.1x", &value), kNotANumber);
+  EXPECT_EQ(ParseNumberText("", &value), kNotANumber);
+  EXPECT_EQ(ParseNumberText(" 1", &value), kNotANumber);
+  EXPECT_EQ(ParseNumberText("1e400", &value),
+            "is outside the range of a double (magnitude above 1.8e+308)");
+  EXPECT_EQ(ParseNumberText("-1e400", &value),
+            "is outside the range of a double (magnitude above 1.8e+308)");
+  EXPECT_EQ(ParseNumberText("1e-400", &value),
+            "underflows: it is nearer 0 than a double can hold (2.2e-308); write 0 if 0 is meant");
+  for (const char* text : {"nan", "inf", "-inf", ".nan", ".inf", "-.inf", ".NaN"}) {
+    EXPECT_EQ(ParseNumberText(text, &value), "is not a finite number") << text;
+  }
+  EXPECT_EQ(value, 1e-300);  // untouched by the failures
+}
+
+TEST(ReadYamlNumber, NamesTheFieldAndTheText) {
+  const YAML::Node root = ParseYamlDocument("a: 1.5\nb: heavy\nc: [1]\nd: 1e999\n", "f.yaml");
+  EXPECT_EQ(ReadYamlNumber(root["a"], "f.yaml", "key 'a'"), 1.5);
+  const auto error = [&](const char* key) {
+    try {
+      ReadYamlNumber(root[key], "f.yaml", std::string("key '") + key + "'");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error("b"), "f.yaml: key 'b': expected a number, found 'heavy'");
+  EXPECT_EQ(error("c"), "f.yaml: key 'c': expected a number");
+  EXPECT_THAT(error("d"), HasSubstr("f.yaml: key 'd': '1e999' is outside the range of a double"));
 }
 
 }  // namespace

@@ -187,6 +187,19 @@ TEST(Config, DuplicateKeyNamesBothLines) {
                         std::to_string(LineOf(sections, "\nsolver:") + 1) + ")"));
 }
 
+TEST(Config, NonFiniteAndUnrepresentableNumbersAreRefused) {
+  EXPECT_THAT(ErrorOf(Edited("link_mass_kg: 0.095", "link_mass_kg: .nan")),
+              HasSubstr("key 'arm.segments[0].link_mass_kg': '.nan' is not a finite number"));
+  EXPECT_THAT(ErrorOf(Edited("youngs_modulus_pa: 2.6e10", "youngs_modulus_pa: .inf")),
+              HasSubstr("key 'driving_cables.youngs_modulus_pa': '.inf' is not a finite number"));
+  EXPECT_THAT(ErrorOf(Edited("ramp_s: 20.0", "ramp_s: -.inf")),
+              HasSubstr("key 'protocol.ramp_s': '-.inf' is not a finite number"));
+  EXPECT_THAT(ErrorOf(Edited("youngs_modulus_pa: 2.6e10", "youngs_modulus_pa: 1e400")),
+              HasSubstr("'1e400' is outside the range of a double"));
+  EXPECT_THAT(ErrorOf(Edited("cross_section_m2: 1.3273e-6", "cross_section_m2: 1e-400")),
+              HasSubstr("key 'driving_cables.cross_section_m2': '1e-400' underflows"));
+}
+
 TEST(Config, ValidateRejectsConfigBuiltInCode) {
   Config c = LoadConfig(kPaperConfig);
   c.arm.segments[0].link_length_m = 0.0;

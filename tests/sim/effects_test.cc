@@ -194,6 +194,8 @@ TEST(EffectParameters, BadEffectInputGetsOneLineNamingWhere) {
               HasSubstr("expected param=value"));
   EXPECT_THAT(ErrorOf([&] { ApplyEffectSpec("backlash:dead_band_rad=x", "--effect", &p); }),
               HasSubstr("is not a number"));
+  EXPECT_THAT(ErrorOf([&] { ApplyEffectSpec("backlash:dead_band_rad=1e-400", "--effect", &p); }),
+              HasSubstr("value '1e-400' of dead_band_rad underflows"));
   EXPECT_EQ(ErrorOf([&] {
               ApplyEffectsYaml("backlash: {dead_band_rad: 0.01, dead_band_rad: 0.02}\n", "fx.yaml",
                                &p);

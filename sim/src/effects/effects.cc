@@ -2,11 +2,11 @@
 // and what motion capture records (ccsrm/sim/effects.h).
 #include "ccsrm/sim/effects.h"
 
-#include <cerrno>
 #include <cstdlib>
 #include <memory>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/number_text.h"
 #include "ccsrm/common/yaml_document.h"
 #include "ccsrm/sim/kinematics.h"
 #include "effect.h"
@@ -29,14 +29,6 @@ const ParameterInfo* EffectParameterInfo(const std::string& effect, const std::s
     if (p.effect == effect && p.short_name == short_name) return &p;
   }
   return nullptr;
-}
-
-double ParseNumber(const std::string& text, bool* ok) {
-  errno = 0;
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  *ok = !text.empty() && end == text.c_str() + text.size() && errno != ERANGE;
-  return value;
 }
 
 }  // namespace
@@ -80,15 +72,7 @@ void ApplyEffectsNode(const YAML::Node& node, const std::string& file,
                         "unknown parameter of " + effect +
                             " (known: " + ParameterList(FindEffect(effect, file)) + ")");
       }
-      double value = 0.0;
-      try {
-        if (!value_entry.second.IsScalar()) {
-          throw YAML::Exception(value_entry.second.Mark(), "not a scalar");
-        }
-        value = value_entry.second.as<double>();
-      } catch (const YAML::Exception&) {
-        ThrowInputError(file, value_where, "expected a number");
-      }
+      const double value = ReadYamlNumber(value_entry.second, file, value_where);
       const std::string problem = ParameterValueProblem(*info, value);
       if (!problem.empty()) ThrowInputError(file, value_where, problem);
       SetParameter(info->name, value, file, &updated);
@@ -149,11 +133,11 @@ std::string ApplyEffectSpec(const std::string& text, const std::string& where,
                       "unknown parameter '" + name + "' of " + effect +
                           " (known: " + ParameterList(info) + ")");
     }
-    bool ok = false;
-    const double value = ParseNumber(item.substr(equals + 1), &ok);
-    if (!ok) {
+    double value = 0.0;
+    const std::string problem = ParseNumberText(item.substr(equals + 1), &value);
+    if (!problem.empty()) {
       ThrowInputError(where, "'" + text + "'",
-                      "value '" + item.substr(equals + 1) + "' of " + name + " is not a number");
+                      "value '" + item.substr(equals + 1) + "' of " + name + " " + problem);
     }
     SetParameter(p->name, value, where, &updated);
     if (comma == std::string::npos) break;

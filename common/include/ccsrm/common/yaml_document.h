@@ -18,4 +18,11 @@ namespace ccsrm {
 // sequence items from 0 as [i].
 YAML::Node ParseYamlDocument(const std::string& text, const std::string& file);
 
+// The finite number a scalar node holds (ParseNumberText). `where` names the
+// field in the message ("line N, key 'a.b'"). Throws InputError
+// "<file>: <where>: expected a number, found 'heavy'" (or "expected a
+// number" for a list or mapping), "...: '1e400' is outside the range of a
+// double ...", "...: '.nan' is not a finite number".
+double ReadYamlNumber(const YAML::Node& node, const std::string& file, const std::string& where);
+
 }  // namespace ccsrm
