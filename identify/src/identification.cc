@@ -732,10 +732,19 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     }
     f.start = sim::GetParameter(base.front(), name);
     if (f.start < f.lower || f.start > f.upper) {
-      char text[256];
-      std::snprintf(text, sizeof(text), "start value %g is outside the bounds [%g, %g] %s", f.start,
-                    f.lower, f.upper, info.units.c_str());
-      ThrowInputError("parameter '" + name + "'", "", text);
+      // Name where the start came from: a value given for the fit (--set,
+      // --params), else the first experiment's configuration.
+      const bool given = options.values.count(name) != 0;
+      char text[320];
+      std::snprintf(text, sizeof(text), "start value %g is outside the bounds [%g, %g] %s%s",
+                    f.start, f.lower, f.upper, info.units.c_str(),
+                    given ? ""
+                          : "; the start is this experiment's configured value: give one "
+                            "inside (--set or --params)");
+      const std::string& path = experiments.front().path;
+      ThrowInputError(given ? "the values given (--set, --params)"
+                            : (path.empty() ? "the first experiment" : path),
+                      "parameter '" + name + "'", text);
     }
     const double nominal = sim::GetParameter(experiments.front().config.parameters, name);
     f.scale = f.start != 0.0   ? std::abs(f.start)

@@ -2,32 +2,24 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cstdio>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/yaml_document.h"
 #include "ccsrm/identify/identification.h"
 
 namespace ccsrm::identify {
 namespace {
 
 double Number(const YAML::Node& node, const std::string& file, const std::string& where) {
-  try {
-    if (!node.IsScalar()) throw YAML::Exception(node.Mark(), "not a scalar");
-    return node.as<double>();
-  } catch (const YAML::Exception&) {
-    ThrowInputError(file, where, "expected a number");
-  }
+  return ReadYamlNumber(node, file, where);
 }
 
 }  // namespace
 
 void ApplyParameterFile(const std::string& yaml_text, const std::string& file,
                         IdentificationOptions* options) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    ThrowInputError(file, "line " + std::to_string(e.mark.line + 1), "not valid YAML: " + e.msg);
-  }
+  YAML::Node root = ParseYamlDocument(yaml_text, file);
   std::string prefix;
   if (root.IsMap() && root["parameters"]) {  // a truth file of ccsrm generate
     root = root["parameters"];
@@ -67,12 +59,15 @@ void ApplyParameterFile(const std::string& yaml_text, const std::string& file,
     if (!entry.second.IsMap()) {
       ThrowInputError(file, where, "expected a number or a mapping {value, free, bounds}");
     }
+    std::string value_at;   // where this entry gives the start value, if it does
+    std::string bounds_at;  // where it gives bounds, if it does
     for (const auto& field : entry.second) {
       const std::string key = field.first.as<std::string>();
       const std::string at = "line " + std::to_string(field.first.Mark().line + 1) + ", key '" +
                              prefix + name + "." + key + "'";
       if (key == "value" || key == "start") {
         set_value(Number(field.second, file, at), at);
+        value_at = at;
       } else if (key == "free") {
         bool free = false;
         try {
@@ -98,8 +93,22 @@ void ApplyParameterFile(const std::string& yaml_text, const std::string& file,
           ThrowInputError(file, at, text);
         }
         updated.bounds[name] = {lower, upper};
+        bounds_at = at;
       } else {
         ThrowInputError(file, at, "unknown field (known: value, free, bounds)");
+      }
+    }
+    // The start must lie inside the bounds given with it (Identify checks
+    // a start taken from the experiment, which this file does not know).
+    const auto value = updated.values.find(name);
+    if (!bounds_at.empty() && value != updated.values.end()) {
+      const auto [lower, upper] = updated.bounds.at(name);
+      if (value->second < lower || value->second > upper) {
+        char text[256];
+        std::snprintf(text, sizeof(text), "start value %g is outside the bounds [%g, %g] %s%s",
+                      value->second, lower, upper, info->units.c_str(),
+                      value_at.empty() ? " (the start was set before this file)" : "");
+        ThrowInputError(file, value_at.empty() ? bounds_at : value_at, text);
       }
     }
   }

@@ -12,6 +12,7 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/yaml_document.h"
 #include "ccsrm/mocap/processing.h"
 #include "ccsrm/sim/kinematics.h"
 
@@ -137,12 +138,7 @@ void ValidateMarkerLayout(const MarkerLayout& layout, const std::string& source)
 }
 
 MarkerLayout ParseRigidBodies(const std::string& yaml_text, const std::string& file) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    ThrowInputError(file, "line " + std::to_string(e.mark.line + 1), "not valid YAML: " + e.msg);
-  }
+  YAML::Node root = ParseYamlDocument(yaml_text, file);
   if (!root.IsMap()) ThrowInputError(file, "", "expected a mapping with 'schema' and 'bodies'");
   ExpectKeys(file, root, "", {"schema", "bodies"});
   const YAML::Node schema = Require(file, root, "", "schema");

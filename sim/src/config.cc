@@ -11,6 +11,7 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/yaml_document.h"
 #include "ccsrm/sim/effects.h"
 #include "effects/effects_yaml.h"
 
@@ -230,14 +231,8 @@ class MapReader {
   }
 
   double AsNumber(const YAML::Node& node, const std::string& key) const {
-    if (!node.IsScalar()) Fail(key, node, "expected a number");
-    double value = 0.0;
-    std::istringstream in(node.Scalar());
-    in.imbue(std::locale::classic());
-    in >> value;
-    if (in.fail() || !in.eof()) Fail(key, node, "expected a number, found '" + node.Scalar() + "'");
-    if (!std::isfinite(value)) Fail(key, node, "must be finite");
-    return value;
+    return ReadYamlNumber(node, file_,
+                          "line " + std::to_string(node.Mark().line + 1) + ", key '" + key + "'");
   }
 
   std::string Allowed() const {
@@ -286,9 +281,11 @@ class Checker {
   void NonNegative(const std::string& key, double value) const {
     if (!(value >= 0.0)) Fail(key, "must be >= 0, found " + Format(value));
   }
-  void InRange(const std::string& key, double value, double lo, double hi) const {
+  void InRange(const std::string& key, double value, double lo, double hi,
+               const std::string& unit = "") const {
     if (!(value >= lo && value <= hi)) {
-      Fail(key, "must be in [" + Format(lo) + ", " + Format(hi) + "], found " + Format(value));
+      Fail(key, "must be in [" + Format(lo) + ", " + Format(hi) + "]" +
+                    (unit.empty() ? "" : " " + unit) + ", found " + Format(value));
     }
   }
   [[noreturn]] void Fail(const std::string& key, const std::string& what) const {
@@ -353,6 +350,83 @@ void CheckArm(const ArmConfig& arm, const Checker& check) {
   check.Positive("connecting_cables.cross_section_m2", cc.cross_section_m2);
 }
 
+// What any real arm of this kind has, from a bench-top arm of a few
+// centimetres to a metre-scale one, with steel to polymer cables. Generous:
+// they do not judge a design, they refuse what no arm has (1e300, a slipped
+// exponent) before a run diverges on it. The model itself (ArmModel,
+// CheckArm) needs only positive values, so a test may build an arm beyond
+// these on purpose.
+struct PhysicalRange {
+  double lower;
+  double upper;
+  const char* unit;
+};
+// Cable materials: none stiffer than diamond (~1.2e12 Pa), none softer than
+// rubber (~1e6 Pa); steel wire rope is ~1e11, the paper's effective 2.6e10.
+constexpr PhysicalRange kYoungsModulus{1e6, 2e12, "Pa"};
+// Load-bearing cross section: from a 0.01 mm fibre (~1e-10 m^2) to a 35 mm
+// rope (1e-3 m^2), far thicker than the cables of a metre-scale arm.
+constexpr PhysicalRange kCrossSection{1e-10, 1e-3, "m^2"};
+// Cable material density: polyethylene fibre (~970 kg/m^3, the lightest
+// cable material) floats on water, so 500 is below any; nothing is denser
+// than osmium (~2.26e4 kg/m^3).
+constexpr PhysicalRange kDensity{500.0, 2.5e4, "kg/m^3"};
+// A link carries two disk halves and a joint: shorter than 1 mm it cannot;
+// a metre-scale arm's links are 0.1-0.5 m, so 2 m is beyond any.
+constexpr PhysicalRange kLinkLength{1e-3, 2.0, "m"};
+// From a 0.1 g printed millimetre link to 100 kg (a metre-scale steel link
+// weighs a few kg).
+constexpr PhysicalRange kLinkMass{1e-4, 100.0, "kg"};
+// Principal inertia: 0.1 g at 0.1 mm from the axis (m r^2 = 1e-12) up to
+// 100 kg spread over 2 m (m L^2 / 12 ~ 33).
+constexpr PhysicalRange kLinkInertia{1e-12, 100.0, "kg m^2"};
+// Radii on the disks (hole circle, pulleys) and the gap between the two
+// disks of a joint: from 0.1 mm (a catheter-sized arm) to 1 m (wider than
+// any disk of a metre-scale arm).
+constexpr PhysicalRange kDiskSize{1e-4, 1.0, "m"};
+// A connecting cable spans one joint to the next, about a link length
+// (< 2 m) plus its wraps: 5 m is beyond any, 1 mm below any.
+constexpr PhysicalRange kConnectingCableLength{1e-3, 5.0, "m"};
+// The input point lies behind the ground disk on the way to the actuator;
+// even a remote actuator pack sits within 10 m of cable.
+constexpr PhysicalRange kInputOffset{1e-4, 10.0, "m"};
+// |g|: 0 (a level air table, as in the paper) to 3 g (29.4 m/s^2), room for
+// any planet's bench or a base that accelerates.
+constexpr PhysicalRange kGravity{0.0, 30.0, "m/s^2"};
+
+void CheckArmRanges(const ArmConfig& arm, const Checker& check) {
+  const auto in = [&](const std::string& key, double value, const PhysicalRange& range) {
+    check.InRange(key, value, range.lower, range.upper, range.unit);
+  };
+  in("arm.joint_disk_gap_m", arm.joint_disk_gap_m, kDiskSize);
+  const double g = arm.gravity_mps2.norm();
+  if (!(g >= kGravity.lower && g <= kGravity.upper)) {
+    std::ostringstream what;
+    what << "magnitude must be in [" << kGravity.lower << ", " << kGravity.upper << "] "
+         << kGravity.unit << ", found " << g;
+    check.Fail("arm.gravity_mps2", what.str());
+  }
+  for (std::size_t i = 0; i < arm.segments.size(); ++i) {
+    const SegmentConfig& s = arm.segments[i];
+    const std::string p = "arm.segments[" + std::to_string(i) + "].";
+    in(p + "link_length_m", s.link_length_m, kLinkLength);
+    in(p + "link_mass_kg", s.link_mass_kg, kLinkMass);
+    for (int k = 0; k < 3; ++k) in(p + "link_inertia_kgm2", s.link_inertia_kgm2[k], kLinkInertia);
+    in(p + "hole_circle_radius_m", s.hole_circle_radius_m, kDiskSize);
+    in(p + "small_s.cable_length_m", s.small_s.cable_length_m, kConnectingCableLength);
+    in(p + "small_s.pulley_radius_m", s.small_s.pulley_radius_m, kDiskSize);
+    in(p + "large_s.cable_length_m", s.large_s.cable_length_m, kConnectingCableLength);
+    in(p + "large_s.pulley_radius_m", s.large_s.pulley_radius_m, kDiskSize);
+  }
+  const DrivingCableConfig& d = arm.driving;
+  in("driving_cables.youngs_modulus_pa", d.youngs_modulus_pa, kYoungsModulus);
+  in("driving_cables.cross_section_m2", d.cross_section_m2, kCrossSection);
+  in("driving_cables.density_kgpm3", d.density_kgpm3, kDensity);
+  in("driving_cables.input_offset_m", d.input_offset_m, kInputOffset);
+  in("connecting_cables.youngs_modulus_pa", arm.connecting.youngs_modulus_pa, kYoungsModulus);
+  in("connecting_cables.cross_section_m2", arm.connecting.cross_section_m2, kCrossSection);
+}
+
 void CheckSolver(const SolverConfig& s, const Checker& check) {
   check.NonNegative("solver.baumgarte_alpha_per_s", s.baumgarte_alpha_per_s);
   check.NonNegative("solver.baumgarte_beta_per_s2", s.baumgarte_beta_per_s2);
@@ -384,6 +458,7 @@ void CheckProtocol(const ProtocolConfig& pr, const Checker& check);
 void ValidateWithLines(const Config& c, const LineMap* lines) {
   const Checker check(c.source_name, lines);
   CheckArm(c.arm, check);
+  CheckArmRanges(c.arm, check);
   // The identifiable parameters: the same table and message as --set and --params.
   for (const ParameterInfo& p : Parameters()) {
     const std::string problem = ParameterValueProblem(p, c.parameters.*p.field);
@@ -427,13 +502,7 @@ int ArmConfig::segment_of_link(int link) const {
 }
 
 Config ParseConfig(const std::string& yaml_text, const std::string& source_name) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    ThrowInputError(source_name, "line " + std::to_string(e.mark.line + 1),
-                    "YAML syntax error: " + e.msg);
-  }
+  const YAML::Node root = ParseYamlDocument(yaml_text, source_name);
   if (!root.IsMap()) ThrowInputError(source_name, "", "expected a YAML mapping at the top level");
 
   LineMap lines;

@@ -2,13 +2,14 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/number_text.h"
+#include "ccsrm/common/yaml_document.h"
 #include "ccsrm/sim/effects.h"
 #include "effects/effect.h"
 #include "effects/effects_yaml.h"
@@ -217,11 +218,10 @@ std::pair<std::string, double> ParseParameterAssignment(const std::string& text,
   const std::string name = text.substr(0, equals);
   const std::string value_text = text.substr(equals + 1);
   FindParameter(name, where);
-  errno = 0;
-  char* end = nullptr;
-  const double value = std::strtod(value_text.c_str(), &end);
-  if (value_text.empty() || end != value_text.c_str() + value_text.size() || errno == ERANGE) {
-    ThrowInputError(where, "'" + text + "'", "value '" + value_text + "' is not a number");
+  double value = 0.0;
+  const std::string problem = ParseNumberText(value_text, &value);
+  if (!problem.empty()) {
+    ThrowInputError(where, "'" + text + "'", "value '" + value_text + "' " + problem);
   }
   return {name, value};
 }
@@ -229,12 +229,7 @@ std::pair<std::string, double> ParseParameterAssignment(const std::string& text,
 std::vector<std::pair<std::string, double>> ApplyParameterYaml(const std::string& yaml_text,
                                                                const std::string& file,
                                                                ArmParameters* parameters) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    ThrowInputError(file, "line " + std::to_string(e.mark.line + 1), "not valid YAML: " + e.msg);
-  }
+  YAML::Node root = ParseYamlDocument(yaml_text, file);
   // A truth file (`ccsrm generate`) keeps the values under `parameters:`
   // beside its other records; a plain file is the mapping itself.
   std::string prefix;
@@ -262,13 +257,7 @@ std::vector<std::pair<std::string, double>> ApplyParameterYaml(const std::string
     if (info == nullptr) {
       ThrowInputError(file, where, "unknown parameter (known: " + KnownNamesFor(key) + ")");
     }
-    double value = 0.0;
-    try {
-      if (!entry.second.IsScalar()) throw YAML::Exception(entry.second.Mark(), "not a scalar");
-      value = entry.second.as<double>();
-    } catch (const YAML::Exception&) {
-      ThrowInputError(file, where, "expected a number");
-    }
+    const double value = ReadYamlNumber(entry.second, file, where);
     const std::string problem = ParameterValueProblem(*info, value);
     if (!problem.empty()) ThrowInputError(file, where, problem);
     SetParameter(key, value, file, &updated);

@@ -191,7 +191,9 @@ TEST(IdentifyCommand, BadInputExitsWithOneLineBeforeAnySimulation) {
       {"--data /nonexistent.h5", "/nonexistent.h5"},
       {"--data " + truncated, truncated},
       {"--data " + exp + " --free mu,friction", "unknown parameter 'friction'"},
-      {"--data " + exp + " --free T_p --params " + params, "start value 50 is outside the bounds"},
+      // The start (50 N) is the experiment's own value: its file is named.
+      {"--data " + exp + " --free T_p --params " + params,
+       exp + ": parameter 'T_p': start value 50 is outside the bounds"},
       {"--data " + exp + " --set beta=3", "parameter 'beta' = 3 is outside"},
       {"--data " + exp + " --threads 0", "--threads"},
   };

@@ -187,6 +187,46 @@ TEST(ParameterFile, NamesLineAndKeyOfABadEntryAndChangesNothing) {
   }
 }
 
+TEST(ParameterFile, StartOutsideItsBoundsNamesTheFileAndKey) {
+  const struct {
+    std::string text, message;
+  } cases[] = {
+      {"T_p: {value: 50, free: true, bounds: [60, 80]}\n",
+       "p.yaml: line 1, key 'T_p.value': start value 50 is outside the bounds [60, 80] N"},
+      {"mu: 0.2\nT_p:\n  free: true\n  bounds: [20, 40]\n  value: 45\n",
+       "p.yaml: line 5, key 'T_p.value': start value 45 is outside the bounds [20, 40] N"},
+  };
+  for (const auto& c : cases) {
+    IdentificationOptions o;
+    try {
+      ApplyParameterFile(c.text, "p.yaml", &o);
+      ADD_FAILURE() << "no error for " << c.text;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.what(), c.message) << c.text;
+    }
+    EXPECT_TRUE(o.values.empty());
+  }
+  // A start given before the file (a value set earlier) must fit bounds the file gives.
+  IdentificationOptions o;
+  o.values["T_p"] = 90.0;
+  try {
+    ApplyParameterFile("T_p: {free: true, bounds: [20, 40]}\n", "p.yaml", &o);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("p.yaml: line 1, key 'T_p.bounds': start value 90 is outside"));
+  }
+}
+
+TEST(ParameterFile, DuplicateKeyNamesBothLines) {
+  IdentificationOptions o;
+  try {
+    ApplyParameterFile("mu: 0.2\nT_p:\n  value: 60\n  value: 70\n", "p.yaml", &o);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "p.yaml: line 4, key 'T_p.value': duplicate key (first at line 3)");
+  }
+}
+
 TEST(Identification, RefusesAStartOutsideItsBoundsBeforeAnyRun) {
   auto backend = std::make_shared<CountingBackend>();
   IdentificationOptions o;
@@ -197,8 +237,9 @@ TEST(Identification, RefusesAStartOutsideItsBoundsBeforeAnyRun) {
     Identify({Recorded()}, o);
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_THAT(e.what(),
-                HasSubstr("parameter 'T_p': start value 50 is outside the bounds [60, 80]"));
+    // The start is the experiment's configured value: the message names it.
+    EXPECT_THAT(e.what(), HasSubstr("synthetic.h5: parameter 'T_p': start value 50 is outside "
+                                    "the bounds [60, 80]"));
   }
   EXPECT_EQ(backend->runs, 0u);
 }

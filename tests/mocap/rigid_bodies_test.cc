@@ -99,6 +99,12 @@ TEST(RigidBodiesFile, DuplicateNamesAreErrors) {
       << e;
 }
 
+TEST(RigidBodiesFile, DuplicateKeyNamesBothLines) {
+  // yaml-cpp keeps the first 'link' and would drop the second without a word.
+  EXPECT_EQ(ErrorOf(Replace(kSmall, "    link: 0\n", "    link: 0\n    link: 2\n")),
+            "rb.yaml: line 11, key 'bodies[1].link': duplicate key (first at line 10)");
+}
+
 TEST(RigidBodiesFile, OtherProblemsNameTheirKey) {
   EXPECT_NE(ErrorOf(Replace(kSmall, "ccsrm-rigid-bodies/1", "ccsrm-rigid-bodies/2"))
                 .find("line 1, key 'schema': is 'ccsrm-rigid-bodies/2'"),

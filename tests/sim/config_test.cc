@@ -169,6 +169,78 @@ TEST(Config, KeysAddedLaterMayBeLeftOutAndMeanThePapersLaw) {
                                        "connecting_cables.stribeck_velocity_mps"));
 }
 
+TEST(Config, DuplicateKeyNamesBothLines) {
+  // yaml-cpp keeps the first of two equal keys: the second mass would be
+  // ignored without a word.
+  const std::string first = "      link_mass_kg: 0.095\n";
+  std::string text = PaperText();
+  const std::string hole = "      hole_circle_radius_m: 0.021\n";
+  text.insert(text.find(hole) + hole.size(), "      link_mass_kg: 0.2\n");
+  EXPECT_EQ(ErrorOf(text),
+            "bad.yaml: line " + std::to_string(LineOf(text, hole) + 1) +
+                ", key 'arm.segments[0].link_mass_kg': duplicate key (first at line " +
+                std::to_string(LineOf(text, first)) + ")");
+  // A second section at the top level.
+  std::string sections = PaperText() + "solver:\n  relative_tolerance: 1e-3\n";
+  EXPECT_THAT(ErrorOf(sections),
+              HasSubstr("key 'solver': duplicate key (first at line " +
+                        std::to_string(LineOf(sections, "\nsolver:") + 1) + ")"));
+}
+
+TEST(Config, PhysicalValuesOutsideAnyArmAreRefused) {
+  const std::string text = Edited("youngs_modulus_pa: 2.6e10", "youngs_modulus_pa: 1e300");
+  EXPECT_EQ(ErrorOf(text), "bad.yaml: line " +
+                               std::to_string(LineOf(text, "youngs_modulus_pa: 1e300")) +
+                               ", key 'driving_cables.youngs_modulus_pa': must be in [1e+06, "
+                               "2e+12] Pa, found 1e+300");
+  const struct {
+    std::string from, to, message;
+  } cases[] = {
+      {"joint_disk_gap_m: 0.016", "joint_disk_gap_m: 3e-5",
+       "key 'arm.joint_disk_gap_m': must be in [0.0001, 1] m, found 3e-05"},
+      {"gravity_mps2: [0.0, 0.0, 0.0]", "gravity_mps2: [0.0, 0.0, -1e6]",
+       "key 'arm.gravity_mps2': magnitude must be in [0, 30] m/s^2, found 1e+06"},
+      {"link_length_m: 0.100", "link_length_m: 50",
+       "key 'arm.segments[1].link_length_m': must be in [0.001, 2] m"},
+      {"link_mass_kg: 0.095", "link_mass_kg: 1e9", "key 'arm.segments[0].link_mass_kg'"},
+      {"[66.0e-6, 62.0e-6, 19.0e-6]", "[66.0e-6, 62.0e6, 19.0e-6]",
+       "key 'arm.segments[0].link_inertia_kgm2': must be in [1e-12, 100] kg m^2"},
+      {"hole_circle_radius_m: 0.021", "hole_circle_radius_m: 21",
+       "key 'arm.segments[0].hole_circle_radius_m'"},
+      {"cable_length_m: 0.084", "cable_length_m: 84",
+       "key 'arm.segments[0].small_s.cable_length_m'"},
+      {"pulley_radius_m: 0.016", "pulley_radius_m: 1e-9",
+       "key 'arm.segments[0].large_s.pulley_radius_m'"},
+      {"cross_section_m2: 1.3273e-6      # A_c", "cross_section_m2: 1.3",
+       "key 'connecting_cables.cross_section_m2': must be in [1e-10, 0.001] m^2"},
+      {"density_kgpm3: 7850.0", "density_kgpm3: 7.85e6",
+       "key 'driving_cables.density_kgpm3': must be in [500, 25000] kg/m^3"},
+      {"input_offset_m: 0.05", "input_offset_m: 5e4", "key 'driving_cables.input_offset_m'"},
+      {"youngs_modulus_pa: 2.6e10        # E_c", "youngs_modulus_pa: 1e3",
+       "key 'connecting_cables.youngs_modulus_pa': must be in [1e+06, 2e+12] Pa, found 1000"},
+  };
+  for (const auto& c : cases) EXPECT_THAT(ErrorOf(Edited(c.from, c.to)), HasSubstr(c.message));
+}
+
+TEST(Config, EveryConfigurationInTheRepositoryPasses) {
+  for (const char* path : {"/configs/paper.yaml", "/datasets/samples/loop/arm.yaml"}) {
+    EXPECT_NO_THROW(LoadConfig(std::string(CCSRM_SOURCE_DIR) + path)) << path;
+  }
+}
+
+TEST(Config, NonFiniteAndUnrepresentableNumbersAreRefused) {
+  EXPECT_THAT(ErrorOf(Edited("link_mass_kg: 0.095", "link_mass_kg: .nan")),
+              HasSubstr("key 'arm.segments[0].link_mass_kg': '.nan' is not a finite number"));
+  EXPECT_THAT(ErrorOf(Edited("youngs_modulus_pa: 2.6e10", "youngs_modulus_pa: .inf")),
+              HasSubstr("key 'driving_cables.youngs_modulus_pa': '.inf' is not a finite number"));
+  EXPECT_THAT(ErrorOf(Edited("ramp_s: 20.0", "ramp_s: -.inf")),
+              HasSubstr("key 'protocol.ramp_s': '-.inf' is not a finite number"));
+  EXPECT_THAT(ErrorOf(Edited("youngs_modulus_pa: 2.6e10", "youngs_modulus_pa: 1e400")),
+              HasSubstr("'1e400' is outside the range of a double"));
+  EXPECT_THAT(ErrorOf(Edited("cross_section_m2: 1.3273e-6", "cross_section_m2: 1e-400")),
+              HasSubstr("key 'driving_cables.cross_section_m2': '1e-400' underflows"));
+}
+
 TEST(Config, ValidateRejectsConfigBuiltInCode) {
   Config c = LoadConfig(kPaperConfig);
   c.arm.segments[0].link_length_m = 0.0;

@@ -194,6 +194,13 @@ TEST(EffectParameters, BadEffectInputGetsOneLineNamingWhere) {
               HasSubstr("expected param=value"));
   EXPECT_THAT(ErrorOf([&] { ApplyEffectSpec("backlash:dead_band_rad=x", "--effect", &p); }),
               HasSubstr("is not a number"));
+  EXPECT_THAT(ErrorOf([&] { ApplyEffectSpec("backlash:dead_band_rad=1e-400", "--effect", &p); }),
+              HasSubstr("value '1e-400' of dead_band_rad underflows"));
+  EXPECT_EQ(ErrorOf([&] {
+              ApplyEffectsYaml("backlash: {dead_band_rad: 0.01, dead_band_rad: 0.02}\n", "fx.yaml",
+                               &p);
+            }),
+            "fx.yaml: line 1, key 'backlash.dead_band_rad': duplicate key (first at line 1)");
   EXPECT_THAT(ErrorOf([&] { ApplyEffectSpec("backlash:dead_band_rad=1", "--effect", &p); }),
               HasSubstr("parameter 'backlash.dead_band_rad' = 1 is outside [0, 0.05] rad"));
   EXPECT_FALSE(p.AnyEffectOn());  // nothing applied by a failed spec

@@ -99,6 +99,16 @@ TEST(Parameters, AssignmentsParseAndBadOnesNameTheProblem) {
                         "<effect>.<parameter>"));
   EXPECT_THAT(ErrorOf([] { ParseParameterAssignment("mu=0.1x", "--set"); }),
               HasSubstr("value '0.1x' is not a number"));
+  // Numbers a double cannot hold say so, not that they are no number.
+  EXPECT_EQ(ErrorOf([] { ParseParameterAssignment("mu=1e-400", "--set"); }),
+            "--set: 'mu=1e-400': value '1e-400' underflows: it is nearer 0 than a double can hold "
+            "(2.2e-308); write 0 if 0 is meant");
+  EXPECT_EQ(ErrorOf([] { ParseParameterAssignment("mu=1e400", "--set"); }),
+            "--set: 'mu=1e400': value '1e400' is outside the range of a double (magnitude above "
+            "1.8e+308)");
+  EXPECT_THAT(ErrorOf([] { ParseParameterAssignment("mu=nan", "--set"); }),
+              HasSubstr("value 'nan' is not a finite number"));
+  EXPECT_EQ(ParseParameterAssignment("mu=0", "--set").second, 0.0);
   ArmParameters c = Paper().parameters;
   EXPECT_THAT(ErrorOf([&] { SetParameter("T_d0", -5, "--set", &c); }),
               HasSubstr("--set: parameter 'T_d0' = -5 is outside [1, 1000] N"));
@@ -125,6 +135,26 @@ TEST(Parameters, YamlFileFlatOrTruthStyleWithLineAndKeyInErrors) {
   EXPECT_EQ(c.c_sc, 0.2);
   EXPECT_THAT(ErrorOf([&] { ApplyParameterYaml("- mu\n", "p.yaml", &c); }),
               HasSubstr("p.yaml: expected a mapping"));
+}
+
+TEST(Parameters, YamlFileWithADuplicateKeyNamesBothLines) {
+  // yaml-cpp keeps the first 'mu' and would drop the second without a word.
+  ArmParameters c = Paper().parameters;
+  EXPECT_EQ(ErrorOf([&] { ApplyParameterYaml("mu: 0.1\nc_sc: 0.2\nmu: 0.3\n", "p.yaml", &c); }),
+            "p.yaml: line 3, key 'mu': duplicate key (first at line 1)");
+  EXPECT_EQ(
+      ErrorOf([&] { ApplyParameterYaml("parameters:\n  T_p: 40\n  T_p: 45\n", "t.yaml", &c); }),
+      "t.yaml: line 3, key 'parameters.T_p': duplicate key (first at line 2)");
+  EXPECT_EQ(c.mu, Paper().parameters.mu);  // unchanged
+}
+
+TEST(Parameters, YamlNumbersOutsideADoubleOrNotFiniteSaySo) {
+  ArmParameters c = Paper().parameters;
+  EXPECT_EQ(ErrorOf([&] { ApplyParameterYaml("mu: 1e400\n", "p.yaml", &c); }),
+            "p.yaml: line 1, key 'mu': '1e400' is outside the range of a double (magnitude above "
+            "1.8e+308)");
+  EXPECT_EQ(ErrorOf([&] { ApplyParameterYaml("mu: .nan\n", "p.yaml", &c); }),
+            "p.yaml: line 1, key 'mu': '.nan' is not a finite number");
 }
 
 }  // namespace

@@ -2,11 +2,12 @@
 // and what motion capture records (ccsrm/sim/effects.h).
 #include "ccsrm/sim/effects.h"
 
-#include <cerrno>
 #include <cstdlib>
 #include <memory>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/number_text.h"
+#include "ccsrm/common/yaml_document.h"
 #include "ccsrm/sim/kinematics.h"
 #include "effect.h"
 #include "effects_yaml.h"
@@ -28,14 +29,6 @@ const ParameterInfo* EffectParameterInfo(const std::string& effect, const std::s
     if (p.effect == effect && p.short_name == short_name) return &p;
   }
   return nullptr;
-}
-
-double ParseNumber(const std::string& text, bool* ok) {
-  errno = 0;
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  *ok = !text.empty() && end == text.c_str() + text.size() && errno != ERANGE;
-  return value;
 }
 
 }  // namespace
@@ -79,15 +72,7 @@ void ApplyEffectsNode(const YAML::Node& node, const std::string& file,
                         "unknown parameter of " + effect +
                             " (known: " + ParameterList(FindEffect(effect, file)) + ")");
       }
-      double value = 0.0;
-      try {
-        if (!value_entry.second.IsScalar()) {
-          throw YAML::Exception(value_entry.second.Mark(), "not a scalar");
-        }
-        value = value_entry.second.as<double>();
-      } catch (const YAML::Exception&) {
-        ThrowInputError(file, value_where, "expected a number");
-      }
+      const double value = ReadYamlNumber(value_entry.second, file, value_where);
       const std::string problem = ParameterValueProblem(*info, value);
       if (!problem.empty()) ThrowInputError(file, value_where, problem);
       SetParameter(info->name, value, file, &updated);
@@ -148,11 +133,11 @@ std::string ApplyEffectSpec(const std::string& text, const std::string& where,
                       "unknown parameter '" + name + "' of " + effect +
                           " (known: " + ParameterList(info) + ")");
     }
-    bool ok = false;
-    const double value = ParseNumber(item.substr(equals + 1), &ok);
-    if (!ok) {
+    double value = 0.0;
+    const std::string problem = ParseNumberText(item.substr(equals + 1), &value);
+    if (!problem.empty()) {
       ThrowInputError(where, "'" + text + "'",
-                      "value '" + item.substr(equals + 1) + "' of " + name + " is not a number");
+                      "value '" + item.substr(equals + 1) + "' of " + name + " " + problem);
     }
     SetParameter(p->name, value, where, &updated);
     if (comma == std::string::npos) break;
@@ -164,12 +149,7 @@ std::string ApplyEffectSpec(const std::string& text, const std::string& where,
 
 void ApplyEffectsYaml(const std::string& yaml_text, const std::string& file,
                       ArmParameters* parameters) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    ThrowInputError(file, "line " + std::to_string(e.mark.line + 1), "not valid YAML: " + e.msg);
-  }
+  YAML::Node root = ParseYamlDocument(yaml_text, file);
   std::string prefix;
   if (root.IsMap() && root["effects"]) {
     root = root["effects"];

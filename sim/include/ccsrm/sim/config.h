@@ -165,12 +165,15 @@ Config LoadConfig(const std::string& path);
 // (so a run file's config_yaml reflects any overrides applied in C++).
 std::string ToYaml(const Config& config);
 
-// Checks cross-field consistency of a Config built or modified in C++.
-// Throws InputError naming the offending key.
+// Checks cross-field consistency of a Config built or modified in C++, and
+// that every physical value of the arm lies in the range any real arm of
+// this kind has (ParseConfig runs the same checks). Throws InputError naming
+// the offending key.
 void Validate(const Config& config);
 
-// The same checks for one part: an arm (ArmModel's constructor), solver
-// settings (Simulate) or a protocol. `source_name` stands for the file in the message.
+// Checks for one part: an arm (ArmModel's constructor: what makes the model
+// well-posed, without Validate's physical ranges), solver settings
+// (Simulate) or a protocol. `source_name` stands for the file in the message.
 void ValidateArm(const ArmConfig& arm, const std::string& source_name);
 void ValidateSolver(const SolverConfig& solver, const std::string& source_name);
 void ValidateProtocol(const ProtocolConfig& protocol, const std::string& source_name);
