@@ -1,12 +1,11 @@
 #include "option_checks.h"
 
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
 #include <functional>
 #include <sstream>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/number_text.h"
 
 namespace ccsrm::app {
 
@@ -32,15 +31,9 @@ std::vector<std::string> SplitList(const std::string& text, const std::string& o
 }
 
 double ParseNumber(const std::string& text, const std::string& option) {
-  errno = 0;
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size()) {
-    ThrowInputError(option, "", "'" + text + "' is not a number");
-  }
-  if (errno == ERANGE || !std::isfinite(value)) {
-    ThrowInputError(option, "", "'" + text + "' is outside the range of finite doubles");
-  }
+  double value = 0.0;
+  const std::string problem = ParseNumberText(text, &value);
+  if (!problem.empty()) ThrowInputError(option, "", "'" + text + "' " + problem);
   return value;
 }
 

@@ -736,8 +736,8 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
       // --params), else the first experiment's configuration.
       const bool given = options.values.count(name) != 0;
       char text[320];
-      std::snprintf(text, sizeof(text), "start value %g is outside the bounds [%g, %g] %s%s",
-                    f.start, f.lower, f.upper, info.units.c_str(),
+      std::snprintf(text, sizeof(text), "start value %g is outside the bounds [%g, %g]%s%s",
+                    f.start, f.lower, f.upper, info.units == "1" ? "" : (" " + info.units).c_str(),
                     given ? ""
                           : "; the start is this experiment's configured value: give one "
                             "inside (--set or --params)");

@@ -105,8 +105,9 @@ void ApplyParameterFile(const std::string& yaml_text, const std::string& file,
       const auto [lower, upper] = updated.bounds.at(name);
       if (value->second < lower || value->second > upper) {
         char text[256];
-        std::snprintf(text, sizeof(text), "start value %g is outside the bounds [%g, %g] %s%s",
-                      value->second, lower, upper, info->units.c_str(),
+        std::snprintf(text, sizeof(text), "start value %g is outside the bounds [%g, %g]%s%s",
+                      value->second, lower, upper,
+                      info->units == "1" ? "" : (" " + info->units).c_str(),
                       value_at.empty() ? " (the start was set before this file)" : "");
         ThrowInputError(file, value_at.empty() ? bounds_at : value_at, text);
       }
