@@ -21,7 +21,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegToRad = kPi / 180.0;
 constexpr const char* kSchema = "ccsrm-config/1";
 // The YAML words of HoleFrictionModel, in its order.
-const std::vector<std::string> kHoleFrictionWords = {"events", "smoothed", "off"};
+const std::vector<std::string> kHoleFrictionWords = {"events", "smoothed", "off", "presliding"};
 // The YAML words of RungeKuttaStepper, in its order (GSL's names).
 const std::vector<std::string> kStepperWords = {"rkck", "rkf45"};
 
@@ -361,6 +361,10 @@ void CheckSolver(const SolverConfig& s, const Checker& check) {
     // The stick band's slope, T mu' theta / v_eps ~ 1e6 N s/m against a
     // node mass of 1e-4 kg, is integrable explicitly only when smoothed.
     check.Fail("solver.hole_friction", "smoothed needs solver.smoothing_step_s > 0");
+  }
+  if (s.hole_friction == HoleFrictionModel::kPresliding && !(s.smoothing_step_s > 0.0)) {
+    // Likewise the presliding spring, ~1e5 N/m against the same mass.
+    check.Fail("solver.hole_friction", "presliding needs solver.smoothing_step_s > 0");
   }
   check.Positive("solver.stick_velocity_tolerance_mps", s.stick_velocity_tolerance_mps);
   check.Positive("solver.stick_force_tolerance_n", s.stick_force_tolerance_n);
