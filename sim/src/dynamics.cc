@@ -164,7 +164,11 @@ std::vector<double> ArmDynamics::ErrorScales() const {
   // The smoothed hole friction is a function of the slip speed across a stick
   // band of v_eps (1e-6 m/s): the slip speeds are resolved to a tenth of it,
   // or the friction force follows the step sequence rather than the state.
-  if (solver_.hole_friction == HoleFrictionModel::kSmoothed) {
+  // The presliding law slides, at its limit, only on loading (s_dot sgn(xi)
+  // > 0, joined over v_eps): slip-speed noise beyond v_eps at a node held at
+  // its limit would ratchet it along, so it needs the same resolution.
+  if (solver_.hole_friction == HoleFrictionModel::kSmoothed ||
+      solver_.hole_friction == HoleFrictionModel::kPresliding) {
     const double slip_scale =
         0.1 * solver_.stick_velocity_tolerance_mps / solver_.absolute_tolerance;
     for (const HoleNodeRef& hole : layout_.holes()) {
@@ -384,12 +388,14 @@ void ArmDynamics::AddHoleFriction(const double* q, const double* qd, const doubl
 // speed v), an elastoplastic spring on its displacement xi
 // (PreslidingHoleFriction), with its memory as for kSmoothed. Model
 // smoothing as for the elastic forces (eqs. 14-16): the force sees xi
-// averaged over the step, xi + (h/2) xi_dot + (h^2/6) xi_dd, with xi_dd
-// linearised as (1 - alpha) s_dd (the share of s_dd that presliding takes
-// up): a damper k h/2 on xi_dot and k (h^2/6)(1 - alpha) added to the
+// averaged over the step, xi + (h/2) xi_dot + (h^2/6) xi_dd, linearised
+// with g = d xi_dot / d s_dot >= 0 (the share of s_dot that presliding
+// takes up): a damper k g h/2 on s_dot and k (h^2/6) g added to the
 // node's mass, which put the spring's mode (k ~ 1e5 N/m against 1e-4 kg)
-// near sqrt(6)/h. The spring's energy joins the elastic energy; the plastic
-// and the smoothing power are dissipated.
+// near sqrt(6)/h. Linearised rather than k (h/2) xi_dot: inside the band
+// v_eps, at the limit, xi_dot falls as s_dot rises (g < 0 before the clamp),
+// and that damper would feed energy in. The spring's energy joins the
+// elastic energy; the plastic and the smoothing power are dissipated.
 void ArmDynamics::AddPreslidingFriction(int h, int s_col, double t_before, double v,
                                         const double* memory) {
   const PreslidingLaw law{
@@ -406,11 +412,11 @@ void ArmDynamics::AddPreslidingFriction(int h, int s_col, double t_before, doubl
   report.required_friction = f.force;
   report.sliding_speed = f.sliding_speed;
   const double step = solver_.smoothing_step_s;
-  const double damping_force = -0.5 * step * f.stiffness * f.rate;
+  const double damping_force = -0.5 * step * f.stiffness * f.engaged_fraction * v;
   force_[s_col] += f.force + damping_force;
   elastic_ += 0.5 * f.stiffness * xi * xi;
   dissipation_ += f.plastic_power - damping_force * v;
-  const double added_mass = step * step / 6.0 * f.stiffness * f.elastic_fraction;
+  const double added_mass = step * step / 6.0 * f.stiffness * f.engaged_fraction;
   if (added_mass > 0.0) {
     system_.values()[layout_.hole_material_diagonal(h)] += added_mass;
     hole_smoothing_power_.push_back({s_col, added_mass * v});

@@ -110,14 +110,20 @@ PreslidingFriction PreslidingHoleFriction(const PreslidingLaw& law, double tensi
   out.load_ratio = std::abs(displacement) / xi_ss;
   const double alpha =
       SmoothStep((out.load_ratio - kPreslidingBreakaway) / (1.0 - kPreslidingBreakaway));
-  out.elastic_fraction = 1.0 - alpha;
   const double loading = s_dot * sigma;
-  double ramp = 0.0;
+  double ramp = 0.0, ramp_slope = 0.0;
   if (loading >= f.stick_velocity_mps) {
     ramp = loading;
+    ramp_slope = 1.0;
   } else if (loading > 0.0) {
-    ramp = loading * SmoothStep(loading / f.stick_velocity_mps);
+    const double u = loading / f.stick_velocity_mps;
+    ramp = loading * SmoothStep(u);
+    ramp_slope = u * u * (9.0 - 8.0 * u);
   }
+  // The clamp acts only sliding near v_eps at the limit, where the slope
+  // of ramp exceeds 1 (it must catch up with x); a negative mass would be
+  // unphysical.
+  out.engaged_fraction = std::max(0.0, 1.0 - alpha * out.load_ratio * ramp_slope);
   const double sliding = alpha * out.load_ratio * sigma * ramp;
   out.rate = s_dot - sliding;
   out.sliding_speed = sliding;

@@ -125,9 +125,11 @@ struct PreslidingFriction {
   double force = 0.0;      // F = -k xi [N], right-hand-side signed
   double stiffness = 0.0;  // k [N/m]
   double rate = 0.0;       // xi_dot [m/s]
-  // 1 - alpha: the share of k that the node feels (1 in the elastic range,
-  // 0 at the limit), for model smoothing.
-  double elastic_fraction = 1.0;
+  // d xi_dot / d s_dot, clamped at >= 0: the share of k that the node feels
+  // (1 in the elastic range and on unloading, 0 sliding at the limit), for
+  // model smoothing. A node held just over its limit slides at a fraction
+  // of v_eps and still feels most of k.
+  double engaged_fraction = 1.0;
   double plastic_power = 0.0;  // k xi (s_dot - xi_dot) >= 0 [W]
   double sliding_speed = 0.0;  // s_dot - xi_dot [m/s]: the part of s_dot that slides
   double load_ratio = 0.0;     // rho
