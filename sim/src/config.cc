@@ -430,6 +430,10 @@ int ArmConfig::segment_of_link(int link) const {
   return -1;
 }
 
+const std::string& HoleFrictionWord(HoleFrictionModel model) {
+  return kHoleFrictionWords.at(static_cast<std::size_t>(model));
+}
+
 Config ParseConfig(const std::string& yaml_text, const std::string& source_name) {
   YAML::Node root;
   try {

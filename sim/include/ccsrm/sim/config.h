@@ -162,6 +162,9 @@ struct Config {
 // key, a missing key or section, a wrong type or a value out of range.
 Config ParseConfig(const std::string& yaml_text, const std::string& source_name);
 
+// The YAML word of a hole friction treatment ("events", "smoothed", ...).
+const std::string& HoleFrictionWord(HoleFrictionModel model);
+
 // Reads and parses a configuration file. Throws InputError.
 Config LoadConfig(const std::string& path);
 
