@@ -76,7 +76,8 @@ class ArmDynamics {
   const std::string& failure() const { return failure_; }
 
   // Hole nodes switch between stick and slip by events (kEvents); otherwise
-  // every node's friction is a function of its state (kSmoothed, kOff).
+  // every node's friction is a function of its state (kSmoothed, kOff,
+  // kPresliding).
   bool has_stick_slip() const { return solver_.hole_friction == HoleFrictionModel::kEvents; }
   const std::vector<HoleNodeRef>& holes() const { return layout_.holes(); }
   std::vector<HoleMode>& hole_modes() { return modes_; }
