@@ -22,7 +22,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegToRad = kPi / 180.0;
 constexpr const char* kSchema = "ccsrm-config/1";
 // The YAML words of HoleFrictionModel, in its order.
-const std::vector<std::string> kHoleFrictionWords = {"events", "smoothed", "off"};
+const std::vector<std::string> kHoleFrictionWords = {"events", "smoothed", "off", "presliding"};
 // The YAML words of RungeKuttaStepper, in its order (GSL's names).
 const std::vector<std::string> kStepperWords = {"rkck", "rkf45"};
 
@@ -436,6 +436,10 @@ void CheckSolver(const SolverConfig& s, const Checker& check) {
     // node mass of 1e-4 kg, is integrable explicitly only when smoothed.
     check.Fail("solver.hole_friction", "smoothed needs solver.smoothing_step_s > 0");
   }
+  if (s.hole_friction == HoleFrictionModel::kPresliding && !(s.smoothing_step_s > 0.0)) {
+    // Likewise the presliding spring, ~1e5 N/m against the same mass.
+    check.Fail("solver.hole_friction", "presliding needs solver.smoothing_step_s > 0");
+  }
   check.Positive("solver.stick_velocity_tolerance_mps", s.stick_velocity_tolerance_mps);
   check.Positive("solver.stick_force_tolerance_n", s.stick_force_tolerance_n);
   check.Positive("solver.large_s_static_velocity_mps", s.large_s_static_velocity_mps);
@@ -499,6 +503,10 @@ int ArmConfig::segment_of_link(int link) const {
     if (link <= last) return static_cast<int>(i);
   }
   return -1;
+}
+
+const std::string& HoleFrictionWord(HoleFrictionModel model) {
+  return kHoleFrictionWords.at(static_cast<std::size_t>(model));
 }
 
 Config ParseConfig(const std::string& yaml_text, const std::string& source_name) {

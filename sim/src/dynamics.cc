@@ -105,6 +105,10 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
     }
     pair_kernels_.push_back(k);
   }
+  if (solver_.hole_friction == HoleFrictionModel::kPresliding) {
+    presliding_ = num_memory_;
+    num_memory_ += static_cast<int>(layout_.holes().size());
+  }
 
   // Effects: only those that act in the right-hand side are kept, each in
   // the list of the hooks it uses; with every effect off the lists are
@@ -160,7 +164,11 @@ std::vector<double> ArmDynamics::ErrorScales() const {
   // The smoothed hole friction is a function of the slip speed across a stick
   // band of v_eps (1e-6 m/s): the slip speeds are resolved to a tenth of it,
   // or the friction force follows the step sequence rather than the state.
-  if (solver_.hole_friction == HoleFrictionModel::kSmoothed) {
+  // The presliding law slides, at its limit, only on loading (s_dot sgn(xi)
+  // > 0, joined over v_eps): slip-speed noise beyond v_eps at a node held at
+  // its limit would ratchet it along, so it needs the same resolution.
+  if (solver_.hole_friction == HoleFrictionModel::kSmoothed ||
+      solver_.hole_friction == HoleFrictionModel::kPresliding) {
     const double slip_scale =
         0.1 * solver_.stick_velocity_tolerance_mps / solver_.absolute_tolerance;
     for (const HoleNodeRef& hole : layout_.holes()) {
@@ -172,6 +180,13 @@ std::vector<double> ArmDynamics::ErrorScales() const {
   // an error of 1e3 absolute_tolerance in z moves a friction coefficient by
   // ~1e-5 relative, the relative tolerance of everything else.
   for (int k = memory_offset(); k < state_size(); ++k) scale[k] = 1e3;
+  // A presliding displacement (up to ~xi_f) is resolved to a hundredth of
+  // xi_f: its force, k xi, then to a hundredth of the capstan force.
+  if (presliding_ >= 0) {
+    const double xi_scale = 0.01 * parameters_.xi_f / solver_.absolute_tolerance;
+    for (std::size_t h = 0; h < layout_.holes().size(); ++h)
+      scale[memory_offset() + presliding_ + h] = xi_scale;
+  }
   return scale;
 }
 
@@ -202,6 +217,10 @@ Eigen::VectorXd ArmDynamics::InitialState() const {
   }
   // At rest every contact has its full static friction.
   y.tail(num_memory_).setOnes();
+  // ... and no presliding displacement.
+  if (presliding_ >= 0) {
+    y.segment(memory_offset() + presliding_, layout_.holes().size()).setZero();
+  }
   return y;
 }
 
@@ -319,6 +338,10 @@ void ArmDynamics::AddHoleFriction(const double* q, const double* qd, const doubl
     report.required_friction = 0.0;
     memory_rate_[h] = 0.0;
     const double v = qd[o + 3];
+    if (presliding_ >= 0) {
+      AddPreslidingFriction(static_cast<int>(h), o + 3, t_before, v, memory);
+      continue;
+    }
     if (solver_.hole_friction == HoleFrictionModel::kSmoothed) {
       double target_slope = 0.0;
       const double target = HoleMemoryTarget(law, v, &target_slope);
@@ -358,6 +381,45 @@ void ArmDynamics::AddHoleFriction(const double* q, const double* qd, const doubl
     const double f = HoleSlipFriction(t_before, mu, report.wrap_angle, sigma);
     force_[o + 3] += f;
     dissipation_ -= f * v;
+  }
+}
+
+// Presliding friction on hole h's material coordinate (column s_col, slip
+// speed v), an elastoplastic spring on its displacement xi
+// (PreslidingHoleFriction), with its memory as for kSmoothed. Model
+// smoothing as for the elastic forces (eqs. 14-16): the force sees xi
+// averaged over the step, xi + (h/2) xi_dot + (h^2/6) xi_dd, linearised
+// with g = d xi_dot / d s_dot >= 0 (the share of s_dot that presliding
+// takes up): a damper k g h/2 on s_dot and k (h^2/6) g added to the
+// node's mass, which put the spring's mode (k ~ 1e5 N/m against 1e-4 kg)
+// near sqrt(6)/h. Linearised rather than k (h/2) xi_dot: inside the band
+// v_eps, at the limit, xi_dot falls as s_dot rises (g < 0 before the clamp),
+// and that damper would feed energy in. The spring's energy joins the
+// elastic energy; the plastic and the smoothing power are dissipated.
+void ArmDynamics::AddPreslidingFriction(int h, int s_col, double t_before, double v,
+                                        const double* memory) {
+  const PreslidingLaw law{
+      {parameters_.mu, parameters_.mu_s, parameters_.v_s, solver_.stick_velocity_tolerance_mps},
+      parameters_.xi_f};
+  HoleReport& report = reports_[h];
+  const bool remembers = parameters_.tau_f > 0.0;
+  const double target = HoleMemoryTarget(law.friction, v, nullptr);
+  const double z = remembers ? memory[h] : target;
+  if (remembers) memory_rate_[h] = (target - z) / parameters_.tau_f;
+  const double xi = memory[presliding_ + h];
+  const PreslidingFriction f = PreslidingHoleFriction(law, t_before, report.wrap_angle, v, z, xi);
+  memory_rate_[presliding_ + h] = f.rate;
+  report.required_friction = f.force;
+  report.sliding_speed = f.sliding_speed;
+  const double step = solver_.smoothing_step_s;
+  const double damping_force = -0.5 * step * f.stiffness * f.engaged_fraction * v;
+  force_[s_col] += f.force + damping_force;
+  elastic_ += 0.5 * f.stiffness * xi * xi;
+  dissipation_ += f.plastic_power - damping_force * v;
+  const double added_mass = step * step / 6.0 * f.stiffness * f.engaged_fraction;
+  if (added_mass > 0.0) {
+    system_.values()[layout_.hole_material_diagonal(h)] += added_mass;
+    hole_smoothing_power_.push_back({s_col, added_mass * v});
   }
 }
 
@@ -833,10 +895,16 @@ void ArmDynamics::Observe(double t, const double* y, TrajectoryFrame* out, bool 
   for (std::size_t h = 0; h < holes.size(); ++h) {
     const int c = holes[h].cable;
     out->hole_slip_velocity[c].push_back(reports_[h].s_dot);
-    // Smoothed: stuck is creeping inside the stick band, the SPEC's definition.
-    const bool stuck = solver_.hole_friction == HoleFrictionModel::kSmoothed
-                           ? std::abs(reports_[h].s_dot) < solver_.stick_velocity_tolerance_mps
-                           : modes_[h] == HoleMode::kStuck;
+    // Smoothed: stuck is creeping inside the stick band, the SPEC's
+    // definition. Presliding: what slides of the slip speed (beyond the
+    // presliding displacement's rate) is inside the band.
+    const double v_eps = solver_.stick_velocity_tolerance_mps;
+    bool stuck = modes_[h] == HoleMode::kStuck;
+    if (solver_.hole_friction == HoleFrictionModel::kSmoothed) {
+      stuck = std::abs(reports_[h].s_dot) < v_eps;
+    } else if (solver_.hole_friction == HoleFrictionModel::kPresliding) {
+      stuck = std::abs(reports_[h].sliding_speed) < v_eps;
+    }
     out->hole_stuck[c].push_back(stuck ? 1 : 0);
   }
   out->input_length_change.resize(model_.num_cables());

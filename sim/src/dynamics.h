@@ -9,7 +9,9 @@
 // State y = [q (n), q_dot (n), dissipated energy (1), frictional memory];
 // q follows eq. 59: every cable node (x, y, z, s) then every link (x, y, z,
 // e0..e3); the memory z in [0, 1] of every hole node, then of every large-S
-// pair's x and y conduit (kernels/hole_friction.h, kernels/connecting.h).
+// pair's x and y conduit (kernels/hole_friction.h, kernels/connecting.h);
+// under hole_friction: presliding, then every hole node's presliding
+// displacement xi [m].
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
@@ -41,6 +43,8 @@ struct HoleReport {
   double required_friction = 0.0;  // stuck: friction the constraint applies on s [N]
   double friction_limit = 0.0;     // f_max (eq. 10) [N]
   double wrap_angle = 0.0;         // rad
+  // Presliding: the part of s_dot that slides, s_dot - xi_dot [m/s].
+  double sliding_speed = 0.0;
 };
 
 class ArmDynamics {
@@ -72,7 +76,8 @@ class ArmDynamics {
   const std::string& failure() const { return failure_; }
 
   // Hole nodes switch between stick and slip by events (kEvents); otherwise
-  // every node's friction is a function of its state (kSmoothed, kOff).
+  // every node's friction is a function of its state (kSmoothed, kOff,
+  // kPresliding).
   bool has_stick_slip() const { return solver_.hole_friction == HoleFrictionModel::kEvents; }
   const std::vector<HoleNodeRef>& holes() const { return layout_.holes(); }
   std::vector<HoleMode>& hole_modes() { return modes_; }
@@ -95,6 +100,7 @@ class ArmDynamics {
   void ComputeLinkKinematics(const double* q, const double* qd);
   bool AddCableElements(const double* q, const double* qd);
   void AddHoleFriction(const double* q, const double* qd, const double* memory);
+  void AddPreslidingFriction(int h, int s_col, double t_before, double v, const double* memory);
   void ComputeJointAngles();
   void AddConnectingMoments(double t, const double* memory);
   void AddEffectLoads(double t, const double* qd);
@@ -123,6 +129,8 @@ class ArmDynamics {
   int n_ = 0;           // coordinates
   int m_ = 0;           // constraint rows
   int num_memory_ = 0;  // frictional memory states
+  // Presliding: index of the first hole's xi among them (-1: none).
+  int presliding_ = -1;
 
   // Element and connecting-pair kernel parameters of this run.
   AleElementParams ale_;

@@ -159,6 +159,15 @@ const std::vector<ParameterInfo>& Parameters() {
        "frictional memory of the large-S conduits: time for the coefficient to follow the slip "
        "speed",
        &P::tau_c_f, 0.0},
+      // Presliding (Dahl) displacements of metal contacts are reported from
+      // about 1 to 50 um (Dupont, Hayward, Armstrong and Altpeter, IEEE TAC
+      // 47(5), 2002; Armstrong-Helouvry et al., Automatica 30(7), 1994); the
+      // bounds leave a decade either side. It must be positive: the
+      // presliding stiffness is the capstan force over it.
+      {"xi_f", "driving_cables.presliding_displacement_m", "m", 1e-7, 1e-4,
+       "presliding displacement of the holes: elastic travel of a node before its friction "
+       "reaches the capstan force (hole_friction: presliding)",
+       &P::xi_f, 1e-5},
   };
   return parameters;
 }

@@ -159,9 +159,13 @@ TEST(Config, KeysAddedLaterMayBeLeftOutAndMeanThePapersLaw) {
   EXPECT_EQ(ParseConfig(Edited("hole_friction: smoothed", "hole_friction: events"), "s.yaml")
                 .solver.hole_friction,
             HoleFrictionModel::kEvents);
+  EXPECT_EQ(ParseConfig(Edited("hole_friction: smoothed", "hole_friction: presliding"), "s.yaml")
+                .solver.hole_friction,
+            HoleFrictionModel::kPresliding);
+  EXPECT_EQ(HoleFrictionWord(HoleFrictionModel::kPresliding), "presliding");
   EXPECT_THAT(ErrorOf(Edited("hole_friction: smoothed", "hole_friction: sticky")),
               HasSubstr("key 'solver.hole_friction': expected one of 'events', 'smoothed', 'off', "
-                        "found 'sticky'"));
+                        "'presliding', found 'sticky'"));
   // The old key and the new one together are ambiguous.
   std::string both = PaperText();
   both.insert(both.find(v_s_line), "  large_s_dynamic_velocity_mps: 2.0e-4\n");

@@ -26,8 +26,9 @@ std::string ErrorOf(const std::function<void()>& f) {
 TEST(Parameters, SpecNamesInOrderEachMappedToItsConfigField) {
   std::vector<std::string> names;
   for (const ParameterInfo& p : Parameters()) names.push_back(p.name);
-  EXPECT_EQ(names, (std::vector<std::string>{"mu", "mu_s", "mu_c", "mu_c_s", "beta", "c_sc", "c_lc",
-                                             "T_p", "T_d0", "v_s", "v_c_s", "tau_f", "tau_c_f"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"mu", "mu_s", "mu_c", "mu_c_s", "beta", "c_sc", "c_lc", "T_p",
+                                      "T_d0", "v_s", "v_c_s", "tau_f", "tau_c_f", "xi_f"}));
   const ArmParameters c = Paper().parameters;
   EXPECT_EQ(GetParameter(c, "mu"), c.mu);
   EXPECT_EQ(GetParameter(c, "T_d0"), 100.0);
@@ -95,7 +96,7 @@ TEST(Parameters, AssignmentsParseAndBadOnesNameTheProblem) {
               HasSubstr("--set: 'mu': expected name=value"));
   EXPECT_THAT(ErrorOf([] { ParseParameterAssignment("nu=1", "--set"); }),
               HasSubstr("unknown parameter 'nu' (known: mu, mu_s, mu_c, mu_c_s, beta, c_sc, c_lc, "
-                        "T_p, T_d0, v_s, v_c_s, tau_f, tau_c_f; effects' parameters as "
+                        "T_p, T_d0, v_s, v_c_s, tau_f, tau_c_f, xi_f; effects' parameters as "
                         "<effect>.<parameter>"));
   EXPECT_THAT(ErrorOf([] { ParseParameterAssignment("mu=0.1x", "--set"); }),
               HasSubstr("value '0.1x' is not a number"));

@@ -227,6 +227,40 @@ TEST(Simulate, SmoothedHoleFrictionMatchesTheEventsToWhatMocapResolves) {
   EXPECT_LT(difference, 0.03);
 }
 
+TEST(Simulate, PreslidingHoleFrictionConvergesOnTheEventsAsThePreslidingDisplacementShrinks) {
+  // The presliding law (issue 31) replaces the stick constraint by an
+  // elastoplastic spring that reaches the capstan force after ~xi_f: each
+  // hole lets its cable through elastically by up to that much (10 um is
+  // ~0.03 deg of a joint), which the paper's rigid stick does not. As xi_f
+  // shrinks the law must converge on the paper's trial and error, without
+  // events.
+  const ShortCase& c = Case2();
+  SimulationOptions presliding = c.Options(1.5), events = c.Options(1.5);
+  presliding.solver.hole_friction = HoleFrictionModel::kPresliding;
+  events.solver.hole_friction = HoleFrictionModel::kEvents;
+  const SimulationResult reference = Simulate(c.model, c.config.parameters, c.inputs, events);
+  ASSERT_TRUE(reference.summary.completed()) << reference.summary.message;
+  EXPECT_GT(reference.summary.stick_slip_switches, 0);
+  std::vector<double> differences;
+  for (double xi_f : {1e-5, 1e-6}) {
+    ArmParameters p = c.config.parameters;
+    p.xi_f = xi_f;
+    const SimulationResult a = Simulate(c.model, p, c.inputs, presliding);
+    ASSERT_TRUE(a.summary.completed()) << a.summary.message;
+    EXPECT_EQ(a.summary.stick_slip_switches, 0);
+    differences.push_back(MaxJointAngleDifference(a.trajectory, reference.trajectory) * 180.0 /
+                          M_PI);
+    std::printf(
+        "presliding (xi_f %.0e m) vs events: %lld vs %lld evaluations, joint angles "
+        "differ by %.4f deg\n",
+        xi_f, static_cast<long long>(a.summary.rhs_evaluations),
+        static_cast<long long>(reference.summary.rhs_evaluations), differences.back());
+  }
+  EXPECT_LT(differences[0], 0.1);
+  EXPECT_LT(differences[1], 0.03);  // what motion capture resolves
+  EXPECT_LT(differences[1], 0.5 * differences[0]);
+}
+
 TEST(Simulate, FramesAreSampledAtTheGivenTimes) {
   // An experiment's mocap frames: irregular times at about 120 Hz. The run
   // lands a step on each, and at the times it shares with the 100 Hz grid

@@ -72,4 +72,63 @@ HoleFrictionForce SmoothedHoleFriction(const HoleFrictionLaw& law, double tensio
   return out;
 }
 
+namespace {
+
+// 3u^2 - 2u^3 on [0, 1], 0 below, 1 above: a C1 step.
+double SmoothStep(double u) {
+  if (u <= 0.0) return 0.0;
+  if (u >= 1.0) return 1.0;
+  return u * u * (3.0 - 2.0 * u);
+}
+
+}  // namespace
+
+PreslidingFriction PreslidingHoleFriction(const PreslidingLaw& law, double tension_before,
+                                          double wrap_angle, double s_dot, double memory,
+                                          double displacement) {
+  PreslidingFriction out;
+  const HoleFrictionLaw& f = law.friction;
+  const double xi_max = law.presliding_displacement_m;
+  const double t_b = std::max(0.0, tension_before);
+  const double sigma = displacement < 0.0 ? -1.0 : 1.0;
+  const double mu_z = f.mu_kinetic + (f.mu_static - f.mu_kinetic) * memory;
+  const double b = f.mu_static * wrap_angle;
+  // q = k xi_ss / (T_b sinh(mu' theta)) = xi_ss / xi_max. At b = 0 (a
+  // straight cable or no static friction) k is 0 and F too; xi_ss keeps its
+  // limit mu_z / mu' (or xi_max without friction) so that xi stays bounded.
+  double q = 1.0;
+  if (b > 0.0) {
+    q = std::abs(std::expm1(-mu_z * wrap_angle * sigma)) / std::sinh(b);
+  } else if (f.mu_static > 0.0) {
+    q = mu_z / f.mu_static;
+  }
+  // A limit of nothing (mu_z = 0 under mu' > 0) would make rho infinite.
+  q = std::max(q, 1e-3);
+  const double xi_ss = xi_max * q;
+  out.stiffness = t_b * std::sinh(b) / xi_max;
+  out.force = -out.stiffness * displacement;
+  out.load_ratio = std::abs(displacement) / xi_ss;
+  const double alpha =
+      SmoothStep((out.load_ratio - kPreslidingBreakaway) / (1.0 - kPreslidingBreakaway));
+  const double loading = s_dot * sigma;
+  double ramp = 0.0, ramp_slope = 0.0;
+  if (loading >= f.stick_velocity_mps) {
+    ramp = loading;
+    ramp_slope = 1.0;
+  } else if (loading > 0.0) {
+    const double u = loading / f.stick_velocity_mps;
+    ramp = loading * SmoothStep(u);
+    ramp_slope = u * u * (9.0 - 8.0 * u);
+  }
+  // The clamp acts only sliding near v_eps at the limit, where the slope
+  // of ramp exceeds 1 (it must catch up with x); a negative mass would be
+  // unphysical.
+  out.engaged_fraction = std::max(0.0, 1.0 - alpha * out.load_ratio * ramp_slope);
+  const double sliding = alpha * out.load_ratio * sigma * ramp;
+  out.rate = s_dot - sliding;
+  out.sliding_speed = sliding;
+  out.plastic_power = out.stiffness * displacement * sliding;
+  return out;
+}
+
 }  // namespace ccsrm::sim::internal

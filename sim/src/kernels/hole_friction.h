@@ -92,4 +92,50 @@ struct HoleFrictionForce {
 HoleFrictionForce SmoothedHoleFriction(const HoleFrictionLaw& law, double tension_before,
                                        double wrap_angle, double s_dot, double memory);
 
+// Presliding (elastoplastic) friction on s_i, for solver.hole_friction:
+// presliding (docs/model-notes.md), after the single-state elastoplastic
+// models of Dupont, Hayward, Armstrong and Altpeter (IEEE TAC 47(5), 2002).
+// The node carries a presliding displacement xi [m], the elastic strain of
+// the contact, and the friction is a spring on it:
+//   F = -k xi,  k = T_b sinh(mu' theta) / xi_max,
+// a stiffness proportional to the load, so that the steady capstan force of
+// eq. 9 in either direction is reached at about xi_max whatever the
+// tensions. xi follows
+//   xi_dot = s_dot - alpha(rho) rho sgn(xi) ramp(s_dot sgn(xi)),
+//   rho = |xi| / xi_ss,  xi_ss = T_b |expm1(-mu_z theta sgn(xi))| / k,
+// where mu_z = mu + (mu' - mu) z is the coefficient of the memory z (as in
+// SmoothedHoleFriction), so that k xi_ss is eq. 9's force with the current
+// coefficient. alpha is 0 below the breakaway rho_ba (pure elastic
+// presliding: a node loaded below it does not move at all) and rises as a
+// C1 smooth step to 1 at rho = 1; ramp(x) is 0 for x <= 0 (unloading and a
+// node at rest are elastic) and x beyond v_eps, joined C1 by x (3u^2 - 2u^3),
+// u = x / v_eps, so that xi_dot is C1 in s_dot. At steady sliding rho -> 1
+// and F is eq. 9's force; where the limit falls below k |xi| (the memory
+// drops) rho > 1 and xi relaxes to the limit as the node slides, rather than
+// storing force.
+// Preconditions: presliding_displacement_m > 0, stick_velocity_mps > 0,
+// theta >= 0, z in [0, 1].
+struct PreslidingLaw {
+  HoleFrictionLaw friction;
+  double presliding_displacement_m = 0.0;  // xi_max
+};
+// rho below which presliding is purely elastic (Dupont et al.'s z_ba / z_ss).
+inline constexpr double kPreslidingBreakaway = 0.5;
+struct PreslidingFriction {
+  double force = 0.0;      // F = -k xi [N], right-hand-side signed
+  double stiffness = 0.0;  // k [N/m]
+  double rate = 0.0;       // xi_dot [m/s]
+  // d xi_dot / d s_dot, clamped at >= 0: the share of k that the node feels
+  // (1 in the elastic range and on unloading, 0 sliding at the limit), for
+  // model smoothing. A node held just over its limit slides at a fraction
+  // of v_eps and still feels most of k.
+  double engaged_fraction = 1.0;
+  double plastic_power = 0.0;  // k xi (s_dot - xi_dot) >= 0 [W]
+  double sliding_speed = 0.0;  // s_dot - xi_dot [m/s]: the part of s_dot that slides
+  double load_ratio = 0.0;     // rho
+};
+PreslidingFriction PreslidingHoleFriction(const PreslidingLaw& law, double tension_before,
+                                          double wrap_angle, double s_dot, double memory,
+                                          double displacement);
+
 }  // namespace ccsrm::sim::internal

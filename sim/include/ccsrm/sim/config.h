@@ -18,8 +18,12 @@ namespace ccsrm::sim {
 //  kSmoothed: one smooth friction law of the slip speed (stick band v_eps,
 //             Stribeck transition), with model smoothing of its slope: no
 //             events, so the output is smooth in every parameter;
-//  kOff:      no friction in the holes, whatever mu and mu' are.
-enum class HoleFrictionModel { kEvents, kSmoothed, kOff };
+//  kOff:      no friction in the holes, whatever mu and mu' are;
+//  kPresliding: an elastoplastic law (Dupont et al. 2002): each node's
+//             friction is a spring on a presliding displacement state that
+//             yields at the capstan force, so a node loaded below its limit
+//             holds without creep; no events, model-smoothed like kSmoothed.
+enum class HoleFrictionModel { kEvents, kSmoothed, kOff, kPresliding };
 
 // The embedded Runge-Kutta 4(5) pair of GSL's odeiv2 that integrates a run
 // (YAML `stepper: rkck | rkf45`).
@@ -92,7 +96,7 @@ struct ArmConfig {
 // a parameter's value, so a fit that reaches a bound of zero keeps the same
 // model.
 struct SolverConfig {
-  // YAML `hole_friction: events | smoothed | off`.
+  // YAML `hole_friction: events | smoothed | off | presliding`.
   HoleFrictionModel hole_friction = HoleFrictionModel::kEvents;
   double baumgarte_alpha_per_s = 100.0;
   double baumgarte_beta_per_s2 = 100.0;
@@ -157,6 +161,9 @@ struct Config {
 // Throws InputError "<file>: line N, key 'a.b.c': <problem>" on an unknown
 // key, a missing key or section, a wrong type or a value out of range.
 Config ParseConfig(const std::string& yaml_text, const std::string& source_name);
+
+// The YAML word of a hole friction treatment ("events", "smoothed", ...).
+const std::string& HoleFrictionWord(HoleFrictionModel model);
 
 // Reads and parses a configuration file. Throws InputError.
 Config LoadConfig(const std::string& path);

@@ -36,6 +36,10 @@ struct ArmParameters {
   // static and kinetic values [s]; 0 follows at once.
   double tau_f = 0.0;
   double tau_c_f = 0.0;
+  // Presliding displacement of the holes: how far a hole node moves
+  // elastically before its friction reaches the steady capstan force, under
+  // solver.hole_friction: presliding (no effect otherwise) [m].
+  double xi_f = 0.0;
 
   // Effects (ccsrm/sim/effects.h): the physics the paper's model lacks, each
   // off by default. An effect is on once enabled (EnableEffect, a
@@ -90,7 +94,8 @@ struct ParameterInfo {
 };
 
 // The model's named parameters: SPEC 6's nine in its order (mu, mu_s, mu_c,
-// mu_c_s, beta, c_sc, c_lc, T_p, T_d0), then v_s, v_c_s, tau_f, tau_c_f.
+// mu_c_s, beta, c_sc, c_lc, T_p, T_d0), then v_s, v_c_s, tau_f, tau_c_f,
+// xi_f.
 // Every entry has a field.
 const std::vector<ParameterInfo>& Parameters();
 
