@@ -19,7 +19,7 @@ namespace {
 std::atomic<int> temp_counter{0};
 
 // "<target>.tmp-<pid>-<n>": the pid lets a later run tell a killed run's
-// leftovers (internal::RemoveStaleTemporaries) from a live run's.
+// leftovers (RemoveStaleTemporaries, output_policy.h) from a live run's.
 std::string TemporaryName(const std::string& target) {
   return target + internal::kTemporaryInfix + std::to_string(::getpid()) + "-" +
          std::to_string(temp_counter.fetch_add(1));
