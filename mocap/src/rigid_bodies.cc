@@ -59,15 +59,7 @@ std::string ScalarString(const std::string& file, const YAML::Node& node, const 
 }
 
 double Number(const std::string& file, const YAML::Node& node, const std::string& key) {
-  double value = 0.0;
-  try {
-    if (!node.IsScalar()) throw YAML::Exception(node.Mark(), "");
-    value = node.as<double>();
-  } catch (const YAML::Exception&) {
-    Fail(file, node, key, "expected a number");
-  }
-  if (!std::isfinite(value)) Fail(file, node, key, "expected a finite number");
-  return value;
+  return ReadYamlNumber(node, file, Line(node) + ", key '" + key + "'");
 }
 
 // Second singular value of the centred cluster: ~0 for collinear markers.

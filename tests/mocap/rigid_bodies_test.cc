@@ -118,6 +118,10 @@ TEST(RigidBodiesFile, OtherProblemsNameTheirKey) {
   EXPECT_NE(ErrorOf(Replace(kSmall, "[0.03, 0.02, -0.01]", "[0.03, zero, -0.01]"))
                 .find("expected a number"),
             std::string::npos);
+  // Read by the one YAML number reader: an overflow is named as such.
+  EXPECT_NE(ErrorOf(Replace(kSmall, "[0.03, 0.02, -0.01]", "[0.03, 1e400, -0.01]"))
+                .find("key 'bodies[0].markers[1].position_m': '1e400' is outside the range"),
+            std::string::npos);
   EXPECT_NE(ErrorOf(Replace(kSmall, "    link: 1\n", "")).find("key 'bodies[0].link': missing"),
             std::string::npos);
   const std::string collinear =
