@@ -23,6 +23,8 @@ constexpr double kDegToRad = kPi / 180.0;
 constexpr const char* kSchema = "ccsrm-config/1";
 // The YAML words of HoleFrictionModel, in its order.
 const std::vector<std::string> kHoleFrictionWords = {"events", "smoothed", "off", "presliding"};
+// The YAML words of ConduitFrictionModel, in its order.
+const std::vector<std::string> kConduitFrictionWords = {"modified_coulomb", "presliding"};
 // The YAML words of RungeKuttaStepper, in its order (GSL's names).
 const std::vector<std::string> kStepperWords = {"rkck", "rkf45"};
 
@@ -440,6 +442,10 @@ void CheckSolver(const SolverConfig& s, const Checker& check) {
     // Likewise the presliding spring, ~1e5 N/m against the same mass.
     check.Fail("solver.hole_friction", "presliding needs solver.smoothing_step_s > 0");
   }
+  if (s.conduit_friction == ConduitFrictionModel::kPresliding && !(s.smoothing_step_s > 0.0)) {
+    // The conduits' presliding spring against a link's inertia.
+    check.Fail("solver.conduit_friction", "presliding needs solver.smoothing_step_s > 0");
+  }
   check.Positive("solver.stick_velocity_tolerance_mps", s.stick_velocity_tolerance_mps);
   check.Positive("solver.stick_force_tolerance_n", s.stick_force_tolerance_n);
   check.Positive("solver.large_s_static_velocity_mps", s.large_s_static_velocity_mps);
@@ -585,6 +591,8 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
     SolverConfig& sc = c.solver;
     sc.hole_friction =
         static_cast<HoleFrictionModel>(s.OptionalWord("hole_friction", kHoleFrictionWords, 0));
+    sc.conduit_friction = static_cast<ConduitFrictionModel>(
+        s.OptionalWord("conduit_friction", kConduitFrictionWords, 0));
     sc.baumgarte_alpha_per_s = s.Number("baumgarte_alpha_per_s");
     sc.baumgarte_beta_per_s2 = s.Number("baumgarte_beta_per_s2");
     sc.smoothing_step_s = s.Number("smoothing_step_s");
@@ -723,6 +731,8 @@ std::string ToYaml(const Config& c) {
   out << YAML::Key << "solver" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "hole_friction" << YAML::Value
       << kHoleFrictionWords[static_cast<int>(s.hole_friction)];
+  out << YAML::Key << "conduit_friction" << YAML::Value
+      << kConduitFrictionWords[static_cast<int>(s.conduit_friction)];
   out << YAML::Key << "baumgarte_alpha_per_s" << YAML::Value << s.baumgarte_alpha_per_s;
   out << YAML::Key << "baumgarte_beta_per_s2" << YAML::Value << s.baumgarte_beta_per_s2;
   out << YAML::Key << "smoothing_step_s" << YAML::Value << s.smoothing_step_s;

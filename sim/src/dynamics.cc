@@ -109,6 +109,13 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
     presliding_ = num_memory_;
     num_memory_ += static_cast<int>(layout_.holes().size());
   }
+  if (solver_.conduit_friction == ConduitFrictionModel::kPresliding) {
+    for (PairKernel& k : pair_kernels_) {
+      if (k.kind != ConnectingKind::kLargeS) continue;
+      k.presliding = num_memory_;
+      num_memory_ += 2;
+    }
+  }
 
   // Effects: only those that act in the right-hand side are kept, each in
   // the list of the hooks it uses; with every effect off the lists are
@@ -187,6 +194,12 @@ std::vector<double> ArmDynamics::ErrorScales() const {
     for (std::size_t h = 0; h < layout_.holes().size(); ++h)
       scale[memory_offset() + presliding_ + h] = xi_scale;
   }
+  // Likewise a conduit's, to a hundredth of xi_c.
+  const double eta_scale = 0.01 * parameters_.xi_c / solver_.absolute_tolerance;
+  for (const PairKernel& k : pair_kernels_) {
+    if (k.presliding < 0) continue;
+    scale[memory_offset() + k.presliding] = scale[memory_offset() + k.presliding + 1] = eta_scale;
+  }
   return scale;
 }
 
@@ -220,6 +233,9 @@ Eigen::VectorXd ArmDynamics::InitialState() const {
   // ... and no presliding displacement.
   if (presliding_ >= 0) {
     y.segment(memory_offset() + presliding_, layout_.holes().size()).setZero();
+  }
+  for (const PairKernel& k : pair_kernels_) {
+    if (k.presliding >= 0) y.segment<2>(memory_offset() + k.presliding).setZero();
   }
   return y;
 }
@@ -503,14 +519,48 @@ void ArmDynamics::AddConnectingMoments(double t, const double* memory) {
         const int z_index = pair.memory + axis;
         const double z = remembers ? memory[z_index] : target;
         memory_rate_[z_index] = remembers ? (target - z) / parameters_.tau_c_f : 0.0;
-        const LargeSResult large = LargeSMoments(*large_params, th_i, th_j, rt_i, rt_j, z);
+        LargeSResult large;
+        if (pair.presliding < 0) {
+          large = LargeSMoments(*large_params, th_i, th_j, rt_i, rt_j, z);
+        } else {
+          // Presliding (model notes row 25): eq. 45's coefficient is a spring
+          // on the couple's presliding displacement eta, M_p = K eta with
+          // K = T_p r Theta mu'_c / xi_c [N m/m], on both joints.
+          const ConduitPreslidingLaw presliding_law{law.mu_kinetic, law.mu_static, parameters_.xi_c,
+                                                    solver_.stick_velocity_tolerance_mps};
+          const int eta_index = pair.presliding + axis;
+          const double eta = memory[eta_index];
+          const double v = ConduitSlipVelocity(*large_params, rt_i, rt_j);
+          const ConduitPresliding f = PreslidingConduitFriction(presliding_law, v, z, eta);
+          memory_rate_[eta_index] = f.rate;
+          large = LargeSMomentsWithCoefficient(*large_params, th_i, th_j, rt_i, rt_j, f.coefficient,
+                                               0.0);
+          const double r = pair.large.pulley_radius_m;
+          const double spring = -large_params->pretension_n * r * pair.large.wrap_angle_rad *
+                                f.coefficient_per_displacement;
+          // Model smoothing as for the holes' presliding (row 24): with
+          // eta_dot ~ g v and v = -(r/2)(theta_dot_i + theta_dot_j), the
+          // spring is k [1 1; 1 1] on (theta_i, theta_j), k = spring g r/2;
+          // averaged over h it adds the damper (h/2) k on the pair's common
+          // rate and (h^2/6) k [1 1; 1 1] to the mass.
+          const double k_common = 0.5 * spring * f.engaged_fraction * r;
+          const double common_damping = -0.5 * h * k_common * (rt_i + rt_j);
+          large.moments.on_i += common_damping;
+          large.moments.on_j += common_damping;
+          friction_smoothing.setConstant(h * h / 6.0 * k_common);
+          // Its energy K eta^2 / r (the moments' power is -2 K eta v / r) is
+          // elastic; what the moments' power leaves over it is the plastic
+          // power 2 K eta (v - eta_dot) / r >= 0, dissipated.
+          elastic_ += spring * eta * eta / r;
+          dissipation_ -= 2.0 * spring * eta * f.rate / r;
+        }
         m = large.moments;
         k_conservative = SmallSStiffness({pair.large.axial_stiffness_n, pair.large.pulley_radius_m,
                                           pair.large.cable_length_m, 0.0});
         k_now = large.stiffness_i;
         if (deflection != nullptr) k_now *= bent.slope;
         damping = pair.large.damping_nmsprad;
-        if (solver_.smooth_connecting_friction && h > 0.0) {
+        if (pair.presliding < 0 && solver_.smooth_connecting_friction && h > 0.0) {
           // Model smoothing of the conduit friction (interpretation beyond
           // the paper, as eqs. 14-16 do for strain): the friction moments
           // M_pi = M_pj see the rates averaged over h, theta_dot + (h/2)

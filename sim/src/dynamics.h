@@ -138,6 +138,9 @@ class ArmDynamics {
     ConnectingKind kind = ConnectingKind::kSmallS;
     int joint_i = 0;  // 1-based; the other joint is joint_i + 1
     int memory = -1;  // large S: index of its x conduit's memory (y: memory + 1)
+    // Large S under conduit presliding: index of its x conduit's presliding
+    // displacement among the memory states (y: presliding + 1); else -1.
+    int presliding = -1;
     SmallSParams small;
     LargeSParams large;
   };

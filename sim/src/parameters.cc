@@ -168,6 +168,12 @@ const std::vector<ParameterInfo>& Parameters() {
        "presliding displacement of the holes: elastic travel of a node before its friction "
        "reaches the capstan force (hole_friction: presliding)",
        &P::xi_f, 1e-5},
+      // The conduit is a wire rope in a steel sleeve: the same contacts and
+      // the same literature range as the holes.
+      {"xi_c", "connecting_cables.presliding_displacement_m", "m", 1e-7, 1e-4,
+       "presliding displacement of the large-S conduits: elastic travel of a couple before its "
+       "friction reaches the limit (conduit_friction: presliding)",
+       &P::xi_c, 1e-5},
   };
   return parameters;
 }

@@ -1,5 +1,7 @@
-// Tests of the presliding (elastoplastic) hole friction, PreslidingHoleFriction
-// (solver.hole_friction: presliding), on one hole node: a node of mass m on
+// Tests of the presliding (elastoplastic) friction: of the holes,
+// PreslidingHoleFriction (solver.hole_friction: presliding), and of the
+// large-S conduits, PreslidingConduitFriction (solver.conduit_friction:
+// presliding). The holes' on one hole node: a node of mass m on
 // its material coordinate s, loaded by a constant force P and held by the
 // friction, with the model smoothing that ArmDynamics applies (a damper
 // k g h/2 and k (h^2/6) g of added mass, g = d xi_dot / d s_dot >= 0).
@@ -8,6 +10,7 @@
 #include <cmath>
 #include <random>
 
+#include "kernels/connecting.h"
 #include "kernels/hole_friction.h"
 
 namespace ccsrm::sim::internal {
@@ -161,6 +164,146 @@ TEST(PreslidingFriction, FrictionNeverReturnsMoreThanTheElasticEnergyItStored) {
     xi += dt * m.rate;
     k = m.stiffness;
     ASSERT_LE(work + 0.5 * k * xi * xi, 1e-6 * 0.5 * k * kXiMax * kXiMax) << step;
+  }
+}
+
+// The conduits' law on one couple: the two joints of a large S turning
+// together by psi (theta_i = theta_j = psi, so the spring between them is
+// idle), inertia 2 J, under a moment M on each joint and the conduit
+// friction M_p on each, with the model smoothing ArmDynamics applies (the
+// damper (h/2) k and (h^2/6) k of added mass on each joint, k = K g r / 2).
+constexpr double kConduitRadius = 0.016;  // r_lc [m]
+constexpr double kConduitWrap = 3.21;     // Theta_lc [rad]
+constexpr double kConduitTension = 50.0;  // T_p [N]
+constexpr double kJointInertia = 6.6e-5;  // J [kg m^2]
+
+ConduitPreslidingLaw ConduitLaw() { return {0.21, 0.25, kXiMax, kStickBand}; }
+
+LargeSParams Couple() {
+  LargeSParams p;
+  p.axial_stiffness_n = 3.45e4;
+  p.pulley_radius_m = kConduitRadius;
+  p.cable_length_m = 0.109;
+  p.wrap_angle_rad = kConduitWrap;
+  p.pretension_n = kConduitTension;
+  p.friction = {0.21, 0.25, 1e-4, 5e-3};
+  return p;
+}
+
+// The static limit of the conduit friction on one joint, T_p r Theta mu'_c.
+double ConduitLimit() { return kConduitTension * kConduitRadius * kConduitWrap * 0.25; }
+
+struct CouplePose {
+  double psi = 0.0, rate = 0.0, eta = 0.0;
+};
+
+CouplePose SettleCouple(double moment, double duration, double dt, CouplePose c = {},
+                        double ramp_s = 0.0) {
+  const ConduitPreslidingLaw law = ConduitLaw();
+  const LargeSParams couple = Couple();
+  auto rate = [&](const CouplePose& x, double at, CouplePose* d) {
+    const double m = at < ramp_s ? moment * at / ramp_s : moment;
+    const double v = ConduitSlipVelocity(couple, x.rate, x.rate);
+    const ConduitPresliding f = PreslidingConduitFriction(law, v, 1.0, x.eta);
+    const LargeSResult r =
+        LargeSMomentsWithCoefficient(couple, x.psi, x.psi, x.rate, x.rate, f.coefficient, 0.0);
+    const double spring =
+        -kConduitTension * kConduitRadius * kConduitWrap * f.coefficient_per_displacement;
+    const double k = 0.5 * spring * f.engaged_fraction * kConduitRadius;
+    // Per joint: inertia J + 2 (h^2/6) k (the form [1 1; 1 1] on equal rates).
+    const double inertia = kJointInertia + 2.0 * kSmoothing * kSmoothing / 6.0 * k;
+    d->psi = x.rate;
+    d->rate = (m + r.moments.on_i - 0.5 * kSmoothing * k * 2.0 * x.rate) / inertia;
+    d->eta = f.rate;
+  };
+  auto add = [](const CouplePose& x, const CouplePose& d, double a) {
+    return CouplePose{x.psi + a * d.psi, x.rate + a * d.rate, x.eta + a * d.eta};
+  };
+  for (double t = 0.0; t < duration; t += dt) {
+    CouplePose k1, k2, k3, k4;
+    rate(c, t, &k1);
+    rate(add(c, k1, dt / 2), t + dt / 2, &k2);
+    rate(add(c, k2, dt / 2), t + dt / 2, &k3);
+    rate(add(c, k3, dt), t + dt, &k4);
+    c.psi += dt / 6 * (k1.psi + 2 * k2.psi + 2 * k3.psi + k4.psi);
+    c.rate += dt / 6 * (k1.rate + 2 * k2.rate + 2 * k3.rate + k4.rate);
+    c.eta += dt / 6 * (k1.eta + 2 * k2.eta + 2 * k3.eta + k4.eta);
+  }
+  return c;
+}
+
+TEST(ConduitPreslidingFriction, CoupleLoadedBelowBreakawayHoldsWithoutDrift) {
+  // A third of the limit: the couple turns by what the presliding spring
+  // takes, then not at all; eq. 45 would let it creep inside v_s.
+  const double moment = ConduitLimit() / 3.0;
+  const CouplePose settled = SettleCouple(moment, 1.0, 1e-5);
+  const CouplePose later = SettleCouple(moment, 10.0, 1e-5, settled);
+  const ConduitPresliding f = PreslidingConduitFriction(ConduitLaw(), 0.0, 1.0, later.eta);
+  const double friction = -kConduitTension * kConduitRadius * kConduitWrap * f.coefficient;
+  EXPECT_NEAR(friction, -moment, 1e-9 * moment);
+  // Nothing slid: eta is all the couple's travel, -r psi.
+  EXPECT_NEAR(later.eta, -kConduitRadius * later.psi, 1e-15);
+  EXPECT_LT(std::abs(later.psi - settled.psi), 1e-13) << "drift over 10 s [rad]";
+  EXPECT_LT(f.load_ratio, kPreslidingBreakaway);
+}
+
+TEST(ConduitPreslidingFriction, CoupleLoadedBeyondTheLimitSlidesAtEquation45sFriction) {
+  // At a prescribed slip speed beyond the bands, eta settles and the
+  // coefficient is eq. 45's at the memory, both ways; the moments are then
+  // LargeSMoments' to the last bit.
+  const ConduitPreslidingLaw law = ConduitLaw();
+  const LargeSParams couple = Couple();
+  for (double v : {2e-2, -2e-2, 3e-4, -3e-4}) {
+    for (double z : {1.0, 0.3}) {
+      double eta = 0.0;
+      const double dt = 1e-3 * kXiMax / std::abs(v);
+      for (int k = 0; k < 20000; ++k) eta += dt * PreslidingConduitFriction(law, v, z, eta).rate;
+      const ConduitPresliding f = PreslidingConduitFriction(law, v, z, eta);
+      const double expected = ModifiedCoulombWithMemory(couple.friction, v, z, nullptr);
+      EXPECT_NEAR(f.coefficient, expected, 1e-6 * std::abs(expected)) << v << " " << z;
+      EXPECT_NEAR(f.sliding_speed, v, 1e-6 * std::abs(v));
+      const double rate = -2.0 * v / kConduitRadius;  // theta_dot_i = theta_dot_j
+      const LargeSResult a =
+          LargeSMomentsWithCoefficient(couple, 0.01, 0.02, rate / 2, rate / 2, expected, 0.0);
+      const LargeSResult b = LargeSMoments(couple, 0.01, 0.02, rate / 2, rate / 2, z);
+      EXPECT_EQ(a.moments.on_i, b.moments.on_i);
+      EXPECT_EQ(a.moments.on_j, b.moments.on_j);
+    }
+  }
+}
+
+TEST(ConduitPreslidingFriction, UnloadingAndRestAreElastic) {
+  const ConduitPreslidingLaw law = ConduitLaw();
+  EXPECT_EQ(PreslidingConduitFriction(law, -3e-4, 1.0, 0.99 * kXiMax).rate, -3e-4);
+  EXPECT_EQ(PreslidingConduitFriction(law, 0.0, 1.0, 0.99 * kXiMax).rate, 0.0);
+  // Without static friction there is no spring, and eta stays bounded.
+  const ConduitPresliding none =
+      PreslidingConduitFriction({0.0, 0.0, kXiMax, kStickBand}, 1e-3, 1.0, 2.0 * kXiMax);
+  EXPECT_EQ(none.coefficient, 0.0);
+  EXPECT_LT(none.rate, 0.0);
+}
+
+TEST(ConduitPreslidingFriction, FrictionMomentsNeverDoMoreWorkThanTheEnergyStored) {
+  // The moments' power, M_p (theta_dot_i + theta_dot_j) = -2 K eta v / r,
+  // equals -d/dt (K eta^2 / r) minus a plastic power 2 K eta (v - eta_dot) / r
+  // >= 0, whatever the slip speed, displacement and memory.
+  const ConduitPreslidingLaw law = ConduitLaw();
+  const LargeSParams couple = Couple();
+  std::mt19937 rng(45);
+  std::uniform_real_distribution<double> speed(-4e-4, 4e-4), state(-2e-5, 2e-5), memory(0.0, 1.0);
+  for (int trial = 0; trial < 5000; ++trial) {
+    const double v = speed(rng), eta = state(rng), z = memory(rng);
+    const ConduitPresliding f = PreslidingConduitFriction(law, v, z, eta);
+    const double rate = -v / kConduitRadius;  // each joint's, so v_tau1 = v
+    const LargeSResult m =
+        LargeSMomentsWithCoefficient(couple, 0.0, 0.0, rate, rate, f.coefficient, 0.0);
+    const double K =
+        -kConduitTension * kConduitRadius * kConduitWrap * f.coefficient_per_displacement;
+    const double power = m.moments.on_i * rate + m.moments.on_j * rate;
+    const double stored_rate = 2.0 * K * eta * f.rate / kConduitRadius;
+    const double plastic = 2.0 * K * eta * f.sliding_speed / kConduitRadius;
+    EXPECT_GE(plastic, 0.0);
+    EXPECT_NEAR(power, -stored_rate - plastic, 1e-9 * std::abs(2.0 * K * eta * v / kConduitRadius));
   }
 }
 

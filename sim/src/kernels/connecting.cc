@@ -1,6 +1,9 @@
 #include "connecting.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include "hole_friction.h"
 
 namespace ccsrm::sim::internal {
 namespace {
@@ -71,18 +74,15 @@ double ConduitSlipVelocity(const LargeSParams& params, double theta_i_dot, doubl
   return -0.5 * params.pulley_radius_m * (theta_i_dot + theta_j_dot);
 }
 
-LargeSResult LargeSMoments(const LargeSParams& params, double theta_i, double theta_j,
-                           double theta_i_dot, double theta_j_dot, double memory) {
+namespace {
+
+// Eqs. 46-53 from the friction exponents a1 = mu_m(v_tau1) Theta and
+// a2 = mu_m(v_tau2) Theta; slope is d mu_m / d v_tau1.
+LargeSResult MomentsFromExponents(const LargeSParams& params, double theta_i, double theta_j,
+                                  double theta_i_dot, double theta_j_dot, double a1, double a2,
+                                  double slope) {
   LargeSResult out;
   out.slip_velocity_1 = ConduitSlipVelocity(params, theta_i_dot, theta_j_dot);
-  const double v2 = -out.slip_velocity_1;
-  double slope = 0.0;
-  const double a1 =
-      ModifiedCoulombWithMemory(params.friction, out.slip_velocity_1, memory, &slope) *
-      params.wrap_angle_rad;
-  const double a2 =
-      ModifiedCoulombWithMemory(params.friction, v2, memory, nullptr) * params.wrap_angle_rad;
-
   // Tension factors at the i ends (eqs. 46-47: T_i = (EA dl / l) phi(a)) and
   // at the j ends (T_j = T_i e^{-a} = (EA dl / l) phi(-a)).
   const double phi_1 = CapstanFactor(a1);
@@ -106,6 +106,49 @@ LargeSResult LargeSMoments(const LargeSParams& params, double theta_i, double th
                      c * (theta_j_dot - theta_i_dot);  // eq. 51
   out.moments.on_j = out.friction_j + out.stiffness_j * (theta_i - theta_j) +
                      c * (theta_i_dot - theta_j_dot);  // eq. 52
+  return out;
+}
+
+}  // namespace
+
+LargeSResult LargeSMoments(const LargeSParams& params, double theta_i, double theta_j,
+                           double theta_i_dot, double theta_j_dot, double memory) {
+  const double v1 = ConduitSlipVelocity(params, theta_i_dot, theta_j_dot);
+  double slope = 0.0;
+  // Both speeds through the law: inside the stick band mu_m(-v) equals
+  // -mu_m(v) only to rounding.
+  const double a1 =
+      ModifiedCoulombWithMemory(params.friction, v1, memory, &slope) * params.wrap_angle_rad;
+  const double a2 =
+      ModifiedCoulombWithMemory(params.friction, -v1, memory, nullptr) * params.wrap_angle_rad;
+  return MomentsFromExponents(params, theta_i, theta_j, theta_i_dot, theta_j_dot, a1, a2, slope);
+}
+
+LargeSResult LargeSMomentsWithCoefficient(const LargeSParams& params, double theta_i,
+                                          double theta_j, double theta_i_dot, double theta_j_dot,
+                                          double coefficient, double coefficient_slope) {
+  const double a1 = coefficient * params.wrap_angle_rad;
+  return MomentsFromExponents(params, theta_i, theta_j, theta_i_dot, theta_j_dot, a1, -a1,
+                              coefficient_slope);
+}
+
+ConduitPresliding PreslidingConduitFriction(const ConduitPreslidingLaw& law, double v,
+                                            double memory, double displacement) {
+  ConduitPresliding out;
+  const double eta_max = law.presliding_displacement_m;
+  const double sigma = displacement < 0.0 ? -1.0 : 1.0;
+  const double mu_z = law.mu_kinetic + (law.mu_static - law.mu_kinetic) * memory;
+  // eta_ss / eta_max = mu_z / mu'_c; without static friction there is no
+  // spring, and eta_ss = eta_max keeps eta bounded. A limit of nothing
+  // (mu_z = 0 under mu'_c > 0) would make rho infinite.
+  const double q = law.mu_static > 0.0 ? std::max(mu_z / law.mu_static, 1e-3) : 1.0;
+  out.coefficient_per_displacement = -law.mu_static / eta_max;
+  out.coefficient = out.coefficient_per_displacement * displacement;
+  out.load_ratio = std::abs(displacement) / (eta_max * q);
+  const ElastoplasticYield yield = ElastoplasticSlide(out.load_ratio, sigma, v, law.band_mps);
+  out.engaged_fraction = yield.engaged_fraction;
+  out.sliding_speed = yield.sliding;
+  out.rate = v - yield.sliding;
   return out;
 }
 

@@ -116,4 +116,44 @@ double ConduitSlipVelocity(const LargeSParams& params, double theta_i_dot, doubl
 LargeSResult LargeSMoments(const LargeSParams& params, double theta_i, double theta_j,
                            double theta_i_dot, double theta_j_dot, double memory);
 
+// Eqs. 46-53 with a given friction coefficient mu_m of the speed v_tau1
+// (mu_m(v_tau2) = -mu_m, as for eq. 45's odd law) and its slope
+// d mu_m / d v_tau1 [s/m] (for conduit_damping); LargeSMoments is this at
+// ModifiedCoulombWithMemory. params.friction is not read.
+LargeSResult LargeSMomentsWithCoefficient(const LargeSParams& params, double theta_i,
+                                          double theta_j, double theta_i_dot, double theta_j_dot,
+                                          double coefficient, double coefficient_slope);
+
+// Presliding (elastoplastic) conduit friction, for solver.conduit_friction:
+// presliding (docs/model-notes.md): the law of PreslidingHoleFriction for
+// the couple sliding in its conduit. Each conduit axis carries a presliding
+// displacement eta [m] of the couple, and eq. 45's coefficient becomes a
+// spring on it,
+//   mu_m = -mu'_c eta / eta_max,
+// which reaches the current limit mu_z = mu_c + (mu'_c - mu_c) z (memory z)
+// at eta_ss = eta_max mu_z / mu'_c. eta follows
+//   eta_dot = v - ElastoplasticSlide(|eta| / eta_ss, sgn eta, v, band).sliding
+// with v = v_tau1: a conduit loaded below its limit does not slide at all
+// (eq. 45's stick band lets it creep at up to v_s), at steady sliding mu_m
+// is -mu_z sgn v, eq. 45 beyond its bands. Moments then follow
+// LargeSMomentsWithCoefficient: M_pi = M_pj = T_p r_lc Theta mu'_c eta / eta_max.
+// Preconditions: presliding_displacement_m > 0, band_mps > 0, z in [0, 1].
+struct ConduitPreslidingLaw {
+  double mu_kinetic = 0.0;                 // mu_c
+  double mu_static = 0.0;                  // mu'_c
+  double presliding_displacement_m = 0.0;  // eta_max
+  double band_mps = 0.0;                   // the yield's ramp (v_eps)
+};
+struct ConduitPresliding {
+  double coefficient = 0.0;  // mu_m [1]
+  // d mu_m / d eta = -mu'_c / eta_max [1/m].
+  double coefficient_per_displacement = 0.0;
+  double rate = 0.0;              // eta_dot [m/s]
+  double engaged_fraction = 1.0;  // d eta_dot / dv clamped at >= 0
+  double sliding_speed = 0.0;     // v - eta_dot [m/s]
+  double load_ratio = 0.0;        // |eta| / eta_ss
+};
+ConduitPresliding PreslidingConduitFriction(const ConduitPreslidingLaw& law, double v,
+                                            double memory, double displacement);
+
 }  // namespace ccsrm::sim::internal

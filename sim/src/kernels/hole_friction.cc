@@ -83,6 +83,28 @@ double SmoothStep(double u) {
 
 }  // namespace
 
+ElastoplasticYield ElastoplasticSlide(double load_ratio, double sigma, double v, double band) {
+  ElastoplasticYield out;
+  const double alpha =
+      SmoothStep((load_ratio - kPreslidingBreakaway) / (1.0 - kPreslidingBreakaway));
+  const double loading = v * sigma;
+  double ramp = 0.0, ramp_slope = 0.0;
+  if (loading >= band) {
+    ramp = loading;
+    ramp_slope = 1.0;
+  } else if (loading > 0.0) {
+    const double u = loading / band;
+    ramp = loading * SmoothStep(u);
+    ramp_slope = u * u * (9.0 - 8.0 * u);
+  }
+  // The clamp acts only sliding near the band at the limit, where the slope
+  // of ramp exceeds 1 (it must catch up with x); a negative mass would be
+  // unphysical.
+  out.engaged_fraction = std::max(0.0, 1.0 - alpha * load_ratio * ramp_slope);
+  out.sliding = alpha * load_ratio * sigma * ramp;
+  return out;
+}
+
 PreslidingFriction PreslidingHoleFriction(const PreslidingLaw& law, double tension_before,
                                           double wrap_angle, double s_dot, double memory,
                                           double displacement) {
@@ -108,26 +130,12 @@ PreslidingFriction PreslidingHoleFriction(const PreslidingLaw& law, double tensi
   out.stiffness = t_b * std::sinh(b) / xi_max;
   out.force = -out.stiffness * displacement;
   out.load_ratio = std::abs(displacement) / xi_ss;
-  const double alpha =
-      SmoothStep((out.load_ratio - kPreslidingBreakaway) / (1.0 - kPreslidingBreakaway));
-  const double loading = s_dot * sigma;
-  double ramp = 0.0, ramp_slope = 0.0;
-  if (loading >= f.stick_velocity_mps) {
-    ramp = loading;
-    ramp_slope = 1.0;
-  } else if (loading > 0.0) {
-    const double u = loading / f.stick_velocity_mps;
-    ramp = loading * SmoothStep(u);
-    ramp_slope = u * u * (9.0 - 8.0 * u);
-  }
-  // The clamp acts only sliding near v_eps at the limit, where the slope
-  // of ramp exceeds 1 (it must catch up with x); a negative mass would be
-  // unphysical.
-  out.engaged_fraction = std::max(0.0, 1.0 - alpha * out.load_ratio * ramp_slope);
-  const double sliding = alpha * out.load_ratio * sigma * ramp;
-  out.rate = s_dot - sliding;
-  out.sliding_speed = sliding;
-  out.plastic_power = out.stiffness * displacement * sliding;
+  const ElastoplasticYield yield =
+      ElastoplasticSlide(out.load_ratio, sigma, s_dot, f.stick_velocity_mps);
+  out.engaged_fraction = yield.engaged_fraction;
+  out.rate = s_dot - yield.sliding;
+  out.sliding_speed = yield.sliding;
+  out.plastic_power = out.stiffness * displacement * yield.sliding;
   return out;
 }
 

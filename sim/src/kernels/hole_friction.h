@@ -121,6 +121,19 @@ struct PreslidingLaw {
 };
 // rho below which presliding is purely elastic (Dupont et al.'s z_ba / z_ss).
 inline constexpr double kPreslidingBreakaway = 0.5;
+
+// The yield of the elastoplastic law, shared by the holes and the large-S
+// conduits: of a contact's slip speed v, the part that slides when its
+// presliding displacement has sign sigma (+-1) and load ratio rho,
+//   sliding = alpha(rho) rho sigma ramp(v sigma),
+// with alpha and ramp (joined over `band`) as above; the displacement's
+// rate is v - sliding.
+struct ElastoplasticYield {
+  double sliding = 0.0;  // [m/s]
+  // d(v - sliding)/dv clamped at >= 0 (PreslidingFriction::engaged_fraction).
+  double engaged_fraction = 1.0;
+};
+ElastoplasticYield ElastoplasticSlide(double load_ratio, double sigma, double v, double band);
 struct PreslidingFriction {
   double force = 0.0;      // F = -k xi [N], right-hand-side signed
   double stiffness = 0.0;  // k [N/m]

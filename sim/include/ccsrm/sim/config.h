@@ -25,6 +25,15 @@ namespace ccsrm::sim {
 //             holds without creep; no events, model-smoothed like kSmoothed.
 enum class HoleFrictionModel { kEvents, kSmoothed, kOff, kPresliding };
 
+// How the large-S conduits' friction acts (docs/model-notes.md):
+//  kModifiedCoulomb: the paper's eq. 45, a law of the slip speed with a
+//             stick band v_s: a conduit loaded below its limit creeps at up
+//             to v_s ("cannot capture stick state in a strict sense");
+//  kPresliding: the elastoplastic law of the holes' kPresliding on a
+//             presliding displacement per conduit axis: a conduit loaded
+//             below its limit holds without creep.
+enum class ConduitFrictionModel { kModifiedCoulomb, kPresliding };
+
 // The embedded Runge-Kutta 4(5) pair of GSL's odeiv2 that integrates a run
 // (YAML `stepper: rkck | rkf45`).
 enum class RungeKuttaStepper { kCashKarp, kFehlberg };
@@ -98,6 +107,8 @@ struct ArmConfig {
 struct SolverConfig {
   // YAML `hole_friction: events | smoothed | off | presliding`.
   HoleFrictionModel hole_friction = HoleFrictionModel::kEvents;
+  // YAML `conduit_friction: modified_coulomb | presliding`.
+  ConduitFrictionModel conduit_friction = ConduitFrictionModel::kModifiedCoulomb;
   double baumgarte_alpha_per_s = 100.0;
   double baumgarte_beta_per_s2 = 100.0;
   double smoothing_step_s = 0.01;

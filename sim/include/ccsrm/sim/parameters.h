@@ -40,6 +40,10 @@ struct ArmParameters {
   // elastically before its friction reaches the steady capstan force, under
   // solver.hole_friction: presliding (no effect otherwise) [m].
   double xi_f = 0.0;
+  // Presliding displacement of the large-S conduits: how far a couple slides
+  // elastically in its conduit before its friction reaches the limit, under
+  // solver.conduit_friction: presliding (no effect otherwise) [m].
+  double xi_c = 0.0;
 
   // Effects (ccsrm/sim/effects.h): the physics the paper's model lacks, each
   // off by default. An effect is on once enabled (EnableEffect, a
@@ -95,7 +99,7 @@ struct ParameterInfo {
 
 // The model's named parameters: SPEC 6's nine in its order (mu, mu_s, mu_c,
 // mu_c_s, beta, c_sc, c_lc, T_p, T_d0), then v_s, v_c_s, tau_f, tau_c_f,
-// xi_f.
+// xi_f, xi_c.
 // Every entry has a field.
 const std::vector<ParameterInfo>& Parameters();
 
