@@ -147,7 +147,7 @@ TEST(Generate, RejectsUnknownParametersAndBadValuesWithOneLine) {
   EXPECT_EQ(ccsrm::testing::CountLines(unknown.err), 1) << unknown.err;
   EXPECT_THAT(unknown.err,
               HasSubstr("unknown parameter 'mu_x' (known: mu, mu_s, mu_c, mu_c_s, "
-                        "beta, c_sc, c_lc, T_p, T_d0, v_s, v_c_s, tau_f, tau_c_f, xi_f; "
+                        "beta, c_sc, c_lc, T_p, T_d0, v_s, v_c_s, tau_f, tau_c_f, xi_f, xi_c; "
                         "effects' parameters as <effect>.<parameter>"));
   const Outcome bounds =
       RunCcsrm("generate --config " + Paper() + " --set mu=3 --out /tmp/ccsrm_never.h5");

@@ -28,7 +28,7 @@ TEST(Parameters, SpecNamesInOrderEachMappedToItsConfigField) {
   for (const ParameterInfo& p : Parameters()) names.push_back(p.name);
   EXPECT_EQ(names,
             (std::vector<std::string>{"mu", "mu_s", "mu_c", "mu_c_s", "beta", "c_sc", "c_lc", "T_p",
-                                      "T_d0", "v_s", "v_c_s", "tau_f", "tau_c_f", "xi_f"}));
+                                      "T_d0", "v_s", "v_c_s", "tau_f", "tau_c_f", "xi_f", "xi_c"}));
   const ArmParameters c = Paper().parameters;
   EXPECT_EQ(GetParameter(c, "mu"), c.mu);
   EXPECT_EQ(GetParameter(c, "T_d0"), 100.0);
@@ -96,7 +96,7 @@ TEST(Parameters, AssignmentsParseAndBadOnesNameTheProblem) {
               HasSubstr("--set: 'mu': expected name=value"));
   EXPECT_THAT(ErrorOf([] { ParseParameterAssignment("nu=1", "--set"); }),
               HasSubstr("unknown parameter 'nu' (known: mu, mu_s, mu_c, mu_c_s, beta, c_sc, c_lc, "
-                        "T_p, T_d0, v_s, v_c_s, tau_f, tau_c_f, xi_f; effects' parameters as "
+                        "T_p, T_d0, v_s, v_c_s, tau_f, tau_c_f, xi_f, xi_c; effects' parameters as "
                         "<effect>.<parameter>"));
   EXPECT_THAT(ErrorOf([] { ParseParameterAssignment("mu=0.1x", "--set"); }),
               HasSubstr("value '0.1x' is not a number"));
