@@ -53,9 +53,11 @@ void RunConfigCheck(const std::string& path) {
     }
     std::printf("  effect on: %s (%s)\n", effect.c_str(), values.c_str());
   }
-  std::printf("  structure: hole friction %s, connecting friction smoothing %s\n",
-              sim::HoleFrictionWord(c.solver.hole_friction).c_str(),
-              c.solver.smooth_connecting_friction ? "on" : "off");
+  std::printf(
+      "  structure: hole friction %s, conduit friction %s, connecting friction smoothing %s\n",
+      sim::HoleFrictionWord(c.solver.hole_friction).c_str(),
+      sim::ConduitFrictionWord(c.solver.conduit_friction).c_str(),
+      c.solver.smooth_connecting_friction ? "on" : "off");
   std::printf("  protocol: amplitude %.4g deg over %.4g s; solver: h = %.4g s, output %.4g Hz\n",
               c.protocol.amplitude_rad * 180.0 / 3.14159265358979323846, c.protocol.duration_s(),
               c.solver.smoothing_step_s, c.solver.output_rate_hz);

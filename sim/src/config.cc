@@ -515,6 +515,10 @@ const std::string& HoleFrictionWord(HoleFrictionModel model) {
   return kHoleFrictionWords.at(static_cast<std::size_t>(model));
 }
 
+const std::string& ConduitFrictionWord(ConduitFrictionModel model) {
+  return kConduitFrictionWords.at(static_cast<std::size_t>(model));
+}
+
 Config ParseConfig(const std::string& yaml_text, const std::string& source_name) {
   const YAML::Node root = ParseYamlDocument(yaml_text, source_name);
   if (!root.IsMap()) ThrowInputError(source_name, "", "expected a YAML mapping at the top level");

@@ -59,7 +59,10 @@ TEST(Config, PaperConfigurationHoldsTable1) {
   EXPECT_DOUBLE_EQ(c.arm.driving.youngs_modulus_pa, 2.6e10);
   EXPECT_DOUBLE_EQ(c.parameters.T_p, 50.0);
   EXPECT_DOUBLE_EQ(c.parameters.mu_s, 0.21);
-  EXPECT_EQ(c.solver.hole_friction, HoleFrictionModel::kSmoothed);
+  EXPECT_EQ(c.solver.hole_friction, HoleFrictionModel::kPresliding);
+  EXPECT_EQ(c.solver.conduit_friction, ConduitFrictionModel::kPresliding);
+  EXPECT_DOUBLE_EQ(c.parameters.xi_f, 1e-5);
+  EXPECT_DOUBLE_EQ(c.parameters.xi_c, 1e-5);
   EXPECT_DOUBLE_EQ(c.parameters.v_s, 5e-3);
   EXPECT_DOUBLE_EQ(c.parameters.v_c_s, 5e-3);
   EXPECT_DOUBLE_EQ(c.parameters.tau_f, 0.01);
@@ -140,7 +143,9 @@ TEST(Config, KeysAddedLaterMayBeLeftOutAndMeanThePapersLaw) {
   // config_yaml from before them still parses, with the paper's trial and
   // error, no Stribeck transition in the holes, no memory, and the conduits'
   // fall closed by the paper's v_d (so v_c_s = v_d - v_s).
-  std::string old = Edited("  hole_friction: smoothed\n", "");
+  std::string old = Edited("  hole_friction: presliding\n", "");
+  const std::string conduit_line = "  conduit_friction: presliding\n";
+  old.replace(old.find(conduit_line), conduit_line.size(), "");
   for (const std::string line :
        {"  stribeck_velocity_mps: 5.0e-3\n", "  friction_memory_s: 0.01\n",
         "  stribeck_velocity_mps: 5.0e-3\n", "  friction_memory_s: 0.01\n"}) {
@@ -151,19 +156,30 @@ TEST(Config, KeysAddedLaterMayBeLeftOutAndMeanThePapersLaw) {
   old.insert(old.find(v_s_line), "  large_s_dynamic_velocity_mps: 3.0e-4\n");
   const Config c = ParseConfig(old, "old.yaml");
   EXPECT_EQ(c.solver.hole_friction, HoleFrictionModel::kEvents);
+  EXPECT_EQ(c.solver.conduit_friction, ConduitFrictionModel::kModifiedCoulomb);  // eq. 45
   EXPECT_EQ(c.parameters.v_s, 0.0);
   EXPECT_EQ(c.parameters.tau_f, 0.0);
   EXPECT_EQ(c.parameters.tau_c_f, 0.0);
   EXPECT_NEAR(c.parameters.v_c_s, 2.0e-4, 1e-18);
   EXPECT_EQ(ParseConfig(with_v_d, "no_v_d.yaml").parameters.v_c_s, 1.0e-4);
-  EXPECT_EQ(ParseConfig(Edited("hole_friction: smoothed", "hole_friction: events"), "s.yaml")
-                .solver.hole_friction,
-            HoleFrictionModel::kEvents);
-  EXPECT_EQ(ParseConfig(Edited("hole_friction: smoothed", "hole_friction: presliding"), "s.yaml")
-                .solver.hole_friction,
-            HoleFrictionModel::kPresliding);
+  EXPECT_EQ(
+      ParseConfig(Edited("\n  hole_friction: presliding", "\n  hole_friction: events"), "s.yaml")
+          .solver.hole_friction,
+      HoleFrictionModel::kEvents);
+  EXPECT_EQ(
+      ParseConfig(Edited("\n  hole_friction: presliding", "\n  hole_friction: smoothed"), "s.yaml")
+          .solver.hole_friction,
+      HoleFrictionModel::kSmoothed);
   EXPECT_EQ(HoleFrictionWord(HoleFrictionModel::kPresliding), "presliding");
-  EXPECT_THAT(ErrorOf(Edited("hole_friction: smoothed", "hole_friction: sticky")),
+  EXPECT_EQ(ParseConfig(Edited("\n  conduit_friction: presliding",
+                               "\n  conduit_friction: modified_coulomb"),
+                        "s.yaml")
+                .solver.conduit_friction,
+            ConduitFrictionModel::kModifiedCoulomb);
+  EXPECT_THAT(ErrorOf(Edited("\n  conduit_friction: presliding", "\n  conduit_friction: lugre")),
+              HasSubstr("key 'solver.conduit_friction': expected one of 'modified_coulomb', "
+                        "'presliding', found 'lugre'"));
+  EXPECT_THAT(ErrorOf(Edited("\n  hole_friction: presliding", "\n  hole_friction: sticky")),
               HasSubstr("key 'solver.hole_friction': expected one of 'events', 'smoothed', 'off', "
                         "'presliding', found 'sticky'"));
   // The old key and the new one together are ambiguous.

@@ -175,6 +175,8 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
 
 // The YAML word of a hole friction treatment ("events", "smoothed", ...).
 const std::string& HoleFrictionWord(HoleFrictionModel model);
+// The YAML word of a ConduitFrictionModel ("modified_coulomb", "presliding").
+const std::string& ConduitFrictionWord(ConduitFrictionModel model);
 
 // Reads and parses a configuration file. Throws InputError.
 Config LoadConfig(const std::string& path);
