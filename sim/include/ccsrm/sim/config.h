@@ -115,6 +115,8 @@ struct SolverConfig {
   // Extends model smoothing to the large-S conduit friction (see
   // docs/model-notes.md): without it eq. 45's slope makes cases 2 and 4 stiff.
   // It acts whatever mu_c and mu'_c are (with both at zero it adds nothing).
+  // Under conduit_friction: presliding it has no effect: that law is always
+  // smoothed, as the holes' presliding law is.
   bool smooth_connecting_friction = true;
   // Extends model smoothing to the connecting-cable springs and dampers (see
   // docs/model-notes.md): their torsional modes (150-300 Hz against the link
