@@ -41,6 +41,7 @@ double Median(std::vector<double> v) {
 void RunBench(const BenchArgs& a) {
   if (a.repeat < 1) ThrowInputError("--repeat", "", "must be >= 1");
   const sim::PaperRun run = sim::PreparePaperRun(a.run);
+  PrintConfigWarnings(run.config);
   const sim::Config& config = run.config;
   const sim::SimulationOptions& options = run.simulation;
   std::printf("ccsrm bench: case %d, %+.3g deg, %.4g s simulated, %d run(s), one thread\n",

@@ -183,6 +183,7 @@ int RunGenerate(const GenerateArgs& a) {
   // is that configuration with the case, amplitude and parameters applied.
   // Effects join the truth only.
   const sim::PaperRun run = sim::PreparePaperRun(a.run);
+  PrintConfigWarnings(run.config);
   sim::Config truth = run.config;
   if (!a.effects_path.empty()) {
     sim::ApplyEffectsYaml(ReadTextFile(a.effects_path), a.effects_path, &truth.parameters);

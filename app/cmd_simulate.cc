@@ -30,6 +30,7 @@ int RunSimulate(const SimulateArgs& a) {
   // Check the output path before spending minutes on the run.
   CheckOut(a.out, RunFileOutput(), {a.run.config_path, a.run.params_path});
   const sim::PaperRun run = sim::PreparePaperRun(a.run);
+  PrintConfigWarnings(run.config);
   sim::SimulationOptions options = run.simulation;
   if (!a.quiet) {
     options.progress = [](const sim::SimulationProgress& p) {

@@ -1,6 +1,7 @@
 #include "paper_run.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include "option_checks.h"
 
@@ -48,6 +49,11 @@ void AddParameterOptions(CLI::App* command, sim::PaperRunOptions* args) {
   command->add_option("--params", args->params_path,
                       "YAML file of parameter values (name: value, or a truth file's "
                       "'parameters:')");
+}
+
+void PrintConfigWarnings(const sim::Config& config) {
+  for (const std::string& w : config.warnings)
+    std::fprintf(stderr, "ccsrm: warning: %s\n", w.c_str());
 }
 
 }  // namespace ccsrm::app

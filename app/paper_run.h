@@ -14,4 +14,8 @@ void AddPaperRunOptions(CLI::App* command, sim::PaperRunOptions* options);
 // table of sim/parameters.h) applied after the case.
 void AddParameterOptions(CLI::App* command, sim::PaperRunOptions* options);
 
+// Prints the configuration's warnings (sim::Config::warnings: values far
+// outside the range of such arms) on stderr, "ccsrm: warning: ..." each.
+void PrintConfigWarnings(const sim::Config& config);
+
 }  // namespace ccsrm::app

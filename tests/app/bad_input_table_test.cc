@@ -105,6 +105,14 @@ std::string EditedPaper(const std::string& pattern, const std::string& replaceme
                             std::regex_constants::format_first_only);
 }
 
+// The second arm (configs/three-segment.yaml) edited as EditedPaper does.
+std::string EditedThreeSegment(const std::string& pattern, const std::string& replacement) {
+  const std::string text =
+      ccsrm::ReadTextFile(std::string(CCSRM_SOURCE_DIR) + "/configs/three-segment.yaml");
+  return std::regex_replace(text, std::regex(pattern), replacement,
+                            std::regex_constants::format_first_only);
+}
+
 class BadInputTable : public ::testing::Test {
  protected:
   // The inputs of every row, made once: configurations, parameter files, a
@@ -120,6 +128,16 @@ class BadInputTable : public ::testing::Test {
     Write(d / "stiff.yaml", EditedPaper("youngs_modulus_pa: .*", "youngs_modulus_pa: 1e300"));
     Write(d / "typo.yaml", EditedPaper("link_mass_kg", "link_mas_kg"));
     Write(d / "syntax.yaml", "schema: ccsrm-config/1\narm: [unclosed\n");
+    // Layouts whose cables cannot bend segment 2 about both axes (issue 32).
+    Write(d / "nocable.yaml", EditedThreeSegment("    - \\{segment: 2, hole_angle_deg: 40.0\\}\n"
+                                                 "    - \\{segment: 2, hole_angle_deg: 160.0\\}\n"
+                                                 "    - \\{segment: 2, hole_angle_deg: 280.0\\}\n",
+                                                 ""));
+    Write(d / "twocables.yaml",
+          EditedThreeSegment("    - \\{segment: 2, hole_angle_deg: 280.0\\}\n", ""));
+    Write(d / "samehole.yaml", EditedThreeSegment("hole_angle_deg: 160.0", "hole_angle_deg: 40.0"));
+    Write(d / "halfplane.yaml",
+          EditedThreeSegment("hole_angle_deg: 280.0", "hole_angle_deg: 100.0"));
     fs::create_directory(d / "confdir");
     Write(d / "p.yaml", "mu: 0.2\n");
     Write(d / "pbounds.yaml", "mu: {value: 0.5, free: true, bounds: [0.1, 0.3]}\n");
@@ -210,6 +228,22 @@ const std::vector<BadInput>& Rows() {
       {"configs", "config check {d}/typo.yaml", {"{d}/typo.yaml", "link_mas_kg"}},
       {"configs", "config check {d}/syntax.yaml", {"{d}/syntax.yaml", "line"}},
       {"configs", "config check {d}/missing.yaml", {"{d}/missing.yaml"}},
+      // Layouts: a segment its cables cannot bend about both axes (issue 32).
+      {"configs",
+       "config check {d}/nocable.yaml",
+       {"{d}/nocable.yaml", "arm.segments[1]", "segment 2", "no driving cable"}},
+      {"configs",
+       "config check {d}/twocables.yaml",
+       {"{d}/twocables.yaml", "segment 2", "2 driving cables"}},
+      {"configs",
+       "config check {d}/samehole.yaml",
+       {"{d}/samehole.yaml", "segment 2", "coincident holes"}},
+      {"configs",
+       "config check {d}/halfplane.yaml",
+       {"{d}/halfplane.yaml", "segment 2", "half-plane"}},
+      {"configs",
+       "simulate --config {d}/halfplane.yaml --duration 0.1 --out {d}/run2.h5",
+       {"{d}/halfplane.yaml", "segment 2", "half-plane"}},
       // Command-line values and parameter files.
       {"overrides",
        "simulate --config {d}/c.yaml --set mu=1e-400 --duration 0.1 --out {d}/run2.h5",
