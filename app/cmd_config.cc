@@ -52,7 +52,7 @@ void RunConfigCheck(const std::string& path) {
   if (effects.empty()) std::printf("  effects: none on\n");
   for (const std::string& effect : effects) {
     std::string values;
-    for (const std::string& name : sim::FindEffect(effect, path).parameters) {
+    for (const std::string& name : sim::EffectParameterNames(effect, c.parameters.arm, path)) {
       char item[96];
       std::snprintf(item, sizeof(item), "%s%s %.4g", values.empty() ? "" : ", ",
                     name.substr(effect.size() + 1).c_str(), sim::GetParameter(c.parameters, name));

@@ -715,13 +715,18 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
   std::vector<sim::ArmParameters> base;
   for (const Experiment& e : experiments) {
     sim::ArmParameters p = e.config.parameters;
-    for (const auto& [name, value] : options.values) SetParameter(name, value, "--set", &p);
+    // Names are checked against the experiments' arm here, where it is known.
+    for (const auto& [name, value] : options.values) {
+      SetParameter(name, value, "the values given (--set, --params), on the arm of " + e.path, &p);
+    }
     base.push_back(p);
   }
+  const sim::ArmSize arm = base.front().arm;
   // The free parameters: start from the first experiment's value.
   std::vector<FreeParameter> free;
   for (const std::string& name : options.free_parameters) {
-    const sim::ParameterInfo& info = sim::FindParameter(name, "--free");
+    const sim::ParameterInfo& info =
+        sim::FindParameter(name, "--free, on the arm of " + experiments.front().path, arm);
     FreeParameter f;
     f.name = name;
     f.lower = info.lower;
@@ -950,7 +955,7 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
   const double t975 =
       internal::StudentT975(summary.effective_samples - static_cast<double>(p_count));
   for (std::size_t i = 0; i < p_count; ++i) {
-    const sim::ParameterInfo& info = sim::FindParameter(free[i].name, "--free");
+    const sim::ParameterInfo& info = sim::FindParameter(free[i].name, "--free", arm);
     ParameterEstimate est;
     est.name = free[i].name;
     est.units = info.units;
@@ -975,7 +980,7 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     summary.parameters.push_back(est);
   }
   // Fixed: every model parameter, and the parameters of the effects that are on.
-  for (const sim::ParameterInfo& info_entry : sim::AllParameters()) {
+  for (const sim::ParameterInfo& info_entry : sim::AllParameters(arm)) {
     const std::string& name = info_entry.name;
     if (std::find(summary.free_names.begin(), summary.free_names.end(), name) !=
         summary.free_names.end()) {
@@ -983,7 +988,7 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     }
     const std::size_t dot = name.find('.');
     if (dot != std::string::npos && !base.front().EffectOn(name.substr(0, dot))) continue;
-    const sim::ParameterInfo& info = sim::FindParameter(name, "parameters");
+    const sim::ParameterInfo& info = sim::FindParameter(name, "parameters", arm);
     ParameterEstimate est;
     est.name = name;
     est.units = info.units;

@@ -656,9 +656,18 @@ void ValidateWithLines(const Config& c, const LineMap* lines) {
     const std::string problem = ParameterValueProblem(p, c.parameters.*p.field);
     if (!problem.empty()) check.Fail(p.config_key, problem);
   }
+  // The parameters' per-joint and per-cable lists are this arm's (an arm
+  // edited in code after LoadConfig must say so: parameters.arm = arm.size()).
+  if (c.parameters.arm != c.arm.size()) {
+    check.Fail("effects", "the parameters are sized for an arm of " +
+                              std::to_string(c.parameters.arm.joints) + " joints and " +
+                              std::to_string(c.parameters.arm.cables) + " driving cables, the arm has " +
+                              std::to_string(c.arm.size().joints) + " and " +
+                              std::to_string(c.arm.size().cables));
+  }
   // Effect parameters, by their key under `effects:`.
   for (const auto& [name, value] : c.parameters.effect_values) {
-    const ParameterInfo& p = FindParameter(name, c.source_name);
+    const ParameterInfo& p = FindParameter(name, c.source_name, c.arm.size());
     const std::string problem = ParameterValueProblem(p, value);
     if (!problem.empty()) check.Fail(p.config_key, problem);
   }
@@ -682,6 +691,10 @@ int ArmConfig::total_links() const {
   int n = 0;
   for (const auto& s : segments) n += s.links;
   return n;
+}
+
+ArmSize ArmConfig::size() const {
+  return ArmSize{total_links(), static_cast<int>(driving.cables.size())};
 }
 
 int ArmConfig::segment_of_link(int link) const {
@@ -758,6 +771,8 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
       dc.cables.push_back(route);
     });
     d.Finish();
+    // The effects' per-joint and per-cable parameters are this arm's.
+    c.parameters.arm = c.arm.size();
   }
   {
     MapReader k = top.Section("connecting_cables");
@@ -950,7 +965,7 @@ std::string ToYaml(const Config& c) {
     for (const EffectInfo& e : Effects()) {
       if (!c.parameters.EffectOn(e.name)) continue;
       out << YAML::Key << e.name << YAML::Value << YAML::BeginMap;
-      for (const std::string& name : e.parameters) {
+      for (const std::string& name : EffectParameterNames(e.name, c.parameters.arm)) {
         out << YAML::Key << name.substr(e.name.size() + 1) << YAML::Value
             << GetParameter(c.parameters, name);
       }

@@ -87,6 +87,9 @@ struct ArmConfig {
   ConnectingCableConfig connecting;
 
   int total_links() const;
+  // Its joints (= links) and driving cables: what sizes the effects'
+  // per-joint and per-cable parameters (ArmParameters::arm).
+  ArmSize size() const;
   // Index (0-based) of the segment that holds link `link` (1-based).
   int segment_of_link(int link) const;
 };
