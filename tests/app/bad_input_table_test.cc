@@ -161,11 +161,21 @@ class BadInputTable : public ::testing::Test {
     o = RunCcsrm("simulate --config " + Paper() + " --case 1 --duration 0.2 --quiet --out " +
                  (w / "run.h5").string());
     ASSERT_EQ(o.status, 0) << o.err;
-    for (const char* name : {"exp.h5", "processed.h5", "run.h5"}) fs::rename(w / name, d / name);
+    // The second arm's (nine cables): the paper's six-cable inputs do not fit it.
+    o = RunCcsrm("generate --config " + std::string(CCSRM_SOURCE_DIR) +
+                 "/configs/three-segment.yaml --case 1 --duration 0.3 --quiet --seed 3 --out " +
+                 (w / "exp9.h5").string());
+    ASSERT_EQ(o.status, 0) << o.err;
+    for (const char* name : {"exp.h5", "processed.h5", "run.h5", "exp9.h5"}) {
+      fs::rename(w / name, d / name);
+    }
     const fs::path processed = d / "processed.h5";
     MutateHdf5(processed, d / "five.h5",
                "put('/input/length_change', f['/input/length_change'][:, :5])");
     MutateHdf5(processed, d / "badyaml.h5", "f.attrs['config_yaml'] = 'arm: [unclosed'");
+    MutateHdf5(processed, d / "nanlength.h5",
+               "x = f['/input/length_change'][...]\nx[3, 2] = np.nan\n"
+               "put('/input/length_change', x)");
     MutateHdf5(processed, d / "huge.h5",
                "put('/measured/joint_angles', f['/measured/joint_angles'][...] * 1e30)");
     MutateHdf5(processed, d / "cut5.h5",
@@ -306,6 +316,22 @@ const std::vector<BadInput>& Rows() {
       {"hdf5",
        "mocap process --in {d}/exp.h5 --inputs {d}/five.h5 --out {d}/x.h5",
        {"{d}/five.h5", "/input/length_change"}},  // 5
+      // Inputs are checked against the arm where they enter (issue 32).
+      {"hdf5",
+       "mocap process --in {d}/exp9.h5 --inputs {d}/exp.h5 --out {d}/x.h5",
+       {"{d}/exp.h5", "/input/length_change", "6 cable columns", "9 driving cables"}},
+      {"hdf5",
+       "mocap process --in {d}/exp9.h5 --inputs {d}/run.h5 --out {d}/x.h5",
+       {"{d}/run.h5", "/input_length_change", "6 cable columns", "9 driving cables"}},
+      {"hdf5",
+       "mocap process --in {d}/exp.h5 --inputs {d}/nanlength.h5 --out {d}/x.h5",
+       {"{d}/nanlength.h5", "/input/length_change", "cable 3", "finite"}},
+      {"hdf5",
+       "dataset inspect {d}/nanlength.h5",
+       {"{d}/nanlength.h5", "/input/length_change", "finite"}},
+      {"hdf5",
+       "identify --data {d}/nanlength.h5 --out {d}/fit",
+       {"{d}/nanlength.h5", "/input/length_change", "finite"}},
       // Marker data.
       {"markers",
        "mocap process --in {d}/nan.h5 --out {d}/x.h5",
