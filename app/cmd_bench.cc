@@ -82,8 +82,7 @@ void AddBenchCommand(CLI::App& root) {
                           "Time the paper's case 2 (+6 deg, 48 s): wall time, real-time factor, "
                           "right-hand-side evaluations per second, steps, peak memory");
   auto a = std::make_shared<BenchArgs>();
-  cmd->add_option("--config", a->run.config_path, "Arm configuration (YAML)")
-      ->capture_default_str();
+  AddConfigOption(cmd, &a->run.config_path);
   cmd->add_option("--case", a->run.case_number, "Paper case 1..4")
       ->check(CLI::Range(1, 4))
       ->capture_default_str();
@@ -95,7 +94,10 @@ void AddBenchCommand(CLI::App& root) {
       ->capture_default_str()
       ->check(AtLeast(1));
   AddParameterOptions(cmd, &a->run);
-  cmd->callback([a] { RunBench(*a); });
+  cmd->callback([a] {
+    a->run.config_path = sim::ConfigPathOrBundled(a->run.config_path);
+    RunBench(*a);
+  });
 }
 
 }  // namespace ccsrm::app

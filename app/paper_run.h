@@ -7,8 +7,13 @@
 
 namespace ccsrm::app {
 
-// --config, --case, --amplitude and --duration.
+// --config, --case, --amplitude and --duration. Once parsed, an empty
+// --config is the bundled configs/paper.yaml (sim::ConfigPathOrBundled).
 void AddPaperRunOptions(CLI::App* command, sim::PaperRunOptions* options);
+
+// --config alone (its help names the bundled default), for a command with
+// options of its own.
+void AddConfigOption(CLI::App* command, std::string* config_path);
 
 // --params FILE and --set name=value (repeatable): named parameters (the
 // table of sim/parameters.h) applied after the case.

@@ -289,8 +289,8 @@ const std::vector<BadInput>& Rows() {
        "report --in {d}/run.h5 --instants -5 --out {d}/report",
        {"--instants", "-5"}},  // 8
       {"overrides", "report --in {d}/run.h5 --instants 1e4 --out {d}/report", {"--instants"}},
-      // From the test's working folder, outside the repository, where the
-      // default configuration is not found: the value is refused first.
+      // From the test's working folder, outside the repository: the value is
+      // refused before the (bundled) configuration is read.
       {"overrides", "bench --duration 0", {"--duration"}},  // 9
       {"overrides",
        "simulate --config {d}/c.yaml --amplitude 100 --duration 0.1 --out {d}/run2.h5",

@@ -8,6 +8,7 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/sim/paper_run.h"
 
 namespace ccsrm::sim {
 namespace {
@@ -346,6 +347,30 @@ TEST(Config, NonFiniteAndUnrepresentableNumbersAreRefused) {
               HasSubstr("'1e400' is outside the range of a double"));
   EXPECT_THAT(ErrorOf(Edited("cross_section_m2: 1.3273e-6", "cross_section_m2: 1e-400")),
               HasSubstr("key 'driving_cables.cross_section_m2': '1e-400' underflows"));
+}
+
+// Issue 32: the default --config was relative to the repository, so the bare
+// command failed anywhere else. The bundled files are found by path.
+TEST(Config, BundledConfigurationsAreFoundWhereverTheCommandRuns) {
+  EXPECT_EQ(BundledConfigPath("paper.yaml"), kPaperConfig);
+  EXPECT_EQ(ConfigPathOrBundled(""), kPaperConfig);
+  EXPECT_EQ(ConfigPathOrBundled("mine.yaml"), "mine.yaml");
+  EXPECT_EQ(BundledConfigPath("three-segment.yaml"),
+            std::string(CCSRM_SOURCE_DIR) + "/configs/three-segment.yaml");
+  // PreparePaperRun without a path reads it, and says which file it read.
+  PaperRunOptions options;
+  options.duration_s = 0.01;
+  EXPECT_EQ(PreparePaperRun(options).config_path, kPaperConfig);
+  // Neither place holds it: one line naming both, asking for --config.
+  try {
+    BundledConfigPath("none.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_THAT(message, HasSubstr("--config: not given, and the bundled none.yaml is in neither " +
+                                   std::string(CCSRM_SOURCE_DIR) + "/configs nor "));
+    EXPECT_THAT(message, HasSubstr("share/ccsrm/configs: pass --config FILE"));
+  }
 }
 
 TEST(Config, ValidateRejectsConfigBuiltInCode) {
