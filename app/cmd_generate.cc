@@ -292,6 +292,7 @@ int RunGenerate(const GenerateArgs& a) {
   WriteTextFileAtomically(truth_yaml_path,
                           TruthYaml(a, truth, duration, options.recording, generated));
 
+  std::printf("%s", sim::DescribeRun(run).c_str());
   std::printf("simulated %.4g s (case %s) in %.2f s wall\n", duration, case_name.c_str(),
               wall_time_s);
   std::string effects;

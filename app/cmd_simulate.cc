@@ -46,6 +46,7 @@ int RunSimulate(const SimulateArgs& a) {
       a.run.case_number != 0 ? std::to_string(a.run.case_number) : "custom";
   datasets::WriteRunFile(
       a.out, sim_io::ToRunFile(run.model, result, {case_name, sim::ToYaml(run.config)}));
+  std::printf("%s", sim::DescribeRun(run).c_str());
   std::printf("%s", result.summary.FullReport().c_str());
   std::printf("  output:                    %s (%zu frames)\n", a.out.c_str(),
               result.trajectory.size());

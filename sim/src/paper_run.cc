@@ -5,6 +5,7 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/sim/describe.h"
 
 namespace ccsrm::sim {
 
@@ -16,6 +17,14 @@ void ApplyPaperCase(int case_number, ArmParameters* parameters) {
   const bool connecting = case_number == 2 || case_number == 4;
   if (!driving) parameters->mu = parameters->mu_s = 0.0;
   if (!connecting) parameters->mu_c = parameters->mu_c_s = 0.0;
+}
+
+std::string DescribeRun(const PaperRun& run) {
+  const bool paper_arm = IsPaperArm(run.config.arm);
+  return "run: " + DescribeCase(run.case_number, paper_arm) + " on " +
+         (paper_arm ? "the paper's arm, " : "the arm of ") + run.config_path +
+         "\n  arm:                       " + DescribeArm(run.config.arm) +
+         "\n  protocol:                  " + DescribeProtocol(run.config.protocol) + "\n";
 }
 
 std::string BundledConfigPath(const std::string& name) {

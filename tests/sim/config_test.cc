@@ -8,6 +8,7 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/sim/describe.h"
 #include "ccsrm/sim/paper_run.h"
 
 namespace ccsrm::sim {
@@ -371,6 +372,31 @@ TEST(Config, BundledConfigurationsAreFoundWhereverTheCommandRuns) {
                                    std::string(CCSRM_SOURCE_DIR) + "/configs nor "));
     EXPECT_THAT(message, HasSubstr("share/ccsrm/configs: pass --config FILE"));
   }
+}
+
+// What decides whether a run may cite the paper: the paper's arm, however
+// its file is named or its friction and protocol are set.
+TEST(Describe, ThePapersArmIsRecognisedAndAnyArmIsNamedAsConfigured) {
+  const Config paper = LoadConfig(kPaperConfig);
+  const Config three = LoadConfig(std::string(CCSRM_SOURCE_DIR) + "/configs/three-segment.yaml");
+  EXPECT_TRUE(IsPaperArm(paper.arm));
+  EXPECT_TRUE(IsPaperArm(ParseConfig(ToYaml(paper), "written.yaml").arm));  // written back
+  EXPECT_TRUE(IsPaperArm(ParseConfig(Edited("friction_kinetic: 0.21", "friction_kinetic: 0.3"),
+                                     "mine.yaml")
+                             .arm));  // friction is not the arm
+  EXPECT_FALSE(IsPaperArm(three.arm));
+  EXPECT_FALSE(IsPaperArm(
+      ParseConfig(Edited("hole_angle_deg: 300.0", "hole_angle_deg: 290.0"), "m.yaml").arm));
+  EXPECT_FALSE(
+      IsPaperArm(ParseConfig(Edited("link_mass_kg: 0.070", "link_mass_kg: 0.071"), "m.yaml").arm));
+  EXPECT_EQ(DescribeArm(paper.arm), "2 segments of 6 and 6 links (12 joints), 6 driving cables");
+  EXPECT_EQ(DescribeArm(three.arm), "3 segments of 4, 4 and 4 links (12 joints), 9 driving cables");
+  EXPECT_EQ(DescribeProtocol(three.protocol),
+            "θx of every joint 0 → 8° along a quintic over 20 s, held 4 s, back over 20 s, at "
+            "rest 4 s; θy planned 0");
+  EXPECT_EQ(DescribeCase(2, true), "paper case 2 (friction on all cables)");
+  EXPECT_EQ(DescribeCase(1, false), "case 1 (no friction)");
+  EXPECT_EQ(DescribeCase(0, true), "friction as configured");
 }
 
 TEST(Config, ValidateRejectsConfigBuiltInCode) {

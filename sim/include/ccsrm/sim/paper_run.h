@@ -52,6 +52,11 @@ struct PaperRun {
 // file or value.
 PaperRun PreparePaperRun(const PaperRunOptions& options);
 
+// The run in words for any arm, the lines a command prints above the
+// simulation's summary: the case and the file (the paper's case only on the
+// paper's arm, sim/describe.h), the arm as configured and the protocol.
+std::string DescribeRun(const PaperRun& run);
+
 // The path of the configuration `name` ("paper.yaml") that ships with ccsrm:
 // in the configs/ folder of the source tree the program was built from, else
 // in the installed data folder (<prefix>/share/ccsrm/configs, where `cmake
