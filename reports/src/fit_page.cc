@@ -489,12 +489,12 @@ Figure ErrorFigure(const FitFolder& fit) {
         panel.x.tics.push_back({j, Show(j, NumberFormat::Integer())});
       if (against_motion) {
         Series motion;
-        motion.label = "motion (measured, RMS about its mean)";
+        motion.label = "motion";  // the caption says what it is
         motion.color = palette::kStart;
         motion.style = SeriesStyle::kBars;
         motion.bar_width = 0.38;
         Series error;
-        error.label = "RMS error fitted";
+        error.label = "fitted";
         error.color = palette::kFitted;
         error.style = SeriesStyle::kBars;
         error.bar_width = 0.38;
@@ -575,7 +575,8 @@ Section ErrorSection(const FitFolder& fit) {
     if (!AxisHasFitPercent(fit.errors, c)) {
       caption += std::string(" ") + AxisName(c) +
                  " barely moves at any joint, so its bottom panel shows, in degrees, its motion "
-                 "(grey) against the fitted RMS error (blue) instead of a fit percent.";
+                 "(grey: the RMS of the measured angles about their mean) against the fitted RMS "
+                 "error (blue) instead of a fit percent.";
     }
   }
   section.blocks.push_back(
