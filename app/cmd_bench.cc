@@ -47,6 +47,7 @@ void RunBench(const BenchArgs& a) {
   std::printf("ccsrm bench: case %d, %+.3g deg, %.4g s simulated, %d run(s), one thread\n",
               a.run.case_number, config.protocol.amplitude_rad * 180.0 / M_PI, options.duration_s,
               a.repeat);
+  std::printf("%s", sim::DescribeRun(run).c_str());
   std::vector<double> wall, rtf, rhs_rate;
   sim::SimulationSummary last;
   for (int k = 0; k < a.repeat; ++k) {
@@ -77,10 +78,11 @@ void RunBench(const BenchArgs& a) {
 }  // namespace
 
 void AddBenchCommand(CLI::App& root) {
-  CLI::App* cmd =
-      root.add_subcommand("bench",
-                          "Time the paper's case 2 (+6 deg, 48 s): wall time, real-time factor, "
-                          "right-hand-side evaluations per second, steps, peak memory");
+  CLI::App* cmd = root.add_subcommand(
+      "bench",
+      "Time case 2 of the configured arm and protocol (by default the paper's: +6 "
+      "deg, 48 s): wall time, real-time factor, "
+      "right-hand-side evaluations per second, steps, peak memory");
   auto a = std::make_shared<BenchArgs>();
   AddConfigOption(cmd, &a->run.config_path);
   cmd->add_option("--case", a->run.case_number, "Paper case 1..4")
