@@ -366,8 +366,7 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
         reduction = Reduction(r, a, &x) - base_reduction;
         bool changed = false;
         for (std::size_t k = 0; k < idx.size(); ++k) {
-          const sim::ParameterInfo& info =
-              sim::FindParameter(cols[idx[k]]->parameter, "loop", arm);
+          const sim::ParameterInfo& info = sim::FindParameter(cols[idx[k]]->parameter, "loop", arm);
           const double value = x[jb.cols() + static_cast<Eigen::Index>(k)];
           if (value < info.lower || value > info.upper) {
             active[idx[k]] = false;

@@ -659,11 +659,11 @@ void ValidateWithLines(const Config& c, const LineMap* lines) {
   // The parameters' per-joint and per-cable lists are this arm's (an arm
   // edited in code after LoadConfig must say so: parameters.arm = arm.size()).
   if (c.parameters.arm != c.arm.size()) {
-    check.Fail("effects", "the parameters are sized for an arm of " +
-                              std::to_string(c.parameters.arm.joints) + " joints and " +
-                              std::to_string(c.parameters.arm.cables) + " driving cables, the arm has " +
-                              std::to_string(c.arm.size().joints) + " and " +
-                              std::to_string(c.arm.size().cables));
+    check.Fail("effects",
+               "the parameters are sized for an arm of " + std::to_string(c.parameters.arm.joints) +
+                   " joints and " + std::to_string(c.parameters.arm.cables) +
+                   " driving cables, the arm has " + std::to_string(c.arm.size().joints) + " and " +
+                   std::to_string(c.arm.size().cables));
   }
   // Effect parameters, by their key under `effects:`.
   for (const auto& [name, value] : c.parameters.effect_values) {

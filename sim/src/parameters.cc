@@ -85,7 +85,8 @@ bool ArmParameters::IsValid(std::string* error) const {
     std::string beyond;
     const ParameterInfo* info = LookUp(name, &arm, &beyond);
     if (info == nullptr || !info->is_effect()) {
-      *error = "unknown effect parameter '" + name + "'" + (beyond.empty() ? "" : " (" + beyond + ")");
+      *error =
+          "unknown effect parameter '" + name + "'" + (beyond.empty() ? "" : " (" + beyond + ")");
       return false;
     }
     const std::string problem = ParameterValueProblem(*info, value);
