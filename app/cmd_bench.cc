@@ -41,11 +41,13 @@ double Median(std::vector<double> v) {
 void RunBench(const BenchArgs& a) {
   if (a.repeat < 1) ThrowInputError("--repeat", "", "must be >= 1");
   const sim::PaperRun run = sim::PreparePaperRun(a.run);
+  PrintConfigWarnings(run.config);
   const sim::Config& config = run.config;
   const sim::SimulationOptions& options = run.simulation;
   std::printf("ccsrm bench: case %d, %+.3g deg, %.4g s simulated, %d run(s), one thread\n",
               a.run.case_number, config.protocol.amplitude_rad * 180.0 / M_PI, options.duration_s,
               a.repeat);
+  std::printf("%s", sim::DescribeRun(run).c_str());
   std::vector<double> wall, rtf, rhs_rate;
   sim::SimulationSummary last;
   for (int k = 0; k < a.repeat; ++k) {
@@ -76,13 +78,13 @@ void RunBench(const BenchArgs& a) {
 }  // namespace
 
 void AddBenchCommand(CLI::App& root) {
-  CLI::App* cmd =
-      root.add_subcommand("bench",
-                          "Time the paper's case 2 (+6 deg, 48 s): wall time, real-time factor, "
-                          "right-hand-side evaluations per second, steps, peak memory");
+  CLI::App* cmd = root.add_subcommand(
+      "bench",
+      "Time case 2 of the configured arm and protocol (by default the paper's: +6 "
+      "deg, 48 s): wall time, real-time factor, "
+      "right-hand-side evaluations per second, steps, peak memory");
   auto a = std::make_shared<BenchArgs>();
-  cmd->add_option("--config", a->run.config_path, "Arm configuration (YAML)")
-      ->capture_default_str();
+  AddConfigOption(cmd, &a->run.config_path);
   cmd->add_option("--case", a->run.case_number, "Paper case 1..4")
       ->check(CLI::Range(1, 4))
       ->capture_default_str();
@@ -94,7 +96,10 @@ void AddBenchCommand(CLI::App& root) {
       ->capture_default_str()
       ->check(AtLeast(1));
   AddParameterOptions(cmd, &a->run);
-  cmd->callback([a] { RunBench(*a); });
+  cmd->callback([a] {
+    a->run.config_path = sim::ConfigPathOrBundled(a->run.config_path);
+    RunBench(*a);
+  });
 }
 
 }  // namespace ccsrm::app

@@ -18,7 +18,14 @@ void RunConfigCheck(const std::string& path) {
   const sim::ArmModel model(c.arm);
   int holes = 0;
   for (const auto& cable : model.cables()) holes += cable.num_holes();
-  std::printf("%s: ok\n", path.c_str());
+  // Far outside the range of such arms: said, with the reason, not refused.
+  if (c.warnings.empty()) {
+    std::printf("%s: ok\n", path.c_str());
+  } else {
+    std::printf("%s: ok, %zu warning%s\n", path.c_str(), c.warnings.size(),
+                c.warnings.size() == 1 ? "" : "s");
+  }
+  for (const std::string& w : c.warnings) std::printf("  warning: %s\n", w.c_str());
   std::printf("  segments: %zu, links: %d, universal joints: %d\n", c.arm.segments.size(),
               c.arm.total_links(), c.arm.total_links());
   for (const auto& s : c.arm.segments) {
@@ -45,7 +52,7 @@ void RunConfigCheck(const std::string& path) {
   if (effects.empty()) std::printf("  effects: none on\n");
   for (const std::string& effect : effects) {
     std::string values;
-    for (const std::string& name : sim::FindEffect(effect, path).parameters) {
+    for (const std::string& name : sim::EffectParameterNames(effect, c.parameters.arm, path)) {
       char item[96];
       std::snprintf(item, sizeof(item), "%s%s %.4g", values.empty() ? "" : ", ",
                     name.substr(effect.size() + 1).c_str(), sim::GetParameter(c.parameters, name));

@@ -139,6 +139,7 @@ int RunDerivatives(const DerivativesArgs& a) {
   }
 
   const sim::PaperRun run = sim::PreparePaperRun(a.run);
+  PrintConfigWarnings(run.config);
   // A parameter at 0 (the friction a case switches off) is stepped relative
   // to its value in the configuration file as written.
   const sim::ArmParameters nominal =

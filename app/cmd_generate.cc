@@ -57,15 +57,19 @@ std::string FormatNumber(double v) {
   return text;
 }
 
-// ccsrm generate --list-effects [--json]: every effect with its parameters,
-// units, bounds, default and realistic magnitude.
-void ListEffects(bool json) {
+// ccsrm generate --list-effects [--json] [--config FILE]: every effect with
+// its parameters on the arm of the configuration (per-joint and per-cable
+// ones for each of its joints and cables), units, bounds, default and
+// realistic magnitude.
+void ListEffects(bool json, const std::string& config_path) {
+  const sim::Config config = sim::LoadConfig(config_path);
+  const sim::ArmSize arm = config.parameters.arm;
   if (json) {
     nlohmann::json effects = nlohmann::json::array();
     for (const sim::EffectInfo& e : sim::Effects()) {
       nlohmann::json parameters = nlohmann::json::array();
-      for (const std::string& name : e.parameters) {
-        const sim::ParameterInfo& p = sim::FindParameter(name, "--list-effects");
+      for (const std::string& name : sim::EffectParameterNames(e.name, arm)) {
+        const sim::ParameterInfo& p = sim::FindParameter(name, "--list-effects", arm);
         parameters.push_back({{"name", p.name},
                               {"units", p.units},
                               {"lower", p.lower},
@@ -79,14 +83,18 @@ void ListEffects(bool json) {
                          {"measurement", e.measurement},
                          {"parameters", parameters}});
     }
-    std::printf("%s\n", nlohmann::json{{"effects", effects}}.dump(2).c_str());
+    const nlohmann::json about = {
+        {"config", config_path}, {"joints", arm.joints}, {"driving_cables", arm.cables}};
+    std::printf("%s\n", nlohmann::json{{"arm", about}, {"effects", effects}}.dump(2).c_str());
     return;
   }
+  std::printf("effects on the arm of %s (%d joints, %d driving cables)\n", config_path.c_str(),
+              arm.joints, arm.cables);
   for (const sim::EffectInfo& e : sim::Effects()) {
     std::printf("%s%s: %s\n", e.name.c_str(), e.measurement ? " (measurement)" : "",
                 e.description.c_str());
-    for (const std::string& name : e.parameters) {
-      const sim::ParameterInfo& p = sim::FindParameter(name, "--list-effects");
+    for (const std::string& name : sim::EffectParameterNames(e.name, arm)) {
+      const sim::ParameterInfo& p = sim::FindParameter(name, "--list-effects", arm);
       const std::string bounds =
           "[" + FormatNumber(p.lower) + ", " + FormatNumber(p.upper) + "] " + p.units;
       std::printf("  %-36s %-24s default %-7s realistic %-8s %s\n", p.name.c_str(), bounds.c_str(),
@@ -134,7 +142,8 @@ std::string TruthYaml(const GenerateArgs& a, const sim::Config& truth, double du
   out << YAML::Value << YAML::BeginMap;
   for (const std::string& effect : truth.parameters.EnabledEffects()) {
     out << YAML::Key << effect << YAML::Value << YAML::BeginMap;
-    for (const std::string& name : sim::FindEffect(effect, "truth").parameters) {
+    for (const std::string& name :
+         sim::EffectParameterNames(effect, truth.parameters.arm, "truth")) {
       out << YAML::Key << name.substr(effect.size() + 1) << YAML::Value
           << sim::GetParameter(truth.parameters, name);
     }
@@ -163,7 +172,7 @@ std::string TruthYaml(const GenerateArgs& a, const sim::Config& truth, double du
 
 int RunGenerate(const GenerateArgs& a) {
   if (a.list_effects) {
-    ListEffects(a.json);
+    ListEffects(a.json, a.run.config_path);
     return 0;
   }
   if (a.out.empty()) ThrowInputError("--out", "", "is required (or --list-effects)");
@@ -183,6 +192,7 @@ int RunGenerate(const GenerateArgs& a) {
   // is that configuration with the case, amplitude and parameters applied.
   // Effects join the truth only.
   const sim::PaperRun run = sim::PreparePaperRun(a.run);
+  PrintConfigWarnings(run.config);
   sim::Config truth = run.config;
   if (!a.effects_path.empty()) {
     sim::ApplyEffectsYaml(ReadTextFile(a.effects_path), a.effects_path, &truth.parameters);
@@ -282,6 +292,7 @@ int RunGenerate(const GenerateArgs& a) {
   WriteTextFileAtomically(truth_yaml_path,
                           TruthYaml(a, truth, duration, options.recording, generated));
 
+  std::printf("%s", sim::DescribeRun(run).c_str());
   std::printf("simulated %.4g s (case %s) in %.2f s wall\n", duration, case_name.c_str(),
               wall_time_s);
   std::string effects;
@@ -325,7 +336,8 @@ void AddGenerateCommand(CLI::App& root) {
                   "An effect on: NAME (at its realistic magnitude) or NAME:param=value,... "
                   "(the others at their defaults); repeatable, after --effects");
   cmd->add_flag("--list-effects", a->list_effects,
-                "List the effects, their parameters, units, bounds and realistic magnitudes");
+                "List the effects, their parameters on the arm of --config (one per joint or "
+                "cable where an effect has such), units, bounds and realistic magnitudes");
   cmd->add_flag("--json", a->json, "With --list-effects: one JSON object");
   cmd->add_option("--out", a->out, "Output experiment (.h5)");
   cmd->add_flag("--quiet", a->quiet, "No progress lines");

@@ -30,6 +30,7 @@ int RunSimulate(const SimulateArgs& a) {
   // Check the output path before spending minutes on the run.
   CheckOut(a.out, RunFileOutput(), {a.run.config_path, a.run.params_path});
   const sim::PaperRun run = sim::PreparePaperRun(a.run);
+  PrintConfigWarnings(run.config);
   sim::SimulationOptions options = run.simulation;
   if (!a.quiet) {
     options.progress = [](const sim::SimulationProgress& p) {
@@ -45,6 +46,7 @@ int RunSimulate(const SimulateArgs& a) {
       a.run.case_number != 0 ? std::to_string(a.run.case_number) : "custom";
   datasets::WriteRunFile(
       a.out, sim_io::ToRunFile(run.model, result, {case_name, sim::ToYaml(run.config)}));
+  std::printf("%s", sim::DescribeRun(run).c_str());
   std::printf("%s", result.summary.FullReport().c_str());
   std::printf("  output:                    %s (%zu frames)\n", a.out.c_str(),
               result.trajectory.size());

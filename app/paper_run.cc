@@ -1,6 +1,7 @@
 #include "paper_run.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include "option_checks.h"
 
@@ -13,8 +14,7 @@ void AddPaperRunOptions(CLI::App* command, sim::PaperRunOptions* args) {
   // reads as "not given", is refused). sim::PreparePaperRun checks them
   // again with the configuration's own rules (sim/src/config.cc), naming the
   // option too; keep the bounds here in step with those.
-  command->add_option("--config", args->config_path, "Arm configuration (YAML)")
-      ->capture_default_str();
+  AddConfigOption(command, &args->config_path);
   command
       ->add_option("--case", args->case_number,
                    "Paper case: 1 no friction, 2 all friction, 3 driving cables only, 4 "
@@ -30,10 +30,21 @@ void AddPaperRunOptions(CLI::App* command, sim::PaperRunOptions* args) {
       ->check(Above(0.0, "s"));
   // --output-rate (simulate) is registered by its command, after these; its
   // value lands in *args, so it is checked with them once parsing is done.
+  // Without --config, the bundled configuration, found wherever the command
+  // runs (its path is what the command names in messages and outputs).
   command->parse_complete_callback([args] {
-    if (std::isnan(args->output_rate_hz)) return;                          // not given
-    CheckInRange("--output-rate", args->output_rate_hz, 1e-3, 1e5, "Hz");  // solver.output_rate_hz
+    if (!std::isnan(args->output_rate_hz)) {
+      CheckInRange("--output-rate", args->output_rate_hz, 1e-3, 1e5,
+                   "Hz");  // solver.output_rate_hz
+    }
+    args->config_path = sim::ConfigPathOrBundled(args->config_path);
   });
+}
+
+void AddConfigOption(CLI::App* command, std::string* config_path) {
+  command->add_option("--config", *config_path,
+                      "Arm configuration (YAML); default: the bundled paper.yaml, from the "
+                      "source tree's configs/ or the installed share/ccsrm/configs");
 }
 
 void AddParameterOptions(CLI::App* command, sim::PaperRunOptions* args) {
@@ -48,6 +59,11 @@ void AddParameterOptions(CLI::App* command, sim::PaperRunOptions* args) {
   command->add_option("--params", args->params_path,
                       "YAML file of parameter values (name: value, or a truth file's "
                       "'parameters:')");
+}
+
+void PrintConfigWarnings(const sim::Config& config) {
+  for (const std::string& w : config.warnings)
+    std::fprintf(stderr, "ccsrm: warning: %s\n", w.c_str());
 }
 
 }  // namespace ccsrm::app

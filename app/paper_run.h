@@ -7,11 +7,20 @@
 
 namespace ccsrm::app {
 
-// --config, --case, --amplitude and --duration.
+// --config, --case, --amplitude and --duration. Once parsed, an empty
+// --config is the bundled configs/paper.yaml (sim::ConfigPathOrBundled).
 void AddPaperRunOptions(CLI::App* command, sim::PaperRunOptions* options);
+
+// --config alone (its help names the bundled default), for a command with
+// options of its own.
+void AddConfigOption(CLI::App* command, std::string* config_path);
 
 // --params FILE and --set name=value (repeatable): named parameters (the
 // table of sim/parameters.h) applied after the case.
 void AddParameterOptions(CLI::App* command, sim::PaperRunOptions* options);
+
+// Prints the configuration's warnings (sim::Config::warnings: values far
+// outside the range of such arms) on stderr, "ccsrm: warning: ..." each.
+void PrintConfigWarnings(const sim::Config& config);
 
 }  // namespace ccsrm::app

@@ -31,10 +31,12 @@ nlohmann::json Number(double value) {
 nlohmann::json ChannelJson(const ChannelErrors& e) {
   nlohmann::json joints = nlohmann::json::array();
   for (std::size_t j = 0; j < e.rms_deg.size(); ++j) {
-    joints.push_back({{"joint", j + 1},
-                      {"rms_deg", {Number(e.rms_deg[j][0]), Number(e.rms_deg[j][1])}},
-                      {"fit_percent", {Number(e.fit_percent[j][0]), Number(e.fit_percent[j][1])}},
-                      {"samples", {e.samples[j][0], e.samples[j][1]}}});
+    joints.push_back(
+        {{"joint", j + 1},
+         {"rms_deg", {Number(e.rms_deg[j][0]), Number(e.rms_deg[j][1])}},
+         {"fit_percent", {Number(e.fit_percent[j][0]), Number(e.fit_percent[j][1])}},
+         {"motion_rms_deg", {Number(e.motion_rms_deg[j][0]), Number(e.motion_rms_deg[j][1])}},
+         {"samples", {e.samples[j][0], e.samples[j][1]}}});
   }
   return {{"rms_deg", Number(e.rms_deg_overall)},
           {"fit_percent", Number(e.fit_percent_overall)},
@@ -130,15 +132,26 @@ std::string IdentificationSummary::FullReport() const {
           << Format("%.3g", d.relative_std_error) << ")\n";
     }
   }
-  out << "\n  joint   RMS θx [deg]   RMS θy [deg]   fit θx [%]   fit θy [%]\n";
+  out << "\n  joint   RMS θx [deg]   RMS θy [deg]   motion θx [deg]  motion θy [deg]  fit θx [%]   "
+         "fit θy [%]\n";
+  bool barely_moves = false;
   for (std::size_t j = 0; j < errors.rms_deg.size(); ++j) {
     char line[256];
-    std::snprintf(line, sizeof(line), "  %5zu   %-14s %-14s %-12s %s\n", j + 1,
+    std::snprintf(line, sizeof(line), "  %5zu   %-14s %-14s %-16s %-16s %-12s %s\n", j + 1,
                   Format("%.4f", errors.rms_deg[j][0]).c_str(),
                   Format("%.4f", errors.rms_deg[j][1]).c_str(),
+                  Format("%.4f", errors.motion_rms_deg[j][0]).c_str(),
+                  Format("%.4f", errors.motion_rms_deg[j][1]).c_str(),
                   Format("%.1f", errors.fit_percent[j][0]).c_str(),
                   Format("%.1f", errors.fit_percent[j][1]).c_str());
     out << line;
+    for (int a = 0; a < 2; ++a)
+      barely_moves = barely_moves || !std::isfinite(errors.fit_percent[j][a]);
+  }
+  if (barely_moves) {
+    out << "  fit -: the axis barely moves (its motion, RMS about its mean, is under a tenth of "
+           "the "
+           "joint's larger or three times its noise); read its RMS error against its motion\n";
   }
   out << "\n";
   for (const ExperimentFit& e : experiments) {

@@ -561,12 +561,25 @@ ChannelErrors AngleErrors(const std::vector<const Experiment*>& experiments,
   ChannelErrors out;
   out.rms_deg.assign(static_cast<std::size_t>(joints), {kNaN, kNaN});
   out.fit_percent.assign(static_cast<std::size_t>(joints), {kNaN, kNaN});
+  out.motion_rms_deg.assign(static_cast<std::size_t>(joints), {kNaN, kNaN});
   out.samples.assign(static_cast<std::size_t>(joints), {0, 0});
-  double total_sq = 0.0, total_spread = 0.0;
-  std::size_t total_n = 0;
+  // Per joint and axis: squared error and squared spread about each
+  // series' mean [deg^2] summed over the experiments, and the samples.
+  std::vector<std::array<double, 2>> sq(static_cast<std::size_t>(joints), {0.0, 0.0});
+  std::vector<std::array<double, 2>> spread(static_cast<std::size_t>(joints), {0.0, 0.0});
+  std::vector<double> noise(static_cast<std::size_t>(joints), 0.0);
   for (int j = 0; j < joints; ++j) {
+    const std::size_t jj = static_cast<std::size_t>(j);
+    std::size_t with_noise = 0;
+    for (const Experiment* x : experiments) {
+      if (x->joints == joints && jj < x->noise_deg.size()) {
+        noise[jj] += x->noise_deg[jj];
+        ++with_noise;
+      }
+    }
+    if (with_noise > 0) noise[jj] /= static_cast<double>(with_noise);
     for (int a = 0; a < 2; ++a) {
-      double sq = 0.0, spread = 0.0;
+      const std::size_t aa = static_cast<std::size_t>(a);
       std::size_t n = 0;
       for (std::size_t e = 0; e < experiments.size(); ++e) {
         const Eigen::MatrixXd& meas = experiments[e]->measured_rad;
@@ -587,25 +600,39 @@ ChannelErrors AngleErrors(const std::vector<const Experiment*>& experiments,
           const double m = meas(f, 2 * j + a);
           if (!std::isfinite(m)) continue;
           const double d = ((*simulated[e])(f, 2 * j + a) - m) * kDeg;
-          sq += d * d;
-          spread += (m - mean) * (m - mean) * kDeg * kDeg;
+          sq[jj][aa] += d * d;
+          spread[jj][aa] += (m - mean) * (m - mean) * kDeg * kDeg;
           ++n;
         }
       }
-      const std::size_t jj = static_cast<std::size_t>(j), aa = static_cast<std::size_t>(a);
       out.samples[jj][aa] = n;
       if (n > 0) {
-        out.rms_deg[jj][aa] = std::sqrt(sq / static_cast<double>(n));
-        out.fit_percent[jj][aa] = spread > 0.0 ? 100.0 * (1.0 - std::sqrt(sq / spread)) : kNaN;
+        out.rms_deg[jj][aa] = std::sqrt(sq[jj][aa] / static_cast<double>(n));
+        out.motion_rms_deg[jj][aa] = std::sqrt(spread[jj][aa] / static_cast<double>(n));
       }
-      total_sq += sq;
-      total_spread += spread;
-      total_n += n;
+    }
+  }
+  double total_sq = 0.0, total_spread = 0.0, fitted_sq = 0.0;
+  std::size_t total_n = 0;
+  for (std::size_t j = 0; j < out.rms_deg.size(); ++j) {
+    const double larger = std::max(out.motion_rms_deg[j][0], out.motion_rms_deg[j][1]);
+    for (std::size_t a = 0; a < 2; ++a) {
+      total_sq += sq[j][a];
+      total_n += out.samples[j][a];
+      const double motion = out.motion_rms_deg[j][a];
+      // ChannelErrors says when an axis moves enough for a fit percent.
+      if (!(motion > 0.0) || motion < kFitMotionShare * larger ||
+          motion < kFitMotionNoiseRatio * noise[j]) {
+        continue;
+      }
+      out.fit_percent[j][a] = 100.0 * (1.0 - std::sqrt(sq[j][a] / spread[j][a]));
+      fitted_sq += sq[j][a];
+      total_spread += spread[j][a];
     }
   }
   out.rms_deg_overall = total_n > 0 ? std::sqrt(total_sq / static_cast<double>(total_n)) : kNaN;
   out.fit_percent_overall =
-      total_spread > 0.0 ? 100.0 * (1.0 - std::sqrt(total_sq / total_spread)) : kNaN;
+      total_spread > 0.0 ? 100.0 * (1.0 - std::sqrt(fitted_sq / total_spread)) : kNaN;
   return out;
 }
 
@@ -715,13 +742,18 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
   std::vector<sim::ArmParameters> base;
   for (const Experiment& e : experiments) {
     sim::ArmParameters p = e.config.parameters;
-    for (const auto& [name, value] : options.values) SetParameter(name, value, "--set", &p);
+    // Names are checked against the experiments' arm here, where it is known.
+    for (const auto& [name, value] : options.values) {
+      SetParameter(name, value, "the values given (--set, --params), on the arm of " + e.path, &p);
+    }
     base.push_back(p);
   }
+  const sim::ArmSize arm = base.front().arm;
   // The free parameters: start from the first experiment's value.
   std::vector<FreeParameter> free;
   for (const std::string& name : options.free_parameters) {
-    const sim::ParameterInfo& info = sim::FindParameter(name, "--free");
+    const sim::ParameterInfo& info =
+        sim::FindParameter(name, "--free, on the arm of " + experiments.front().path, arm);
     FreeParameter f;
     f.name = name;
     f.lower = info.lower;
@@ -950,7 +982,7 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
   const double t975 =
       internal::StudentT975(summary.effective_samples - static_cast<double>(p_count));
   for (std::size_t i = 0; i < p_count; ++i) {
-    const sim::ParameterInfo& info = sim::FindParameter(free[i].name, "--free");
+    const sim::ParameterInfo& info = sim::FindParameter(free[i].name, "--free", arm);
     ParameterEstimate est;
     est.name = free[i].name;
     est.units = info.units;
@@ -975,7 +1007,7 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     summary.parameters.push_back(est);
   }
   // Fixed: every model parameter, and the parameters of the effects that are on.
-  for (const sim::ParameterInfo& info_entry : sim::AllParameters()) {
+  for (const sim::ParameterInfo& info_entry : sim::AllParameters(arm)) {
     const std::string& name = info_entry.name;
     if (std::find(summary.free_names.begin(), summary.free_names.end(), name) !=
         summary.free_names.end()) {
@@ -983,7 +1015,7 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     }
     const std::size_t dot = name.find('.');
     if (dot != std::string::npos && !base.front().EffectOn(name.substr(0, dot))) continue;
-    const sim::ParameterInfo& info = sim::FindParameter(name, "parameters");
+    const sim::ParameterInfo& info = sim::FindParameter(name, "parameters", arm);
     ParameterEstimate est;
     est.name = name;
     est.units = info.units;

@@ -30,10 +30,10 @@ std::string Format(const char* format, double value) {
 // dead band, a creep fraction, drag, offsets). Shape parameters (a smoothing
 // rate, a creep's time constant) default to their realistic value; they
 // stay there: at zero size they have no effect to fit.
-std::vector<std::string> SizeParameters(const std::string& effect) {
+std::vector<std::string> SizeParameters(const std::string& effect, const sim::ArmSize& arm) {
   std::vector<std::string> out;
-  for (const std::string& name : sim::FindEffect(effect, "--candidates").parameters) {
-    const sim::ParameterInfo& info = sim::FindParameter(name, "--candidates");
+  for (const std::string& name : sim::EffectParameterNames(effect, arm, "--candidates")) {
+    const sim::ParameterInfo& info = sim::FindParameter(name, "--candidates", arm);
     const bool shape = info.absent_value != 0.0 && info.absent_value == info.realistic;
     if (!shape) out.push_back(name);
   }
@@ -43,8 +43,8 @@ std::vector<std::string> SizeParameters(const std::string& effect) {
 // The secant step of a size parameter in the score test: its realistic
 // magnitude, which is inside its bounds and large enough to rise above the
 // solver's own noise.
-double ScoreStep(const std::string& name) {
-  const sim::ParameterInfo& info = sim::FindParameter(name, "--candidates");
+double ScoreStep(const std::string& name, const sim::ArmSize& arm) {
+  const sim::ParameterInfo& info = sim::FindParameter(name, "--candidates", arm);
   const double step = std::abs(info.realistic);
   return step > 0.0 ? step : 0.01 * (info.upper - info.lower);
 }
@@ -171,6 +171,8 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
     if (options.on_progress) options.on_progress({round, stage, candidate, message});
   };
 
+  // The arm of the experiments: how many per-joint parameters a candidate has.
+  const sim::ArmSize arm = training.front().config.parameters.arm;
   // The candidates: those given, else every effect the declared model has off.
   std::vector<std::string> candidates = options.candidates;
   if (candidates.empty()) {
@@ -282,8 +284,8 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
     std::vector<std::size_t> request_column;
     for (std::size_t c = 0; c < remaining.size(); ++c) {
       const bool measurement = sim::FindEffect(remaining[c], "--candidates").measurement;
-      for (const std::string& q : SizeParameters(remaining[c])) {
-        Column col{c, q, ScoreStep(q), {}};
+      for (const std::string& q : SizeParameters(remaining[c], arm)) {
+        Column col{c, q, ScoreStep(q, arm), {}};
         for (std::size_t e = 0; e < training.size(); ++e) {
           sim::ArmParameters p = current.experiments[e].parameters;
           sim::SetParameter(q, col.step, "loop", &p);
@@ -364,7 +366,7 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
         reduction = Reduction(r, a, &x) - base_reduction;
         bool changed = false;
         for (std::size_t k = 0; k < idx.size(); ++k) {
-          const sim::ParameterInfo& info = sim::FindParameter(cols[idx[k]]->parameter, "loop");
+          const sim::ParameterInfo& info = sim::FindParameter(cols[idx[k]]->parameter, "loop", arm);
           const double value = x[jb.cols() + static_cast<Eigen::Index>(k)];
           if (value < info.lower || value > info.upper) {
             active[idx[k]] = false;
@@ -417,8 +419,8 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       o.bounds.clear();
       for (const auto& [name, range] : options.fit.bounds) o.bounds[name] = range;
       for (const std::string& q : cand.parameters) {
-        const sim::ParameterInfo& info = sim::FindParameter(q, "loop");
-        const double scale = ScoreStep(q);
+        const sim::ParameterInfo& info = sim::FindParameter(q, "loop", arm);
+        const double scale = ScoreStep(q, arm);
         double start = cand.linearised.count(q) ? cand.linearised[q] : 0.0;
         // Start inside the bounds with room for a difference step.
         start = std::clamp(start, info.lower, info.upper);

@@ -13,6 +13,7 @@
 #include "ccsrm/datasets/run_file.h"
 #include "ccsrm/mocap/marker_io.h"
 #include "ccsrm/sim/config.h"
+#include "ccsrm/sim_io/experiment_check.h"
 
 namespace ccsrm::mocap {
 namespace {
@@ -139,27 +140,22 @@ ResolvedLayout ResolveLayout(const RecordingRequest& request, const Recording& r
   return out;
 }
 
-// /input/time and /input/length_change of a run or experiment file. With an
-// arm known (`model` not null, described by `arm_source`), its cable columns
-// must be the arm's driving cables: refused here, where the file is read.
+// /input/time and /input/length_change of a run or experiment file, checked
+// here, where the file is read (sim_io::CheckInputs: a finite, increasing
+// time base, finite lengths and, with an arm known (`model` not null,
+// described by `arm_source`), one column per driving cable of that arm).
 void CopyInputs(const std::string& path, const sim::ArmModel* model, const std::string& arm_source,
                 datasets::ExperimentFile* experiment) {
   const datasets::AnyFile file = datasets::ReadAnyFile(path);
-  std::string field = "/input/length_change";
   if (const auto* source = std::get_if<datasets::ExperimentFile>(&file)) {
+    sim_io::CheckInputs(*source, path, model, arm_source);
     experiment->input_time = source->input_time;
     experiment->input_length_change = source->input_length_change;
   } else {
     const datasets::RunFile& run = std::get<datasets::RunFile>(file);
+    sim_io::CheckInputs(run, path, model, arm_source);
     experiment->input_time = run.time;
     experiment->input_length_change = run.input_length_change;
-    field = "/input_length_change";
-  }
-  const std::size_t cables = experiment->input_length_change.shape[1];
-  if (model != nullptr && cables != static_cast<std::size_t>(model->num_cables())) {
-    ThrowInputError(path, field,
-                    "has " + std::to_string(cables) + " cable columns, the arm of " + arm_source +
-                        " has " + std::to_string(model->num_cables()) + " driving cables");
   }
 }
 
@@ -169,6 +165,28 @@ ProcessedRecording Process(const RecordingRequest& request, Recording recording)
   ProcessedRecording out;
   ResolvedLayout layout = ResolveLayout(request, recording);
   out.static_trial = std::move(layout.static_trial);
+  datasets::ExperimentFile& experiment = recording.experiment;
+  if (!request.inputs.empty() &&
+      !(recording.has_file_inputs && !request.in.empty() && SameFile(request.inputs, request.in))) {
+    // Read and checked first, before markers are reconstructed or processed:
+    // against the arm the experiment is written with (--config, else the
+    // input's own config_yaml: an experiment's, or a run's, which the layout
+    // may not have needed).
+    const std::string arm_source =
+        !request.config.empty() ? request.config : recording.source + " (its config_yaml)";
+    const std::string& written_yaml =
+        recording.from_experiment
+            ? experiment.config_yaml
+            : (!layout.config_yaml.empty() ? layout.config_yaml : recording.run_config_yaml);
+    const sim::ArmModel* arm = layout.model.get();
+    std::unique_ptr<sim::ArmModel> own_arm;
+    if (arm == nullptr && !written_yaml.empty()) {
+      own_arm = std::make_unique<sim::ArmModel>(
+          sim::ParseConfig(written_yaml, recording.source + ": attribute 'config_yaml'").arm);
+      arm = own_arm.get();
+    }
+    CopyInputs(request.inputs, arm, arm_source, &experiment);
+  }
   if (request.reconstruct) {
     ReconstructedMarkers reconstructed = request.reconstruct(layout.layout, layout.model.get());
     recording.table = std::move(reconstructed.markers);
@@ -178,7 +196,6 @@ ProcessedRecording Process(const RecordingRequest& request, Recording recording)
                               recording.source, layout.chain ? &*layout.chain : nullptr);
   const ProcessingResult& result = out.result;
 
-  datasets::ExperimentFile& experiment = recording.experiment;
   if (!recording.from_experiment) {
     experiment.name =
         !request.name.empty() ? request.name : fs::path(recording.source).stem().string();
@@ -195,12 +212,6 @@ ProcessedRecording Process(const RecordingRequest& request, Recording recording)
       experiment.input_time = datasets::Array({1}, result.time.front());
       experiment.input_length_change = datasets::Array({1, 0});
     }
-  }
-  if (!request.inputs.empty() &&
-      !(recording.has_file_inputs && !request.in.empty() && SameFile(request.inputs, request.in))) {
-    const std::string arm_source =
-        !request.config.empty() ? request.config : recording.source + " (its config_yaml)";
-    CopyInputs(request.inputs, layout.model.get(), arm_source, &experiment);
   }
   experiment.rigid_bodies = ToExperimentRigidBodies(layout.layout);
   experiment.mocap_quality.clear();

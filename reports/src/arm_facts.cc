@@ -5,6 +5,7 @@
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/sim/config.h"
+#include "ccsrm/sim/describe.h"
 #include "ccsrm/sim/kinematics.h"
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/protocol.h"
@@ -63,6 +64,9 @@ ArmFacts ReadArmFacts(const std::string& config_yaml, const std::string& source,
   const sim::ProtocolConfig& p = config.protocol;
   facts.protocol =
       ProtocolPhases{p.amplitude_rad * kDegPerRad, p.ramp_s, p.hold_s, p.return_s, p.rest_s};
+  facts.arm_words = sim::DescribeArm(arm);
+  facts.protocol_words = sim::DescribeProtocol(p);
+  facts.paper_arm = sim::IsPaperArm(arm);
   if (plan_times == nullptr || joints == 0) return facts;
   try {
     const sim::ArmModel model(config.arm);
@@ -82,6 +86,20 @@ ArmFacts ReadArmFacts(const std::string& config_yaml, const std::string& source,
                              e.what() + "): no plan is drawn.");
   }
   return facts;
+}
+
+int CaseNumber(const std::string& case_name) {
+  for (int k = 1; k <= 4; ++k) {
+    if (case_name == std::to_string(k)) return k;
+  }
+  return 0;
+}
+
+std::string CaseFriction(int case_number) { return sim::CaseFriction(case_number); }
+
+std::string CaseWords(const std::string& case_name, bool paper_arm) {
+  const int number = CaseNumber(case_name);
+  return number != 0 ? sim::DescribeCase(number, paper_arm) : "case '" + case_name + "'";
 }
 
 }  // namespace ccsrm::reports::internal

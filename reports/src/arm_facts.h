@@ -1,8 +1,9 @@
 #pragma once
 // What the report pages take from the simulator library: the arm's segments
-// and cable routing, the protocol's phases and, for a paper-case run, the
-// planned motion. All calls into ccsrm::sim live in ReadArmFacts, so a change
-// of the simulator's API touches one function.
+// and cable routing, the protocol's phases, the arm and protocol in words,
+// whether the arm is the paper's and, for a run of the protocol, the planned
+// motion. All calls into ccsrm::sim live in arm_facts.cc, so a change of the
+// simulator's API touches one file.
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -36,6 +37,13 @@ struct ArmFacts {
   // entries; all 0 in the fallback).
   std::vector<int> cable_segment;
   std::optional<ProtocolPhases> protocol;
+  // The arm and the protocol as configured, in words (sim/describe.h);
+  // empty when the configuration cannot be read.
+  std::string arm_words;
+  std::string protocol_words;
+  // The arm is the paper's (sim::IsPaperArm): only then may a page cite the
+  // paper's cases and figures.
+  bool paper_arm = false;
   // Planned joint angles at the requested times: T × J × 2 (θx, θy), rad.
   std::optional<datasets::Array> plan;
   // Why something above is missing, one sentence each (shown on the page).
@@ -50,5 +58,12 @@ struct ArmFacts {
 // is reported in `problems` and the facts fall back as documented above.
 ArmFacts ReadArmFacts(const std::string& config_yaml, const std::string& source, std::size_t joints,
                       std::size_t cables, const std::vector<double>* plan_times);
+
+// The friction case of a run file's `case` attribute ("1".."4"), 0 for any
+// other ("custom"), and its words: "paper case 2 (friction on all cables)"
+// on the paper's arm, "case 2 (friction on all cables)" on another.
+int CaseNumber(const std::string& case_name);
+std::string CaseFriction(int case_number);  // "no friction", ...
+std::string CaseWords(const std::string& case_name, bool paper_arm);
 
 }  // namespace ccsrm::reports::internal

@@ -44,10 +44,11 @@ body { font-family: "DejaVu Sans", "Segoe UI", Helvetica, Arial, sans-serif; col
 main { max-width: 1400px; margin: 0 auto; padding: 24px 32px 64px; background: #fff; }
 header h1 { font-size: 26px; margin: 0 0 6px; }
 header .meta { color: #555; font-size: 13px; }
-header .meta code { background: #f0f0f0; padding: 1px 4px; border-radius: 3px; }
+header .meta code { background: #f0f0f0; padding: 1px 4px; border-radius: 3px;
+                   overflow-wrap: anywhere; }
 nav { margin: 16px 0 8px; padding: 8px 12px; background: #f7f7f9; border: 1px solid #e3e3e8;
-      border-radius: 6px; font-size: 14px; }
-nav a { margin-right: 16px; color: #1f5fa8; text-decoration: none; white-space: nowrap; }
+      border-radius: 6px; font-size: 14px; display: flex; flex-wrap: wrap; gap: 4px 16px; }
+nav a { color: #1f5fa8; text-decoration: none; white-space: nowrap; }
 nav a:hover { text-decoration: underline; }
 section { margin-top: 32px; border-top: 1px solid #e3e3e8; padding-top: 8px; }
 h2 { font-size: 21px; margin: 12px 0 10px; }

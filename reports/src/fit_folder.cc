@@ -27,6 +27,10 @@ FitErrors ReadErrors(const JsonReader& in, const json& object, const std::string
     if (joint.joint != static_cast<int>(j) + 1) in.Fail(at + ".joint", "expected joints 1, 2, ...");
     joint.rms_deg = in.Pair(in.At(joints[j], at, "rms_deg"), at + ".rms_deg", true);
     joint.fit_percent = in.Pair(in.At(joints[j], at, "fit_percent"), at + ".fit_percent", true);
+    if (joints[j].contains("motion_rms_deg")) {  // absent from older fit.json files
+      joint.motion_rms_deg =
+          in.Pair(in.At(joints[j], at, "motion_rms_deg"), at + ".motion_rms_deg", true);
+    }
     joint.samples = in.Pair(in.At(joints[j], at, "samples"), at + ".samples", false);
     errors.per_joint.push_back(joint);
   }

@@ -42,7 +42,11 @@ struct FitErrors {
   struct Joint {
     int joint = 0;
     std::array<double, 2> rms_deg{kUnknown, kUnknown};
+    // NaN where the axis barely moves (identify::ChannelErrors).
     std::array<double, 2> fit_percent{kUnknown, kUnknown};
+    // RMS of the measured angles about their mean: the axis's motion. NaN
+    // in a fit.json written before it was recorded.
+    std::array<double, 2> motion_rms_deg{kUnknown, kUnknown};
     std::array<double, 2> samples{0.0, 0.0};
   };
   std::vector<Joint> per_joint;

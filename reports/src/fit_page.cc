@@ -51,7 +51,7 @@ Table FitTable(const FitFolder& fit) {
       "variance: 2 cost / (N − p), 1 when the residuals are as large as the measurement noise. "
       "Effective samples: N corrected for the autocorrelation of the residuals (used for the "
       "standard errors). Fit percent: 100 (1 − ‖fitted − measured‖ / ‖measured − its mean‖) "
-      "over every measured series.");
+      "over every measured series of an axis that moves (Errors per joint says which).");
   AddText(&table, "free parameters", ListNames(fit.free));
   AddText(&table, "termination", fit.termination);
   AddText(&table, "message", fit.message);
@@ -121,7 +121,7 @@ Section SummarySection(const FitFolder& fit) {
   text += "The RMS error of the joint angles went from " + Show(fit.rms_deg_start, kRms) +
           " deg at the start values to " + Show(fit.rms_deg, kRms) +
           " deg, and the fitted angles reproduce " + Show(fit.fit_percent, kPercent) +
-          " % of the measured motion (fit percent; " +
+          " % of the measured motion (fit percent over the axes that move; " +
           Show(fit.start_errors.fit_percent, kPercent) + " % at the start). ";
   text += "Residual variance " + Show(fit.residual_variance, NumberFormat::Significant(3)) +
           ": 1 means the remaining differences are as large as the measurement noise; much more "
@@ -453,6 +453,15 @@ Section IdentifiabilitySection(const FitFolder& fit) {
 
 // ------------------------------------------------------------------ errors
 
+// True when some joint has a fit percent on axis `c`: the arm moves about
+// it (identify::ChannelErrors).
+bool AxisHasFitPercent(const FitErrors& errors, int c) {
+  for (const FitErrors::Joint& joint : errors.per_joint) {
+    if (std::isfinite(joint.fit_percent[static_cast<std::size_t>(c)])) return true;
+  }
+  return false;
+}
+
 Figure ErrorFigure(const FitFolder& fit) {
   Figure figure;
   figure.name = "errors_per_joint";
@@ -462,16 +471,44 @@ Figure ErrorFigure(const FitFolder& fit) {
   const double joints = static_cast<double>(fit.errors.per_joint.size());
   for (int quantity = 0; quantity < 2; ++quantity) {
     for (int c = 0; c < 2; ++c) {
+      const std::size_t axis = static_cast<std::size_t>(c);
+      // An axis with no fit percent anywhere (θy of an arm bent in its
+      // plane): its errors against its own motion instead, in degrees.
+      const bool against_motion = quantity == 1 && !AxisHasFitPercent(fit.errors, c);
       Panel panel;
-      panel.title = std::string(quantity == 0 ? "RMS error " : "Fit percent ") + AxisName(c);
+      panel.title = quantity == 0    ? std::string("RMS error ") + AxisName(c)
+                    : against_motion ? std::string("RMS error against motion ") + AxisName(c)
+                                     : std::string("Fit percent ") + AxisName(c);
       panel.x = Axis{"joint", "1"};
       panel.x.min = 0.4;
       panel.x.max = joints + 0.6;
-      panel.y = quantity == 0 ? Axis{"RMS error", "deg"} : Axis{"fit", "%"};
-      if (quantity == 0) panel.y.min = 0.0;
+      panel.y = quantity == 1 && !against_motion ? Axis{"fit", "%"} : Axis{"RMS", "deg"};
+      if (quantity == 0 || against_motion) panel.y.min = 0.0;
       panel.legend = LegendPlace::kBelow;
       for (double j = 1; j <= joints; ++j)
         panel.x.tics.push_back({j, Show(j, NumberFormat::Integer())});
+      if (against_motion) {
+        Series motion;
+        motion.label = "motion";  // the caption says what it is
+        motion.color = palette::kStart;
+        motion.style = SeriesStyle::kBars;
+        motion.bar_width = 0.38;
+        Series error;
+        error.label = "fitted";
+        error.color = palette::kFitted;
+        error.style = SeriesStyle::kBars;
+        error.bar_width = 0.38;
+        for (const FitErrors::Joint& joint : fit.errors.per_joint) {
+          motion.x.push_back(joint.joint - 0.2);
+          motion.y.push_back(joint.motion_rms_deg[axis]);
+          error.x.push_back(joint.joint + 0.2);
+          error.y.push_back(joint.rms_deg[axis]);
+        }
+        panel.series.push_back(std::move(motion));
+        panel.series.push_back(std::move(error));
+        figure.panels.push_back(std::move(panel));
+        continue;
+      }
       const std::pair<const FitErrors*, const std::string*> sets[] = {
           {&fit.start_errors, &palette::kStart}, {&fit.errors, &palette::kFitted}};
       for (int s = 0; s < 2; ++s) {
@@ -482,8 +519,7 @@ Figure ErrorFigure(const FitFolder& fit) {
         bars.bar_width = 0.38;
         for (const FitErrors::Joint& joint : sets[s].first->per_joint) {
           bars.x.push_back(joint.joint + (s == 0 ? -0.2 : 0.2));
-          bars.y.push_back(quantity == 0 ? joint.rms_deg[static_cast<std::size_t>(c)]
-                                         : joint.fit_percent[static_cast<std::size_t>(c)]);
+          bars.y.push_back(quantity == 0 ? joint.rms_deg[axis] : joint.fit_percent[axis]);
         }
         panel.series.push_back(std::move(bars));
       }
@@ -497,17 +533,24 @@ Section ErrorSection(const FitFolder& fit) {
   Section section{"errors", "Errors per joint", {}};
   Table table;
   table.id = "errors_per_joint";
-  table.title = "RMS error and fit percent per joint";
+  table.title = "RMS error, motion and fit percent per joint";
   table.caption =
       "Over every experiment (fit.json 'start_errors' and 'errors'): at the start values and "
-      "with the fitted parameters. Fit percent 100 % is a perfect fit and 0 % no better than the "
-      "series' mean; an axis that barely moves (θy in the paper's protocol) can score near or "
-      "below 0 even with a small RMS error. Samples: measured frames per axis.";
+      "with the fitted parameters. Motion: the RMS of the measured angles about their mean, what "
+      "an error is to be read against. Fit percent, 100 (1 − RMS error / motion), is 100 % for a "
+      "perfect fit, 0 % no better than the series' mean and below 0 worse than that mean. It is "
+      "given only for an axis that moves: its motion at least a tenth of the joint's larger "
+      "axis motion and three times the joint's measurement noise. An axis that barely moves (θy "
+      "of a joint bent in its plane) has '–': there the ratio measures noise and by-products, "
+      "and its RMS error is to be read against its motion in degrees. Samples: measured frames "
+      "per axis.";
   table.columns = {{"joint", "joint", "", NumberFormat::Integer()},
                    {"rms_x_start_deg", "RMS θx start", "deg", kRms},
                    {"rms_x_fitted_deg", "RMS θx fitted", "deg", kRms},
+                   {"motion_x_deg", "motion θx", "deg", kRms},
                    {"rms_y_start_deg", "RMS θy start", "deg", kRms},
                    {"rms_y_fitted_deg", "RMS θy fitted", "deg", kRms},
+                   {"motion_y_deg", "motion θy", "deg", kRms},
                    {"fit_x_start_percent", "fit θx start", "%", kPercent},
                    {"fit_x_fitted_percent", "fit θx fitted", "%", kPercent},
                    {"fit_y_start_percent", "fit θy start", "%", kPercent},
@@ -518,17 +561,26 @@ Section ErrorSection(const FitFolder& fit) {
     const FitErrors::Joint& a = fit.start_errors.per_joint[j];
     const FitErrors::Joint& b = fit.errors.per_joint[j];
     table.AddRow({Cell::Number(b.joint), Cell::Number(a.rms_deg[0]), Cell::Number(b.rms_deg[0]),
-                  Cell::Number(a.rms_deg[1]), Cell::Number(b.rms_deg[1]),
+                  Cell::Number(b.motion_rms_deg[0]), Cell::Number(a.rms_deg[1]),
+                  Cell::Number(b.rms_deg[1]), Cell::Number(b.motion_rms_deg[1]),
                   Cell::Number(a.fit_percent[0]), Cell::Number(b.fit_percent[0]),
                   Cell::Number(a.fit_percent[1]), Cell::Number(b.fit_percent[1]),
                   Cell::Number(b.samples[0]), Cell::Number(b.samples[1])});
   }
-  section.blocks.push_back(FigureBlock{
-      ErrorFigure(fit), "Before and after, per joint",
+  std::string caption =
       "RMS error (top) and fit percent (bottom) of θx (left) and θy (right) per joint over every "
       "experiment: grey at the start values, blue with the fitted parameters. The fit-percent axes "
-      "span the data, not 0 to 100 %.",
-      ""});
+      "span the data, not 0 to 100 %.";
+  for (int c = 0; c < 2; ++c) {
+    if (!AxisHasFitPercent(fit.errors, c)) {
+      caption += std::string(" ") + AxisName(c) +
+                 " barely moves at any joint, so its bottom panel shows, in degrees, its motion "
+                 "(grey: the RMS of the measured angles about their mean) against the fitted RMS "
+                 "error (blue) instead of a fit percent.";
+    }
+  }
+  section.blocks.push_back(
+      FigureBlock{ErrorFigure(fit), "Before and after, per joint", caption, ""});
   section.blocks.push_back(std::move(table));
   return section;
 }

@@ -1,7 +1,9 @@
 // The page of a simulation run (ccsrm-run/1): summary and solver statistics,
-// joint angles against the plan (the paper's Figs. 16 and 18–21), input
-// tensions (Fig. 22), stick–slip, tension along the cables at chosen
-// instants, constraint violation and energy.
+// joint angles against the plan, input tensions, stick–slip, tension along
+// the cables at chosen instants, constraint violation and energy. The page
+// names the arm and the protocol as configured; it cites the paper (its
+// cases, its Figs. 16, 18–21 and 22) only for a run of one of the paper's
+// cases on the paper's arm (PaperWords).
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -23,12 +25,24 @@ using internal::ArmFacts;
 using internal::Instant;
 using internal::kDegPerRad;
 
-const char* PaperCaseFriction(const std::string& case_name) {
-  if (case_name == "1") return "no friction";
-  if (case_name == "2") return "friction on all cables";
-  if (case_name == "3") return "friction on the driving cables only";
-  if (case_name == "4") return "friction on the connecting cables only";
-  return nullptr;
+// How a run page speaks. A case number (the file's `case`, 1-4) says which
+// cables have friction and that the run followed the configured protocol,
+// whose plan can be drawn again; on any arm. It is one of the paper's
+// cases, which may be compared with the paper's figures, only on the
+// paper's arm, recognised from the stored configuration (sim::IsPaperArm):
+// the run file holds the arm it ran, so no flag can disagree with it.
+struct Words {
+  bool protocol_case = false;  // case 1-4: the protocol's plan applies
+  bool paper = false;          // and the arm is the paper's
+  std::string case_words;      // "paper case 2 (...)", "case 1 (...)", "case 'custom'"
+};
+
+Words WordsFor(const RunFile& run, const ArmFacts& facts) {
+  Words w;
+  w.protocol_case = internal::CaseNumber(run.case_name) != 0;
+  w.paper = w.protocol_case && facts.paper_arm;
+  w.case_words = internal::CaseWords(run.case_name, facts.paper_arm);
+  return w;
 }
 
 std::string Slug(const std::string& label) {
@@ -46,7 +60,7 @@ std::string Slug(const std::string& label) {
 
 // The instants of ReportOptions::instants_s (see there for the default).
 std::vector<Instant> ChooseInstants(const std::vector<double>& time, const ArmFacts& facts,
-                                    bool paper_case, const ReportOptions& options) {
+                                    bool protocol_case, const ReportOptions& options) {
   const double first = time.front(), last = time.back();
   std::vector<std::pair<std::string, double>> wanted;
   if (!options.instants_s.empty()) {
@@ -64,7 +78,7 @@ std::vector<Instant> ChooseInstants(const std::vector<double>& time, const ArmFa
       wanted.push_back({"t = " + internal::FormatSeconds(t) + " s", t});
     }
   } else {
-    if (paper_case && facts.protocol) {
+    if (protocol_case && facts.protocol) {
       const internal::ProtocolPhases& p = *facts.protocol;
       const std::pair<std::string, double> phases[] = {
           {"end of ramp", p.ramp_s},
@@ -128,14 +142,15 @@ Table JointAnglesAtInstants(const RunFile& run, const ArmFacts& facts,
   table.title = axis + " of every joint at the chosen instants";
   table.caption = "Degrees, read from /joint_angles at the frames listed under Instants." +
                   std::string(facts.plan ? " Plan: the planned " + axis +
-                                               " at the same frames (the same for every "
-                                               "joint of the paper's protocol)."
+                                               " at the same frames (the protocol plans the same "
+                                               "angle for every joint)."
                                          : "");
   table.columns = {{"joint", "joint", "", NumberFormat::Integer()},
                    {"segment", "segment", "", NumberFormat::Integer()}};
   for (const Instant& instant : instants) {
-    // θx to 0.001 deg (the scale of the paper's figures); θy, which stays
-    // small, to 3 significant digits so 1e-5 deg does not show as 0.
+    // θx to 0.001 deg (the scale of the paper's figures, and well below
+    // mocap noise); θy, which stays small, to 3 significant digits so
+    // 1e-5 deg does not show as 0.
     table.columns.push_back(
         {key + "_deg_" + Slug(instant.label), InstantHeader(instant), "deg",
          component == 0 ? NumberFormat::Fixed(3) : NumberFormat::Significant(3)});
@@ -180,7 +195,7 @@ Table JointAnglesAtInstants(const RunFile& run, const ArmFacts& facts,
 }
 
 Section SummarySection(const RunFile& run, const std::string& source, const ArmFacts& facts,
-                       bool paper_case, const std::vector<Instant>& instants) {
+                       const Words& words, const std::vector<Instant>& instants) {
   Section section{"summary", "Summary", {}};
   const double first = run.time.values.front(), last = run.time.values.back();
   const bool completed = run.status == datasets::RunStatus::kCompleted;
@@ -189,9 +204,14 @@ Section SummarySection(const RunFile& run, const std::string& source, const ArmF
                                         "Root attributes of the run file and the protocol of its "
                                         "stored configuration.");
   AddText(&about, "file", source);
-  AddText(
-      &about, "case",
-      paper_case ? run.case_name + " (" + PaperCaseFriction(run.case_name) + ")" : run.case_name);
+  const int case_number = internal::CaseNumber(run.case_name);
+  AddText(&about, "case",
+          case_number != 0 ? run.case_name + " (" + internal::CaseFriction(case_number) + ")"
+                           : run.case_name);
+  if (!facts.arm_words.empty()) {
+    AddText(&about, "arm", (facts.paper_arm ? "the paper's: " : "") + facts.arm_words);
+    AddText(&about, "protocol", facts.protocol_words);
+  }
   if (facts.protocol) {
     AddValue(&about, "planned amplitude", facts.protocol->amplitude_deg, "deg",
              NumberFormat::Fixed(3));
@@ -228,7 +248,12 @@ Section SummarySection(const RunFile& run, const std::string& source, const ArmF
            "mixed", NumberFormat::Significant(3));
 
   // The text summary quotes the tables, so it shows their numbers exactly.
-  std::string text = paper_case ? "Paper case " + about.rows[1][1].text : "A custom run";
+  std::string text = words.case_words;
+  text[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(text[0])));
+  if (!facts.arm_words.empty()) {
+    text +=
+        words.paper ? " on the paper's arm" : " on the configured arm (" + facts.arm_words + ")";
+  }
   if (facts.protocol) text += ", planned amplitude " + Shown(about, "planned amplitude") + " deg";
   text += ": " + Shown(about, "last frame") + " s simulated";
   if (run.wall_time_s > 0.0) {
@@ -243,11 +268,12 @@ Section SummarySection(const RunFile& run, const std::string& source, const ArmF
         "This run diverged (" + run.status_message + "); the page shows the frames up to then.",
         true});
   }
-  if (!paper_case) {
+  if (!words.protocol_case) {
     section.blocks.push_back(
         Paragraph{"The run's case is '" + run.case_name +
-                      "', not one of the paper's cases 1–4: the planned motion is not drawn "
-                      "(only a paper-case run can be planned again from its configuration).",
+                      "', not one of the cases 1–4 of the protocol: the planned motion is not "
+                      "drawn (only a run of the protocol can be planned again from its "
+                      "configuration).",
                   true});
   }
   for (const std::string& problem : facts.problems) {
@@ -273,32 +299,33 @@ Section SummarySection(const RunFile& run, const std::string& source, const ArmF
   return section;
 }
 
-Section JointAngleSection(const RunFile& run, const ArmFacts& facts,
+Section JointAngleSection(const RunFile& run, const ArmFacts& facts, const Words& words,
                           const std::vector<Instant>& instants) {
   Section section{"joint-angles", "Joint angles", {}};
   const std::string plan = facts.plan ? " Dashed black: the planned motion." : "";
+  const std::string layout = words.paper ? ": the layout of the paper's Figs. 16 and 18–21." : ".";
   section.blocks.push_back(FigureBlock{
       internal::JointAngleFigure("theta_x", run.time.values, run.joint_angles, 0, facts.segments,
                                  facts.plan),
       "θx against time",
       "Bending angle θx of every universal joint (X–Y Cardan pair of SPEC §2), one panel per "
-      "segment, joints in order from the root: the layout of the paper's Figs. 16 and 18–21." +
-          plan,
+      "segment, joints in order from the root" +
+          layout + plan,
       ""});
-  section.blocks.push_back(FigureBlock{
-      internal::JointAngleFigure("theta_y", run.time.values, run.joint_angles, 1, facts.segments,
-                                 facts.plan),
-      "θy against time",
-      "Out-of-plane angle θy of every joint (the paper's protocol plans 0), same layout and "
-      "colours." +
-          plan,
-      ""});
+  section.blocks.push_back(
+      FigureBlock{internal::JointAngleFigure("theta_y", run.time.values, run.joint_angles, 1,
+                                             facts.segments, facts.plan),
+                  "θy against time",
+                  std::string("Out-of-plane angle θy of every joint") +
+                      (words.protocol_case ? " (the protocol plans 0)" : "") +
+                      ", same layout and colours." + plan,
+                  ""});
   section.blocks.push_back(JointAnglesAtInstants(run, facts, instants, 0));
   section.blocks.push_back(JointAnglesAtInstants(run, facts, instants, 1));
   return section;
 }
 
-Section InputSection(const RunFile& run, const ArmFacts& facts,
+Section InputSection(const RunFile& run, const ArmFacts& facts, const Words& words,
                      const std::vector<Instant>& instants) {
   Section section{"inputs", "Input tensions", {}};
   const std::vector<double>& time = run.time.values;
@@ -306,8 +333,10 @@ Section InputSection(const RunFile& run, const ArmFacts& facts,
       internal::CableFigure("input_tension", time, run.input_tension, 1.0, Axis{"tension", "N"},
                             facts.segments, facts.cable_segment, SeriesStyle::kLine),
       "Input tension against time",
-      "Tension of the first element of each driving cable (/input_tension), the force the "
-      "actuator holds: the paper's Fig. 22. One panel per segment the cables drive.",
+      std::string("Tension of the first element of each driving cable (/input_tension), the force "
+                  "the actuator holds") +
+          (words.paper ? ": the paper's Fig. 22" : "") +
+          ". One panel per segment the cables drive.",
       ""});
   section.blocks.push_back(FigureBlock{
       internal::CableFigure("input_length", time, run.input_length_change, 1000.0,
@@ -488,21 +517,24 @@ Document BuildRunDocument(const RunFile& run, const std::string& source,
   if (!options.IsValid(&why)) ThrowInputError("report options", "", why);
   datasets::ValidateRunFile(run, source);
   const std::vector<double>& time = run.time.values;
-  const bool paper_case = PaperCaseFriction(run.case_name) != nullptr;
+  const bool protocol_case = internal::CaseNumber(run.case_name) != 0;
   const ArmFacts facts = internal::ReadArmFacts(
       run.config_yaml, source + ": attribute 'config_yaml'", run.joint_angles.shape[1],
-      run.input_tension.shape[1], paper_case ? &time : nullptr);
-  const std::vector<Instant> instants = ChooseInstants(time, facts, paper_case, options);
+      run.input_tension.shape[1], protocol_case ? &time : nullptr);
+  const Words words = WordsFor(run, facts);
+  const std::vector<Instant> instants = ChooseInstants(time, facts, protocol_case, options);
 
   Document document;
   document.kind = "run";
-  document.title = paper_case ? "Simulation run — paper case " + run.case_name
-                              : "Simulation run — " + run.case_name;
+  // The paper's case by its name; any other run by its case and its arm.
+  document.title = words.paper ? "Simulation run — paper case " + run.case_name
+                               : "Simulation run — " + words.case_words +
+                                     (facts.arm_words.empty() ? "" : ", " + facts.arm_words);
   document.source = source;
   document.ccsrm_version = kVersion;
-  document.sections.push_back(SummarySection(run, source, facts, paper_case, instants));
-  document.sections.push_back(JointAngleSection(run, facts, instants));
-  document.sections.push_back(InputSection(run, facts, instants));
+  document.sections.push_back(SummarySection(run, source, facts, words, instants));
+  document.sections.push_back(JointAngleSection(run, facts, words, instants));
+  document.sections.push_back(InputSection(run, facts, words, instants));
   document.sections.push_back(StickSlipSection(run, facts, instants));
   document.sections.push_back(CableTensionSection(run, instants));
   document.sections.push_back(DiagnosticsSection(run, instants));

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <map>
 #include <set>
@@ -429,6 +430,192 @@ void CheckArmRanges(const ArmConfig& arm, const Checker& check) {
   in("connecting_cables.cross_section_m2", arm.connecting.cross_section_m2, kCrossSection);
 }
 
+// Two holes of one segment closer than this are one: below 1 deg two lines
+// of pull differ by less than the scatter of drilled holes, whatever the
+// cable. A thicker cable needs more (CheckCableLayout).
+constexpr double kMinHoleSeparationDeg = 1.0;
+
+// What a segment's driving cables must be able to do: bend it about both
+// axes, either way. A cable only pulls, and it pulls its segment toward its
+// own hole, so the bends the cables can make are the non-negative
+// combinations of their hole directions. Those cover every direction only
+// when no closed half-plane through the axis holds every hole (the largest
+// angular gap between neighbouring holes is below 180 deg), which takes
+// three cables at least. Two cables at one angle pull along one line, and
+// their holes overlap on the disks. Refused here, before a run "completes"
+// with a segment swinging out of the plan (issue 32).
+void CheckCableLayout(const ArmConfig& arm, const Checker& check) {
+  const auto degrees = [](double rad, int digits = 6) {
+    std::ostringstream out;
+    out << std::setprecision(digits) << rad / kDegToRad;
+    return out.str();
+  };
+  // A cable's diameter, from its load-bearing cross section (a solid round).
+  const double diameter = 2.0 * std::sqrt(arm.driving.cross_section_m2 / kPi);
+  for (std::size_t s = 0; s < arm.segments.size(); ++s) {
+    const SegmentConfig& segment = arm.segments[s];
+    const std::string name = "segment " + std::to_string(s + 1) + " ('" + segment.name + "')";
+    struct Hole {
+      double angle_rad;   // in [0, 2 pi)
+      std::size_t cable;  // index into arm.driving.cables
+    };
+    std::vector<Hole> holes;
+    for (std::size_t k = 0; k < arm.driving.cables.size(); ++k) {
+      if (arm.driving.cables[k].segment != static_cast<int>(s) + 1) continue;
+      double angle = std::fmod(arm.driving.cables[k].hole_angle_rad, 2.0 * kPi);
+      if (angle < 0.0) angle += 2.0 * kPi;
+      holes.push_back({angle, k});
+    }
+    const auto key = [](std::size_t cable) {
+      return "driving_cables.cables[" + std::to_string(cable) + "]";
+    };
+    if (holes.empty()) {
+      check.Fail("arm.segments[" + std::to_string(s) + "]",
+                 name +
+                     " has no driving cable: at least three are needed to bend it about "
+                     "both axes");
+    }
+    if (holes.size() < 3) {
+      std::string list;
+      for (const Hole& h : holes)
+        list += (list.empty() ? "" : " and ") + std::to_string(h.cable + 1);
+      check.Fail(key(holes.back().cable),
+                 name + " has " + std::to_string(holes.size()) + " driving cable" +
+                     (holes.size() == 1 ? " (cable " : "s (cables ") + list +
+                     "): at least three are needed to bend it about both axes (a cable only "
+                     "pulls)");
+    }
+    std::sort(holes.begin(), holes.end(),
+              [](const Hole& a, const Hole& b) { return a.angle_rad < b.angle_rad; });
+    // Holes overlap when their centres are closer than one cable diameter
+    // on the segment's hole circle (chord 2 r sin(dphi / 2) < diameter).
+    const double overlap =
+        2.0 * std::asin(std::min(1.0, diameter / (2.0 * segment.hole_circle_radius_m)));
+    const double tolerance = std::max(kMinHoleSeparationDeg * kDegToRad, overlap);
+    double widest_gap = 0.0;
+    std::size_t gap_after = 0;
+    for (std::size_t i = 0; i < holes.size(); ++i) {
+      const Hole& a = holes[i];
+      const Hole& b = holes[(i + 1) % holes.size()];
+      const double gap =
+          i + 1 < holes.size() ? b.angle_rad - a.angle_rad : b.angle_rad + 2.0 * kPi - a.angle_rad;
+      if (gap < tolerance) {
+        const std::size_t first = std::min(a.cable, b.cable), second = std::max(a.cable, b.cable);
+        check.Fail(key(second),
+                   name + ": cables " + std::to_string(first + 1) + " and " +
+                       std::to_string(second + 1) + " sit at hole angles " +
+                       degrees(arm.driving.cables[first].hole_angle_rad) + " and " +
+                       degrees(arm.driving.cables[second].hole_angle_rad) + " deg, closer than " +
+                       degrees(tolerance, 3) +
+                       " deg: coincident holes (they overlap on the disks, the larger of 1 deg "
+                       "and one cable diameter on the hole circle) pull along one line");
+      }
+      if (gap > widest_gap) {
+        widest_gap = gap;
+        gap_after = i;
+      }
+    }
+    // A closed half-plane: a gap of 180 deg exactly (cables at 0, 90 and
+    // 180 deg) leaves the direction across it out of reach too.
+    if (widest_gap >= kPi - 1e-9) {
+      std::string list;
+      for (const Hole& h : holes) {
+        list += (list.empty() ? "" : ", ") + degrees(arm.driving.cables[h.cable].hole_angle_rad);
+      }
+      const Hole& from = holes[gap_after];
+      const Hole& to = holes[(gap_after + 1) % holes.size()];
+      check.Fail(key(holes.back().cable),
+                 name + ": its " + std::to_string(holes.size()) + " cables (hole angles " + list +
+                     " deg) lie within a half-plane, no cable between " +
+                     degrees(arm.driving.cables[from.cable].hole_angle_rad) + " and " +
+                     degrees(arm.driving.cables[to.cable].hole_angle_rad) + " deg (a gap of " +
+                     degrees(widest_gap, 3) +
+                     " deg): cables only pull, so the segment cannot be bent toward that side");
+    }
+  }
+}
+
+// Values far outside what arms of this kind have, though the model can run
+// them: each a warning with its reason, not a refusal (a test rig may be
+// odd on purpose). Ratios rather than absolute values, so that they hold
+// from a catheter-sized arm to a metre-scale one.
+std::vector<std::string> ArmWarnings(const Config& c, const LineMap* lines) {
+  std::vector<std::string> warnings;
+  const auto warn = [&](const std::string& key, const std::string& what) {
+    warnings.push_back(FormatInputError(c.source_name, Where(lines, key), what));
+  };
+  const auto text = [](double v) {
+    std::ostringstream out;
+    out << std::setprecision(3) << v;
+    return out.str();
+  };
+  for (std::size_t i = 0; i < c.arm.segments.size(); ++i) {
+    const SegmentConfig& s = c.arm.segments[i];
+    const std::string p = "arm.segments[" + std::to_string(i) + "].";
+    // Hole circle against link length: arms of this kind put their holes at
+    // 0.1-0.5 of a link's length from the axis (the paper's 0.16 and 0.25).
+    // Beyond one length the disks are wider than the links are long; below a
+    // fiftieth the cables have almost no lever on the joints.
+    const double ratio = s.hole_circle_radius_m / s.link_length_m;
+    if (ratio > 1.0 || ratio < 0.02) {
+      warn(p + "hole_circle_radius_m",
+           "hole circle radius " + text(s.hole_circle_radius_m) + " m is " + text(ratio) +
+               " times the link length " + text(s.link_length_m) + " m: " +
+               (ratio > 1.0 ? "disks wider than the links are long"
+                            : "the cables would have almost no lever on the joints") +
+               "; arms of this kind have 0.1-0.5 (the paper's arm 0.16-0.25): check the units");
+    }
+    // Mass against size: the mean density of the link's envelope, a
+    // cylinder of its length out to twice the hole circle (the disks reach
+    // past their holes). The paper's links make 200 kg/m^3 (hollow disks on
+    // a spine); below 10 a link is lighter than foam through and through,
+    // above 1e4 denser than solid steel filling the whole envelope.
+    const double envelope = kPi * std::pow(2.0 * s.hole_circle_radius_m, 2) * s.link_length_m;
+    const double density = s.link_mass_kg / envelope;
+    if (density < 10.0 || density > 1e4) {
+      warn(p + "link_mass_kg",
+           "a link of " + text(s.link_mass_kg) + " kg in an envelope of " + text(envelope) +
+               " m^3 (its length, out to twice the hole circle) is " + text(density) +
+               " kg/m^3 on average: " +
+               (density < 10.0 ? "lighter than foam" : "denser than solid steel") +
+               " (the paper's arm: about 200)");
+    }
+    // Inertia against mass and size: no principal moment exceeds all the
+    // mass at the far end of the envelope, m ((L/2)^2 + (2 r_h)^2), and a
+    // rigid body's moments satisfy the triangle inequality.
+    const Eigen::Vector3d& I = s.link_inertia_kgm2;
+    const double most = s.link_mass_kg * (std::pow(0.5 * s.link_length_m, 2) +
+                                          std::pow(2.0 * s.hole_circle_radius_m, 2));
+    if (I.maxCoeff() > most) {
+      warn(p + "link_inertia_kgm2",
+           "a principal moment of " + text(I.maxCoeff()) + " kg m^2 exceeds " + text(most) +
+               ", all of the link's mass at the far end of its envelope: check the units");
+    } else if (I[0] + I[1] < I[2] || I[1] + I[2] < I[0] || I[2] + I[0] < I[1]) {
+      warn(p + "link_inertia_kgm2",
+           "the principal moments break the triangle inequality (each at most the sum of the "
+           "other two): no rigid body has them");
+    }
+  }
+  // Stiffness against pre-tension: the strain a cable's pre-tension gives
+  // it. The paper's is 0.3 %; above 2 % a steel cable has yielded (at about
+  // 0.5 %) and a fibre rope is near its breaking strain (3-4 %).
+  const auto strain = [&](const std::string& key, double tension, double youngs, double area,
+                          const std::string& which) {
+    const double e = tension / (youngs * area);
+    if (e > 0.02) {
+      warn(key, "the pre-tension " + text(tension) + " N stretches the " + which + " by " +
+                    text(100.0 * e) + " % (E A = " + text(youngs * area) +
+                    " N): beyond the elastic range of any cable (steel yields near 0.5 %, fibre "
+                    "ropes break near 3 %; the paper's 0.3 %)");
+    }
+  };
+  strain("driving_cables.pretension_n", c.parameters.T_d0, c.arm.driving.youngs_modulus_pa,
+         c.arm.driving.cross_section_m2, "driving cables");
+  strain("connecting_cables.pretension_n", c.parameters.T_p, c.arm.connecting.youngs_modulus_pa,
+         c.arm.connecting.cross_section_m2, "connecting cables");
+  return warnings;
+}
+
 void CheckSolver(const SolverConfig& s, const Checker& check) {
   check.NonNegative("solver.baumgarte_alpha_per_s", s.baumgarte_alpha_per_s);
   check.NonNegative("solver.baumgarte_beta_per_s2", s.baumgarte_beta_per_s2);
@@ -469,14 +656,24 @@ void ValidateWithLines(const Config& c, const LineMap* lines) {
   const Checker check(c.source_name, lines);
   CheckArm(c.arm, check);
   CheckArmRanges(c.arm, check);
+  CheckCableLayout(c.arm, check);
   // The identifiable parameters: the same table and message as --set and --params.
   for (const ParameterInfo& p : Parameters()) {
     const std::string problem = ParameterValueProblem(p, c.parameters.*p.field);
     if (!problem.empty()) check.Fail(p.config_key, problem);
   }
+  // The parameters' per-joint and per-cable lists are this arm's (an arm
+  // edited in code after LoadConfig must say so: parameters.arm = arm.size()).
+  if (c.parameters.arm != c.arm.size()) {
+    check.Fail("effects",
+               "the parameters are sized for an arm of " + std::to_string(c.parameters.arm.joints) +
+                   " joints and " + std::to_string(c.parameters.arm.cables) +
+                   " driving cables, the arm has " + std::to_string(c.arm.size().joints) + " and " +
+                   std::to_string(c.arm.size().cables));
+  }
   // Effect parameters, by their key under `effects:`.
   for (const auto& [name, value] : c.parameters.effect_values) {
-    const ParameterInfo& p = FindParameter(name, c.source_name);
+    const ParameterInfo& p = FindParameter(name, c.source_name, c.arm.size());
     const std::string problem = ParameterValueProblem(p, value);
     if (!problem.empty()) check.Fail(p.config_key, problem);
   }
@@ -500,6 +697,10 @@ int ArmConfig::total_links() const {
   int n = 0;
   for (const auto& s : segments) n += s.links;
   return n;
+}
+
+ArmSize ArmConfig::size() const {
+  return ArmSize{total_links(), static_cast<int>(driving.cables.size())};
 }
 
 int ArmConfig::segment_of_link(int link) const {
@@ -580,6 +781,8 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
       dc.cables.push_back(route);
     });
     d.Finish();
+    // The effects' per-joint and per-cable parameters are this arm's.
+    c.parameters.arm = c.arm.size();
   }
   {
     MapReader k = top.Section("connecting_cables");
@@ -651,6 +854,7 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
   }
   top.Finish();
   ValidateWithLines(c, &lines);
+  c.warnings = ArmWarnings(c, &lines);
   return c;
 }
 
@@ -775,7 +979,7 @@ std::string ToYaml(const Config& c) {
     for (const EffectInfo& e : Effects()) {
       if (!c.parameters.EffectOn(e.name)) continue;
       out << YAML::Key << e.name << YAML::Value << YAML::BeginMap;
-      for (const std::string& name : e.parameters) {
+      for (const std::string& name : EffectParameterNames(e.name, c.parameters.arm)) {
         out << YAML::Key << name.substr(e.name.size() + 1) << YAML::Value
             << GetParameter(c.parameters, name);
       }

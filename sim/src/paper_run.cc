@@ -1,7 +1,11 @@
 #include "ccsrm/sim/paper_run.h"
 
+#include <filesystem>
+#include <system_error>
+
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/sim/describe.h"
 
 namespace ccsrm::sim {
 
@@ -15,9 +19,36 @@ void ApplyPaperCase(int case_number, ArmParameters* parameters) {
   if (!connecting) parameters->mu_c = parameters->mu_c_s = 0.0;
 }
 
+std::string DescribeRun(const PaperRun& run) {
+  const bool paper_arm = IsPaperArm(run.config.arm);
+  return "run: " + DescribeCase(run.case_number, paper_arm) + " on " +
+         (paper_arm ? "the paper's arm, " : "the arm of ") + run.config_path +
+         "\n  arm:                       " + DescribeArm(run.config.arm) +
+         "\n  protocol:                  " + DescribeProtocol(run.config.protocol) + "\n";
+}
+
+std::string BundledConfigPath(const std::string& name) {
+  // Set by CMake (sim/CMakeLists.txt): the source tree's configs/ and the
+  // installed data folder, in the order they are tried.
+  const std::string places[] = {CCSRM_SOURCE_CONFIG_DIR, CCSRM_INSTALLED_CONFIG_DIR};
+  for (const std::string& folder : places) {
+    const std::string path = folder + "/" + name;
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(path, ec)) return path;
+  }
+  ThrowInputError("--config", "",
+                  "not given, and the bundled " + name + " is in neither " + places[0] + " nor " +
+                      places[1] + ": pass --config FILE");
+}
+
+std::string ConfigPathOrBundled(const std::string& path) {
+  return path.empty() ? BundledConfigPath("paper.yaml") : path;
+}
+
 PaperRun PreparePaperRun(const PaperRunOptions& o) {
-  std::string text = ReadTextFile(o.config_path);
-  Config config = ParseConfig(text, o.config_path);
+  const std::string path = ConfigPathOrBundled(o.config_path);
+  std::string text = ReadTextFile(path);
+  Config config = ParseConfig(text, path);
   if (o.case_number != 0) ApplyPaperCase(o.case_number, &config.parameters);
   if (!o.params_path.empty()) {
     ApplyParameterYaml(ReadTextFile(o.params_path), o.params_path, &config.parameters);
@@ -45,8 +76,13 @@ PaperRun PreparePaperRun(const PaperRunOptions& o) {
   SimulationOptions simulation;
   simulation.duration_s = duration;
   simulation.solver = config.solver;
-  return PaperRun{std::move(text),   std::move(config),     std::move(model),
-                  std::move(inputs), std::move(simulation), o.case_number};
+  return PaperRun{path,
+                  std::move(text),
+                  std::move(config),
+                  std::move(model),
+                  std::move(inputs),
+                  std::move(simulation),
+                  o.case_number};
 }
 
 }  // namespace ccsrm::sim

@@ -17,8 +17,8 @@
 namespace ccsrm::sim {
 namespace {
 
-// The model's names, then how effect parameters are named: listing all 35
-// of them would bury the line.
+// The model's names, then how effect parameters are named: listing all of
+// them would bury the line.
 std::string KnownNames() {
   std::string names;
   for (const ParameterInfo& p : Parameters()) names += (names.empty() ? "" : ", ") + p.name;
@@ -27,16 +27,13 @@ std::string KnownNames() {
   return names + "; effects' parameters as <effect>.<parameter>, effects: " + effects;
 }
 
-// For "effect.x": that effect's parameters, when the effect exists.
-std::string KnownNamesFor(const std::string& name) {
+// For "effect.x": that effect's parameters (on `arm`, when known), when the
+// effect exists.
+std::string KnownNamesFor(const std::string& name, const ArmSize* arm) {
   const std::size_t dot = name.find('.');
   if (dot != std::string::npos) {
-    for (const EffectInfo& e : Effects()) {
-      if (e.name != name.substr(0, dot)) continue;
-      std::string list;
-      for (const std::string& p : e.parameters) list += (list.empty() ? "" : ", ") + p;
-      return list;
-    }
+    const internal::EffectDefinition* d = internal::FindEffectDefinition(name.substr(0, dot));
+    if (d != nullptr) return internal::DescribeParameters(*d, arm, true);
   }
   return KnownNames();
 }
@@ -47,11 +44,23 @@ std::string FormatValue(double value) {
   return buffer;
 }
 
-const ParameterInfo* LookUp(const std::string& name) {
-  for (const ParameterInfo& p : AllParameters()) {
+// The entry of `name` (a model parameter, or an effect's on `arm` when
+// given, on any arm otherwise), or null with *beyond saying why when it is
+// an indexed effect parameter the arm does not have.
+const ParameterInfo* LookUp(const std::string& name, const ArmSize* arm,
+                            std::string* beyond = nullptr) {
+  for (const ParameterInfo& p : Parameters()) {
     if (p.name == name) return &p;
   }
-  return nullptr;
+  return internal::FindEffectParameter(name, arm, beyond);
+}
+
+[[noreturn]] void ThrowUnknown(const std::string& name, const std::string& where,
+                               const ArmSize* arm, const std::string& beyond) {
+  ThrowInputError(where, "",
+                  "unknown parameter '" + name + "' (" +
+                      (beyond.empty() ? "known" : beyond + ": known") + ": " +
+                      KnownNamesFor(name, arm) + ")");
 }
 
 }  // namespace
@@ -73,9 +82,11 @@ bool ArmParameters::IsValid(std::string* error) const {
     }
   }
   for (const auto& [name, value] : effect_values) {
-    const ParameterInfo* info = LookUp(name);
+    std::string beyond;
+    const ParameterInfo* info = LookUp(name, &arm, &beyond);
     if (info == nullptr || !info->is_effect()) {
-      *error = "unknown effect parameter '" + name + "'";
+      *error =
+          "unknown effect parameter '" + name + "'" + (beyond.empty() ? "" : " (" + beyond + ")");
       return false;
     }
     const std::string problem = ParameterValueProblem(*info, value);
@@ -178,23 +189,26 @@ const std::vector<ParameterInfo>& Parameters() {
   return parameters;
 }
 
-const std::vector<ParameterInfo>& AllParameters() {
-  static const std::vector<ParameterInfo> all = [] {
-    std::vector<ParameterInfo> list = Parameters();
-    for (const internal::EffectDefinition& d : internal::EffectDefinitions()) {
-      list.insert(list.end(), d.parameters.begin(), d.parameters.end());
-    }
-    return list;
-  }();
-  return all;
+std::vector<ParameterInfo> AllParameters(const ArmSize& arm) {
+  std::vector<ParameterInfo> list = Parameters();
+  for (const internal::EffectDefinition& d : internal::EffectDefinitions()) {
+    const std::vector<ParameterInfo> on_arm = internal::ParametersOnArm(d, arm);
+    list.insert(list.end(), on_arm.begin(), on_arm.end());
+  }
+  return list;
+}
+
+const ParameterInfo& FindParameter(const std::string& name, const std::string& where,
+                                   const ArmSize& arm) {
+  std::string beyond;
+  const ParameterInfo* info = LookUp(name, &arm, &beyond);
+  if (info == nullptr) ThrowUnknown(name, where, &arm, beyond);
+  return *info;
 }
 
 const ParameterInfo& FindParameter(const std::string& name, const std::string& where) {
-  const ParameterInfo* info = LookUp(name);
-  if (info == nullptr) {
-    ThrowInputError(where, "",
-                    "unknown parameter '" + name + "' (known: " + KnownNamesFor(name) + ")");
-  }
+  const ParameterInfo* info = LookUp(name, nullptr);
+  if (info == nullptr) ThrowUnknown(name, where, nullptr, "");
   return *info;
 }
 
@@ -205,7 +219,7 @@ std::string ParameterValueProblem(const ParameterInfo& info, double value) {
 }
 
 double GetParameter(const ArmParameters& parameters, const std::string& name) {
-  const ParameterInfo& info = FindParameter(name, "GetParameter");
+  const ParameterInfo& info = FindParameter(name, "GetParameter", parameters.arm);
   if (info.field != nullptr) return parameters.*info.field;
   const auto it = parameters.effect_values.find(name);
   return it != parameters.effect_values.end() ? it->second : info.absent_value;
@@ -213,7 +227,7 @@ double GetParameter(const ArmParameters& parameters, const std::string& name) {
 
 void SetParameter(const std::string& name, double value, const std::string& where,
                   ArmParameters* parameters) {
-  const ParameterInfo& info = FindParameter(name, where);
+  const ParameterInfo& info = FindParameter(name, where, parameters->arm);
   const std::string problem = ParameterValueProblem(info, value);
   if (!problem.empty()) ThrowInputError(where, "", problem);
   if (info.field != nullptr) {
@@ -268,9 +282,12 @@ std::vector<std::pair<std::string, double>> ApplyParameterYaml(const std::string
     if (prefix.empty() && key == "effects" && effects) continue;  // below
     const std::string where =
         "line " + std::to_string(entry.first.Mark().line + 1) + ", key '" + prefix + key + "'";
-    const ParameterInfo* info = LookUp(key);
+    std::string beyond;
+    const ParameterInfo* info = LookUp(key, &updated.arm, &beyond);
     if (info == nullptr) {
-      ThrowInputError(file, where, "unknown parameter (known: " + KnownNamesFor(key) + ")");
+      ThrowInputError(file, where,
+                      "unknown parameter (" + (beyond.empty() ? "known" : beyond + ": known") +
+                          ": " + KnownNamesFor(key, &updated.arm) + ")");
     }
     const double value = ReadYamlNumber(entry.second, file, where);
     const std::string problem = ParameterValueProblem(*info, value);

@@ -105,6 +105,14 @@ std::string EditedPaper(const std::string& pattern, const std::string& replaceme
                             std::regex_constants::format_first_only);
 }
 
+// The second arm (configs/three-segment.yaml) edited as EditedPaper does.
+std::string EditedThreeSegment(const std::string& pattern, const std::string& replacement) {
+  const std::string text =
+      ccsrm::ReadTextFile(std::string(CCSRM_SOURCE_DIR) + "/configs/three-segment.yaml");
+  return std::regex_replace(text, std::regex(pattern), replacement,
+                            std::regex_constants::format_first_only);
+}
+
 class BadInputTable : public ::testing::Test {
  protected:
   // The inputs of every row, made once: configurations, parameter files, a
@@ -120,6 +128,16 @@ class BadInputTable : public ::testing::Test {
     Write(d / "stiff.yaml", EditedPaper("youngs_modulus_pa: .*", "youngs_modulus_pa: 1e300"));
     Write(d / "typo.yaml", EditedPaper("link_mass_kg", "link_mas_kg"));
     Write(d / "syntax.yaml", "schema: ccsrm-config/1\narm: [unclosed\n");
+    // Layouts whose cables cannot bend segment 2 about both axes (issue 32).
+    Write(d / "nocable.yaml", EditedThreeSegment("    - \\{segment: 2, hole_angle_deg: 40.0\\}\n"
+                                                 "    - \\{segment: 2, hole_angle_deg: 160.0\\}\n"
+                                                 "    - \\{segment: 2, hole_angle_deg: 280.0\\}\n",
+                                                 ""));
+    Write(d / "twocables.yaml",
+          EditedThreeSegment("    - \\{segment: 2, hole_angle_deg: 280.0\\}\n", ""));
+    Write(d / "samehole.yaml", EditedThreeSegment("hole_angle_deg: 160.0", "hole_angle_deg: 40.0"));
+    Write(d / "halfplane.yaml",
+          EditedThreeSegment("hole_angle_deg: 280.0", "hole_angle_deg: 100.0"));
     fs::create_directory(d / "confdir");
     Write(d / "p.yaml", "mu: 0.2\n");
     Write(d / "pbounds.yaml", "mu: {value: 0.5, free: true, bounds: [0.1, 0.3]}\n");
@@ -143,11 +161,21 @@ class BadInputTable : public ::testing::Test {
     o = RunCcsrm("simulate --config " + Paper() + " --case 1 --duration 0.2 --quiet --out " +
                  (w / "run.h5").string());
     ASSERT_EQ(o.status, 0) << o.err;
-    for (const char* name : {"exp.h5", "processed.h5", "run.h5"}) fs::rename(w / name, d / name);
+    // The second arm's (nine cables): the paper's six-cable inputs do not fit it.
+    o = RunCcsrm("generate --config " + std::string(CCSRM_SOURCE_DIR) +
+                 "/configs/three-segment.yaml --case 1 --duration 0.3 --quiet --seed 3 --out " +
+                 (w / "exp9.h5").string());
+    ASSERT_EQ(o.status, 0) << o.err;
+    for (const char* name : {"exp.h5", "processed.h5", "run.h5", "exp9.h5"}) {
+      fs::rename(w / name, d / name);
+    }
     const fs::path processed = d / "processed.h5";
     MutateHdf5(processed, d / "five.h5",
                "put('/input/length_change', f['/input/length_change'][:, :5])");
     MutateHdf5(processed, d / "badyaml.h5", "f.attrs['config_yaml'] = 'arm: [unclosed'");
+    MutateHdf5(processed, d / "nanlength.h5",
+               "x = f['/input/length_change'][...]\nx[3, 2] = np.nan\n"
+               "put('/input/length_change', x)");
     MutateHdf5(processed, d / "huge.h5",
                "put('/measured/joint_angles', f['/measured/joint_angles'][...] * 1e30)");
     MutateHdf5(processed, d / "cut5.h5",
@@ -210,6 +238,22 @@ const std::vector<BadInput>& Rows() {
       {"configs", "config check {d}/typo.yaml", {"{d}/typo.yaml", "link_mas_kg"}},
       {"configs", "config check {d}/syntax.yaml", {"{d}/syntax.yaml", "line"}},
       {"configs", "config check {d}/missing.yaml", {"{d}/missing.yaml"}},
+      // Layouts: a segment its cables cannot bend about both axes (issue 32).
+      {"configs",
+       "config check {d}/nocable.yaml",
+       {"{d}/nocable.yaml", "arm.segments[1]", "segment 2", "no driving cable"}},
+      {"configs",
+       "config check {d}/twocables.yaml",
+       {"{d}/twocables.yaml", "segment 2", "2 driving cables"}},
+      {"configs",
+       "config check {d}/samehole.yaml",
+       {"{d}/samehole.yaml", "segment 2", "coincident holes"}},
+      {"configs",
+       "config check {d}/halfplane.yaml",
+       {"{d}/halfplane.yaml", "segment 2", "half-plane"}},
+      {"configs",
+       "simulate --config {d}/halfplane.yaml --duration 0.1 --out {d}/run2.h5",
+       {"{d}/halfplane.yaml", "segment 2", "half-plane"}},
       // Command-line values and parameter files.
       {"overrides",
        "simulate --config {d}/c.yaml --set mu=1e-400 --duration 0.1 --out {d}/run2.h5",
@@ -245,8 +289,8 @@ const std::vector<BadInput>& Rows() {
        "report --in {d}/run.h5 --instants -5 --out {d}/report",
        {"--instants", "-5"}},  // 8
       {"overrides", "report --in {d}/run.h5 --instants 1e4 --out {d}/report", {"--instants"}},
-      // From the test's working folder, outside the repository, where the
-      // default configuration is not found: the value is refused first.
+      // From the test's working folder, outside the repository: the value is
+      // refused before the (bundled) configuration is read.
       {"overrides", "bench --duration 0", {"--duration"}},  // 9
       {"overrides",
        "simulate --config {d}/c.yaml --amplitude 100 --duration 0.1 --out {d}/run2.h5",
@@ -272,6 +316,22 @@ const std::vector<BadInput>& Rows() {
       {"hdf5",
        "mocap process --in {d}/exp.h5 --inputs {d}/five.h5 --out {d}/x.h5",
        {"{d}/five.h5", "/input/length_change"}},  // 5
+      // Inputs are checked against the arm where they enter (issue 32).
+      {"hdf5",
+       "mocap process --in {d}/exp9.h5 --inputs {d}/exp.h5 --out {d}/x.h5",
+       {"{d}/exp.h5", "/input/length_change", "6 cable columns", "9 driving cables"}},
+      {"hdf5",
+       "mocap process --in {d}/exp9.h5 --inputs {d}/run.h5 --out {d}/x.h5",
+       {"{d}/run.h5", "/input_length_change", "6 cable columns", "9 driving cables"}},
+      {"hdf5",
+       "mocap process --in {d}/exp.h5 --inputs {d}/nanlength.h5 --out {d}/x.h5",
+       {"{d}/nanlength.h5", "/input/length_change", "cable 3", "finite"}},
+      {"hdf5",
+       "dataset inspect {d}/nanlength.h5",
+       {"{d}/nanlength.h5", "/input/length_change", "finite"}},
+      {"hdf5",
+       "identify --data {d}/nanlength.h5 --out {d}/fit",
+       {"{d}/nanlength.h5", "/input/length_change", "finite"}},
       // Marker data.
       {"markers",
        "mocap process --in {d}/nan.h5 --out {d}/x.h5",

@@ -418,6 +418,67 @@ TEST(Generate, ListEffectsGivesEveryEffectWithUnitsBoundsAndRealisticMagnitude) 
   EXPECT_THAT(text.out, HasSubstr("table_tilt.lateral_rad"));
 }
 
+// The second arm (configs/three-segment.yaml) with every segment given
+// `links` links: 3 makes a 9-joint arm, 5 a 15-joint one.
+std::string ThreeSegmentArmWithLinks(const fs::path& dir, int links) {
+  std::string text =
+      ccsrm::ReadTextFile(std::string(CCSRM_SOURCE_DIR) + "/configs/three-segment.yaml");
+  std::string pattern;
+  for (int k = 0; k + 1 < links; ++k) {
+    pattern += std::string(k ? ", " : "") + (k % 2 ? "large" : "small");
+  }
+  for (std::size_t at; (at = text.find("links: 4")) != std::string::npos;) {
+    text.replace(at, 8, "links: " + std::to_string(links));
+  }
+  for (std::size_t at; (at = text.find("[small, large, small]")) != std::string::npos;) {
+    text.replace(at, 21, "[" + pattern + "]");
+  }
+  const fs::path path = dir / ("arm" + std::to_string(3 * links) + ".yaml");
+  ccsrm::WriteTextFileAtomically(path.string(), text);
+  return path.string();
+}
+
+// Issue 32: effects are sized to the arm of --config, at every door.
+TEST(Generate, EffectsAreSizedToTheArmOfTheConfiguration) {
+  const fs::path dir = FreshDir("sized_effects");
+  const std::string nine = ThreeSegmentArmWithLinks(dir, 3);
+  const std::string fifteen = ThreeSegmentArmWithLinks(dir, 5);
+  for (const auto& [config, joints] : {std::make_pair(nine, 9), std::make_pair(fifteen, 15)}) {
+    const Outcome o = RunCcsrm("generate --list-effects --json --config " + config);
+    ASSERT_EQ(o.status, 0) << o.err;
+    const nlohmann::json j = nlohmann::json::parse(o.out);
+    EXPECT_EQ(j["arm"]["joints"], joints);
+    EXPECT_EQ(j["arm"]["config"], config);
+    const nlohmann::json& offsets = j["effects"][6]["parameters"];
+    ASSERT_EQ(j["effects"][6]["name"], "mocap_offset");
+    ASSERT_EQ(offsets.size(), static_cast<std::size_t>(2 * joints));
+    EXPECT_EQ(offsets.back()["name"], "mocap_offset.joint" + std::to_string(joints) + "_y_rad");
+  }
+  // A joint the arm does not have: one line naming the option and why.
+  for (const std::string& args :
+       {"generate --config " + nine + " --effect mocap_offset:joint12_x_rad=0.01 --out " +
+            (dir / "x.h5").string(),
+        "simulate --config " + nine + " --set mocap_offset.joint12_x_rad=0.01 --out " +
+            (dir / "x.h5").string()}) {
+    SCOPED_TRACE(args);
+    const Outcome o = RunCcsrm(args + " --duration 0.1 --quiet");
+    EXPECT_EQ(o.status, 2);
+    EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
+    EXPECT_THAT(o.err, HasSubstr("joint12_x_rad"));
+    EXPECT_THAT(o.err, HasSubstr("this arm has 9 joints"));
+    EXPECT_FALSE(fs::exists(dir / "x.h5"));
+  }
+  // On 15 joints, --effect mocap_offset offsets all of them in the truth.
+  const std::string exp = (dir / "exp.h5").string();
+  const Outcome g =
+      RunCcsrm("generate --config " + fifteen +
+               " --case 1 --duration 0.05 --quiet --effect mocap_offset --out " + exp);
+  ASSERT_EQ(g.status, 0) << g.err;
+  const std::string truth = ccsrm::ReadTextFile((dir / "exp.truth.yaml").string());
+  EXPECT_THAT(truth, HasSubstr("joint15_y_rad: "));
+  EXPECT_EQ(truth.find("joint16_x_rad"), std::string::npos);
+}
+
 TEST(Generate, EffectsGoToTheTruthOnlyAndMocapOffsetIntoTheRecordedAngles) {
   const fs::path dir = FreshDir("effects");
   const std::string effects = (dir / "effects.yaml").string();

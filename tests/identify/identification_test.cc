@@ -227,6 +227,43 @@ TEST(ParameterFile, DuplicateKeyNamesBothLines) {
   }
 }
 
+// Issue 32: a θy "fit %" of -11.9 % on an axis planned to stay at 0. Fit
+// percent divides by the axis's own motion; it is given only where the
+// axis moves, and the motion is given everywhere to read an RMS against.
+TEST(AngleErrors, FitPercentOnlyWhereTheAxisMoves) {
+  // One joint, 200 frames: θx swings 5° (RMS about its mean 5/√2 = 3.5°),
+  // θy wobbles 0.05° about 0.2° (under a tenth of θx's motion); joint 2
+  // barely moves either way (0.05° RMS in θx, within 3 x its 0.03° noise).
+  Experiment e;
+  e.joints = 2;
+  e.noise_deg = {0.03, 0.03};
+  const int frames = 200;
+  e.measured_rad = Eigen::MatrixXd(frames, 4);
+  Eigen::MatrixXd simulated(frames, 4);
+  const double rad = M_PI / 180.0;
+  for (int f = 0; f < frames; ++f) {
+    const double phase = 2.0 * M_PI * f / frames;
+    e.measured_rad.row(f) << 5.0 * std::sin(phase), 0.2 + 0.05 * std::sin(3 * phase),
+        0.05 * std::sqrt(2.0) * std::sin(phase), 0.0;
+    e.measured_rad.row(f) *= rad;
+    // The fit is off by 0.1° everywhere: 98 % of θx's motion, but more than
+    // θy's whole motion (a fit percent of -183 % there).
+    simulated.row(f) = e.measured_rad.row(f).array() + 0.1 * rad;
+  }
+  const ChannelErrors errors = AngleErrors({&e}, {&simulated});
+  EXPECT_NEAR(errors.motion_rms_deg[0][0], 5.0 / std::sqrt(2.0), 1e-9);
+  EXPECT_NEAR(errors.motion_rms_deg[0][1], 0.05 / std::sqrt(2.0), 1e-9);
+  EXPECT_NEAR(errors.rms_deg[0][1], 0.1, 1e-12);
+  EXPECT_NEAR(errors.fit_percent[0][0], 100.0 * (1.0 - 0.1 / (5.0 / std::sqrt(2.0))), 1e-9);
+  EXPECT_TRUE(std::isnan(errors.fit_percent[0][1]));  // a tenth of θx's motion: no %
+  EXPECT_NEAR(errors.motion_rms_deg[1][0], 0.05, 1e-9);
+  EXPECT_TRUE(std::isnan(errors.fit_percent[1][0]));  // under 3 x the noise: no %
+  EXPECT_TRUE(std::isnan(errors.fit_percent[1][1]));  // no motion at all
+  // Overall: over θx of joint 1 only, the one axis that moves.
+  EXPECT_NEAR(errors.fit_percent_overall, errors.fit_percent[0][0], 1e-9);
+  EXPECT_NEAR(errors.rms_deg_overall, 0.1, 1e-12);  // the RMS is over everything
+}
+
 TEST(Identification, RefusesAStartOutsideItsBoundsBeforeAnyRun) {
   auto backend = std::make_shared<CountingBackend>();
   IdentificationOptions o;

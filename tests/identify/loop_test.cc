@@ -142,7 +142,7 @@ TEST(Loop, FindsAnUndeclaredMocapOffsetAndReachesTheNoise) {
   EXPECT_GE(*s.holdout_rms_before_deg, 2.0 * *s.holdout_rms_after_deg);
   // Every offset within 20 % of the truth or the truth inside its interval.
   int checked = 0;
-  for (const std::string& name : sim::FindEffect("mocap_offset", "test").parameters) {
+  for (const std::string& name : sim::EffectParameterNames("mocap_offset", truth.arm)) {
     const ParameterEstimate* p = s.final_fit.Find(name);
     ASSERT_NE(p, nullptr) << name;
     const double t = sim::GetParameter(truth, name);

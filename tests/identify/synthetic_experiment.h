@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "ccsrm/datasets/experiment_file.h"
+#include "ccsrm/identify/experiment.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/effects.h"
 #include "ccsrm/sim/model.h"
@@ -20,11 +21,12 @@ namespace ccsrm::identify::testing_support {
 
 inline constexpr double kDeg = 180.0 / M_PI;
 
-// The nominal configuration of the experiments: the paper's arm, case 4's
+// The nominal configuration of the experiments: the paper's arm (or the
+// bundled configuration `config`, e.g. "three-segment.yaml"), case 4's
 // friction (none on the driving cables), a compressed protocol of which the
 // experiments record the 2 s ramp and the 1 s hold.
-inline sim::Config Nominal() {
-  sim::Config c = sim::LoadConfig(std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml");
+inline sim::Config Nominal(const std::string& config = "paper.yaml") {
+  sim::Config c = sim::LoadConfig(std::string(CCSRM_SOURCE_DIR) + "/configs/" + config);
   c.protocol.ramp_s = 2.0;
   c.protocol.hold_s = 1.0;
   c.protocol.return_s = 2.0;
@@ -37,8 +39,7 @@ inline sim::Config Nominal() {
 // true angles at 100 Hz plus white noise of noise_deg, and a twist record of
 // the same noise (from which the loader estimates it).
 inline datasets::ExperimentFile Record(const sim::ArmParameters& truth, double noise_deg,
-                                       unsigned seed) {
-  const sim::Config config = Nominal();
+                                       unsigned seed, const sim::Config& config = Nominal()) {
   const sim::ArmModel model(config.arm);
   const double duration = config.protocol.ramp_s + config.protocol.hold_s;
   const sim::CableInputs planned =
@@ -99,6 +100,24 @@ inline sim::ArmParameters Truth() {
   sim::ArmParameters p = Nominal().parameters;
   p.T_p = 65.0;  // nominal 50
   return p;
+}
+
+// The second arm of configs/ (three segments of four links, nine cables) on
+// the same compressed protocol, and experiments of it recorded with the
+// mocap floor's 0.03 deg of noise, one per seed ("arm3_<seed>").
+inline constexpr double kSecondArmNoiseDeg = 0.03;
+inline sim::Config SecondArm() { return Nominal("three-segment.yaml"); }
+inline std::vector<Experiment> Recordings(const sim::ArmParameters& truth,
+                                          const std::vector<unsigned>& seeds,
+                                          const sim::Config& config) {
+  std::vector<Experiment> out;
+  for (unsigned seed : seeds) {
+    const std::string name = "arm3_" + std::to_string(seed);
+    out.push_back(
+        MakeExperiment(Record(truth, kSecondArmNoiseDeg, seed, config), name + ".h5", {}));
+    out.back().name = name;
+  }
+  return out;
 }
 
 }  // namespace ccsrm::identify::testing_support

@@ -11,10 +11,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <string>
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/mocap/recording.h"
+#include "ccsrm/sim/config.h"
+#include "ccsrm/sim/model.h"
+#include "ccsrm/sim_io/experiment_check.h"
 #include "mocap_test_util.h"
 #include "round_trip.h"
 #include "same_experiment.h"
@@ -251,6 +255,67 @@ TEST(RecordingCall, ReconstructionIsCalledWithTheResolvedLayoutAndModel) {
   // The file's time base against frame i at i / rate: the same to rounding.
   ccsrm::testing::ExpectSameArray(*reconstructed.experiment.measured_joint_angles,
                                   *file.experiment.measured_joint_angles, "joint angles", 1e-12);
+}
+
+// Inputs of another arm are refused where they enter, before any marker is
+// reconstructed or processed (issue 32: `mocap process --inputs` used to
+// work through a recording first).
+TEST(RecordingCall, InputsOfAnotherArmAreRefusedBeforeTheMarkers) {
+  RecordingRequest request;
+  request.config = std::string(CCSRM_SOURCE_DIR) + "/configs/three-segment.yaml";  // 9 cables
+  request.inputs = Trial().experiment_path;  // the paper arm's 6
+  request.reconstruction_source = "fake-cameras.yaml";
+  bool reconstructed = false;
+  request.reconstruct = [&](const MarkerLayout&, const sim::ArmModel*) {
+    reconstructed = true;
+    return ReconstructedMarkers{MarkerTableFromExperiment(Trial().experiment), ""};
+  };
+  std::string message;
+  try {
+    ProcessRecording(request);
+  } catch (const InputError& e) {
+    message = e.what();
+  }
+  EXPECT_EQ(message, request.inputs + ": /input/length_change: has 6 cable columns, the arm of " +
+                         request.config + " has 9 driving cables");
+  EXPECT_FALSE(reconstructed);
+}
+
+// The one check of recorded inputs (sim_io::CheckInputs), on inputs
+// assembled in memory: the time base, the lengths, the arm's cables.
+TEST(InputCheck, TimeBaseLengthsAndCablesAreCheckedWithOneLine) {
+  const sim::ArmModel arm(sim::LoadConfig(Paper()).arm);
+  datasets::ExperimentFile good = Trial().experiment;
+  EXPECT_NO_THROW(sim_io::CheckInputs(good, "e.h5", &arm, "arm.yaml"));
+  const auto error = [&](const std::function<void(datasets::ExperimentFile*)>& change) {
+    datasets::ExperimentFile e = good;
+    change(&e);
+    try {
+      sim_io::CheckInputs(e, "e.h5", &arm, "arm.yaml");
+    } catch (const InputError& x) {
+      return std::string(x.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_THAT(
+      error([](datasets::ExperimentFile* e) { e->input_time.values[5] = e->input_time.values[4]; }),
+      HasSubstr("e.h5: /input/time: not strictly increasing: sample 5 holds "));
+  EXPECT_THAT(error([](datasets::ExperimentFile* e) { e->input_time.values[2] = NAN; }),
+              HasSubstr("e.h5: /input/time: sample 2 is nan: the time base must be finite"));
+  EXPECT_THAT(
+      error([](datasets::ExperimentFile* e) { e->input_length_change.at(7, 4) = INFINITY; }),
+      HasSubstr("e.h5: /input/length_change: sample 7, cable 5 is inf: a length change "
+                "must be finite"));
+  EXPECT_EQ(error([](datasets::ExperimentFile* e) {
+              e->input_length_change = datasets::Array({e->input_time.rows(), 4}, 0.0);
+            }),
+            "e.h5: /input/length_change: has 4 cable columns, the arm of arm.yaml has 6 driving "
+            "cables");
+  // No cable column: a recording without an actuator record, allowed.
+  EXPECT_EQ(error([](datasets::ExperimentFile* e) {
+              e->input_length_change = datasets::Array({e->input_time.rows(), 0});
+            }),
+            "(no error)");
 }
 
 }  // namespace

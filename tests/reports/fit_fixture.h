@@ -28,12 +28,14 @@ inline double FittedX(std::size_t i, std::size_t j, double scale = 1.0) {
   return MeasuredX(i, j) + scale * 0.01 * (j + 1);
 }
 
+// θy barely moves (a planar protocol): no fit percent, its motion instead.
 inline json Errors(double scale) {
   json joints = json::array();
   for (std::size_t j = 0; j < kJoints; ++j) {
     joints.push_back({{"joint", j + 1},
                       {"rms_deg", {scale * 0.01 * (j + 1), scale * 0.002 * (j + 1)}},
-                      {"fit_percent", {100.0 - scale * (j + 1), -scale * 0.5 * (j + 1)}},
+                      {"fit_percent", {100.0 - scale * (j + 1), nullptr}},
+                      {"motion_rms_deg", {0.7071067811865476, 0.003 * (j + 1)}},
                       {"samples", {kFrames, 3}}});
   }
   return {{"rms_deg", scale * 0.031164149880225006},

@@ -81,8 +81,22 @@ TEST(FitPage, KnownFitShowsItsNumbers) {
   EXPECT_EQ(joint3["rms_x_fitted_deg"], 0.03);
   EXPECT_EQ(joint3["rms_y_fitted_deg"], 0.006);
   EXPECT_EQ(joint3["fit_x_fitted_percent"], 97.0);
-  EXPECT_EQ(joint3["fit_y_start_percent"], -3.0);
+  EXPECT_EQ(joint3["motion_x_deg"], 0.7071);
+  // θy barely moves: no fit percent (never a negative one without reason),
+  // its RMS error against its motion in degrees instead.
+  EXPECT_TRUE(joint3["fit_y_start_percent"].is_null());
+  EXPECT_TRUE(joint3["fit_y_fitted_percent"].is_null());
+  EXPECT_EQ(joint3["motion_y_deg"], 0.009);
   EXPECT_EQ(joint3["samples_x"], 5);
+  const auto& errors = document.sections[document.sections.size() - 3];
+  ASSERT_EQ(errors.id, "errors");
+  const FigureBlock& bars = std::get<FigureBlock>(errors.blocks[0]);
+  EXPECT_EQ(bars.figure.panels[2].title, "Fit percent θx");
+  EXPECT_EQ(bars.figure.panels[3].title, "RMS error against motion θy");
+  EXPECT_THAT(bars.caption, HasSubstr("θy barely moves at any joint"));
+  const Table& per_joint = std::get<Table>(errors.blocks[1]);
+  EXPECT_THAT(per_joint.caption, HasSubstr("given only for an axis that moves"));
+  EXPECT_THAT(per_joint.caption, HasSubstr("below 0 worse than that mean"));
 
   auto fit = [&](const std::string& quantity) {
     return RowOf(summary, "fit", "quantity", quantity)["value"];

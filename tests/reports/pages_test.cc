@@ -37,11 +37,13 @@ std::string PaperYaml() {
 // (0-based) has θx = 0.01 (j + 1) i rad and θy = -0.001 (j + 1) i rad in
 // frame i; cable k has input tension 100 + k + i N; cable 3's stuck count
 // goes 0, 2, 5, 5, 1 (and repeats).
-datasets::RunFile KnownRun(const std::string& case_name, std::size_t frames = 5, double dt = 0.5) {
-  const std::size_t t = frames, j = 12, c = 6;
+// With `config_yaml` and `cables` given, another arm of 12 joints.
+datasets::RunFile KnownRun(const std::string& case_name, std::size_t frames = 5, double dt = 0.5,
+                           const std::string& config_yaml = PaperYaml(), std::size_t cables = 6) {
+  const std::size_t t = frames, j = 12, c = cables;
   datasets::RunFile run;
   run.case_name = case_name;
-  run.config_yaml = PaperYaml();
+  run.config_yaml = config_yaml;
   run.created = "2026-01-02T03:04:05Z";
   run.wall_time_s = 0.8;
   run.steps = 1234;
@@ -150,6 +152,48 @@ TEST(RunPage, KnownRunShowsItsStoredNumbers) {
     std::string why;
     EXPECT_TRUE(figure->figure.IsValid(&why)) << why;
   }
+}
+
+// Issue 32: "Simulation run — paper case 2" and captions citing the paper's
+// figures on a user's arm. A run of the protocol on another arm is named by
+// its case and its arm as configured, with its plan, and no paper word.
+TEST(RunPage, AnotherArmIsNamedAsConfiguredWithoutThePapersWords) {
+  const std::string three_segment =
+      ReadTextFile(std::string(CCSRM_SOURCE_DIR) + "/configs/three-segment.yaml");
+  const Document document =
+      BuildRunDocument(KnownRun("1", 5, 0.5, three_segment, 9), "arm3.h5", ReportOptions());
+  const nlohmann::json json = ToJson(document);
+  EXPECT_EQ(json["title"],
+            "Simulation run — case 1 (no friction), 3 segments of 4, 4 and 4 links (12 joints), 9 "
+            "driving cables");
+  EXPECT_EQ(Row(json, "run", "quantity", "case")["value"], "1 (no friction)");
+  EXPECT_EQ(Row(json, "run", "quantity", "arm")["value"],
+            "3 segments of 4, 4 and 4 links (12 joints), 9 driving cables");
+  EXPECT_EQ(Row(json, "run", "quantity", "protocol")["value"],
+            "θx of every joint 0 → 8° along a quintic over 20 s, held 4 s, back over 20 s, at "
+            "rest 4 s; θy planned 0");
+  // The protocol's plan on any arm: 8° · quintic(2 s / 20 s) at the end.
+  EXPECT_EQ(Row(json, "theta_x_at_instants", "joint", "plan")["theta_x_deg_end_of_run"],
+            Fixed3(8.0 * sim::QuinticBlend(0.1)));
+  EXPECT_EQ(Row(json, "input_tension", "cable", 9)["segment"], 3);
+  const std::string html = ToHtml(document);
+  for (const char* word : {"paper", "Paper", "Fig."}) {
+    EXPECT_EQ(html.find(word), std::string::npos) << word << " on the page of another arm";
+  }
+  EXPECT_THAT(html, HasSubstr("Case 1 (no friction) on the configured arm (3 segments"));
+
+  // The paper's arm in a paper case: its case and figures by name.
+  const std::string paper = ToHtml(BuildRunDocument(KnownRun("2"), "known.h5", ReportOptions()));
+  EXPECT_THAT(paper, HasSubstr("Paper case 2 (friction on all cables) on the paper's arm"));
+  EXPECT_THAT(paper, HasSubstr("the paper's Fig. 22"));
+  EXPECT_THAT(paper, HasSubstr("the layout of the paper's Figs. 16 and 18–21"));
+  // The paper's arm with one hole moved is the user's: no paper words.
+  std::string moved = PaperYaml();
+  moved.replace(moved.find("hole_angle_deg: 300.0"), 21, "hole_angle_deg: 290.0");
+  const std::string edited =
+      ToHtml(BuildRunDocument(KnownRun("2", 5, 0.5, moved), "moved.h5", ReportOptions()));
+  EXPECT_EQ(edited.find("paper"), std::string::npos);
+  EXPECT_THAT(edited, HasSubstr("Case 2 (friction on all cables) on the configured arm"));
 }
 
 TEST(RunPage, PaperInstantsWithinAFullRun) {

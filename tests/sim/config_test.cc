@@ -8,6 +8,8 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/sim/describe.h"
+#include "ccsrm/sim/paper_run.h"
 
 namespace ccsrm::sim {
 namespace {
@@ -242,9 +244,112 @@ TEST(Config, PhysicalValuesOutsideAnyArmAreRefused) {
   for (const auto& c : cases) EXPECT_THAT(ErrorOf(Edited(c.from, c.to)), HasSubstr(c.message));
 }
 
-TEST(Config, EveryConfigurationInTheRepositoryPasses) {
-  for (const char* path : {"/configs/paper.yaml", "/datasets/samples/loop/arm.yaml"}) {
-    EXPECT_NO_THROW(LoadConfig(std::string(CCSRM_SOURCE_DIR) + path)) << path;
+TEST(Config, EveryConfigurationInTheRepositoryPassesWithoutWarnings) {
+  for (const char* path :
+       {"/configs/paper.yaml", "/configs/three-segment.yaml", "/datasets/samples/loop/arm.yaml"}) {
+    Config c;
+    EXPECT_NO_THROW(c = LoadConfig(std::string(CCSRM_SOURCE_DIR) + path)) << path;
+    EXPECT_TRUE(c.warnings.empty()) << path << ": " << c.warnings.front();
+  }
+}
+
+// The second arm (three segments of four links, nine cables) with the first
+// occurrence of `from` replaced; every `from` must be there.
+std::string EditedThreeSegment(const std::string& from, const std::string& to) {
+  std::string text = ReadTextFile(std::string(CCSRM_SOURCE_DIR) + "/configs/three-segment.yaml");
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+// Issue 32: layouts whose cables cannot bend a segment about both axes
+// "completed" with the segment swinging to 53 deg. Each is refused with one
+// line naming the file, the cable (or segment) line and the segment.
+TEST(Config, SegmentsTheirCablesCannotBendBothWaysAreRefused) {
+  const std::string seg2 = "segment 2 ('segment2')";
+  const struct {
+    std::string what, text, message;
+  } cases[] = {
+      {"no cable",
+       EditedThreeSegment("    - {segment: 2, hole_angle_deg: 40.0}\n"
+                          "    - {segment: 2, hole_angle_deg: 160.0}\n"
+                          "    - {segment: 2, hole_angle_deg: 280.0}\n",
+                          ""),
+       "key 'arm.segments[1]': " + seg2 + " has no driving cable: at least three are needed"},
+      {"two cables", EditedThreeSegment("    - {segment: 2, hole_angle_deg: 280.0}\n", ""),
+       "key 'driving_cables.cables[4]': " + seg2 +
+           " has 2 driving cables (cables 4 and 5): at least three are needed"},
+      {"coincident angles",
+       EditedThreeSegment("{segment: 2, hole_angle_deg: 160.0}",
+                          "{segment: 2, hole_angle_deg: 40.5}"),
+       "key 'driving_cables.cables[4]': " + seg2 +
+           ": cables 4 and 5 sit at hole angles 40 and 40.5 deg, closer than 3.72 deg"},
+      // Equal angles written differently (360 deg apart) are still one hole.
+      {"one angle twice",
+       EditedThreeSegment("{segment: 2, hole_angle_deg: 160.0}",
+                          "{segment: 2, hole_angle_deg: -320.0}"),
+       "cables 4 and 5 sit at hole angles 40 and -320 deg"},
+      {"open half-plane",
+       EditedThreeSegment("{segment: 2, hole_angle_deg: 280.0}",
+                          "{segment: 2, hole_angle_deg: 100.0}"),
+       "key 'driving_cables.cables[4]': " + seg2 +
+           ": its 3 cables (hole angles 40, 100, 160 deg) lie within a half-plane, no cable "
+           "between 160 and 40 deg (a gap of 240 deg)"},
+      // A gap of exactly 180 deg: nothing pulls across it either.
+      {"closed half-plane",
+       EditedThreeSegment("{segment: 2, hole_angle_deg: 280.0}",
+                          "{segment: 2, hole_angle_deg: 220.0}"),
+       "lie within a half-plane, no cable between 220 and 40 deg (a gap of 180 deg)"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    const std::string error = ErrorOf(c.text);
+    EXPECT_THAT(error, HasSubstr("bad.yaml: line "));
+    EXPECT_THAT(error, HasSubstr(c.message));
+    EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+  }
+  // Four cables 90 deg apart (no gap reaches 180) bend a segment both ways.
+  EXPECT_EQ(ErrorOf(EditedThreeSegment("{segment: 2, hole_angle_deg: 280.0}",
+                                       "{segment: 2, hole_angle_deg: 280.0}\n"
+                                       "    - {segment: 2, hole_angle_deg: 350.0}")),
+            "(no error)");
+  // Validate applies the same rule to an arm built in code.
+  Config c = LoadConfig(kPaperConfig);
+  c.arm.driving.cables[5].hole_angle_rad = c.arm.driving.cables[4].hole_angle_rad;
+  EXPECT_THROW(Validate(c), InputError);
+}
+
+// Far outside the range of such arms but runnable: a warning naming the
+// key and the reason; the file still loads.
+TEST(Config, ValuesFarOutsideSuchArmsAreWarnedWithTheReason) {
+  const struct {
+    std::string from, to, warning;
+  } cases[] = {
+      {"hole_circle_radius_m: 0.020", "hole_circle_radius_m: 0.5",
+       "key 'arm.segments[1].hole_circle_radius_m': hole circle radius 0.5 m is 5.88 times the "
+       "link length 0.085 m: disks wider than the links are long"},
+      {"hole_circle_radius_m: 0.015", "hole_circle_radius_m: 0.0015",
+       "key 'arm.segments[2].hole_circle_radius_m': hole circle radius 0.0015 m is 0.0187 times "
+       "the link length 0.08 m: the cables would have almost no lever"},
+      {"link_mass_kg: 0.085", "link_mass_kg: 85",
+       "key 'arm.segments[1].link_mass_kg': a link of 85 kg in an envelope of 0.000427 m^3"},
+      {"[58.0e-6, 56.0e-6, 14.0e-6]", "[58.0e-6, 56.0e-6, 140.0e-6]",
+       "key 'arm.segments[1].link_inertia_kgm2': the principal moments break the triangle "
+       "inequality"},
+      {"[58.0e-6, 56.0e-6, 14.0e-6]", "[58.0e-2, 56.0e-2, 14.0e-2]",
+       "key 'arm.segments[1].link_inertia_kgm2': a principal moment of 0.58 kg m^2 exceeds"},
+      {"pretension_n: 100.0", "pretension_n: 900.0",
+       "key 'driving_cables.pretension_n': the pre-tension 900 N stretches the driving cables by "
+       "2.61 %"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.to);
+    Config config;
+    ASSERT_NO_THROW(config = ParseConfig(EditedThreeSegment(c.from, c.to), "odd.yaml"));
+    ASSERT_FALSE(config.warnings.empty());
+    EXPECT_THAT(config.warnings.front(), HasSubstr("odd.yaml: line "));
+    EXPECT_THAT(config.warnings.front(), HasSubstr(c.warning));
   }
 }
 
@@ -259,6 +364,55 @@ TEST(Config, NonFiniteAndUnrepresentableNumbersAreRefused) {
               HasSubstr("'1e400' is outside the range of a double"));
   EXPECT_THAT(ErrorOf(Edited("cross_section_m2: 1.3273e-6", "cross_section_m2: 1e-400")),
               HasSubstr("key 'driving_cables.cross_section_m2': '1e-400' underflows"));
+}
+
+// Issue 32: the default --config was relative to the repository, so the bare
+// command failed anywhere else. The bundled files are found by path.
+TEST(Config, BundledConfigurationsAreFoundWhereverTheCommandRuns) {
+  EXPECT_EQ(BundledConfigPath("paper.yaml"), kPaperConfig);
+  EXPECT_EQ(ConfigPathOrBundled(""), kPaperConfig);
+  EXPECT_EQ(ConfigPathOrBundled("mine.yaml"), "mine.yaml");
+  EXPECT_EQ(BundledConfigPath("three-segment.yaml"),
+            std::string(CCSRM_SOURCE_DIR) + "/configs/three-segment.yaml");
+  // PreparePaperRun without a path reads it, and says which file it read.
+  PaperRunOptions options;
+  options.duration_s = 0.01;
+  EXPECT_EQ(PreparePaperRun(options).config_path, kPaperConfig);
+  // Neither place holds it: one line naming both, asking for --config.
+  try {
+    BundledConfigPath("none.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_THAT(message, HasSubstr("--config: not given, and the bundled none.yaml is in neither " +
+                                   std::string(CCSRM_SOURCE_DIR) + "/configs nor "));
+    EXPECT_THAT(message, HasSubstr("share/ccsrm/configs: pass --config FILE"));
+  }
+}
+
+// What decides whether a run may cite the paper: the paper's arm, however
+// its file is named or its friction and protocol are set.
+TEST(Describe, ThePapersArmIsRecognisedAndAnyArmIsNamedAsConfigured) {
+  const Config paper = LoadConfig(kPaperConfig);
+  const Config three = LoadConfig(std::string(CCSRM_SOURCE_DIR) + "/configs/three-segment.yaml");
+  EXPECT_TRUE(IsPaperArm(paper.arm));
+  EXPECT_TRUE(IsPaperArm(ParseConfig(ToYaml(paper), "written.yaml").arm));  // written back
+  EXPECT_TRUE(IsPaperArm(ParseConfig(Edited("friction_kinetic: 0.21", "friction_kinetic: 0.3"),
+                                     "mine.yaml")
+                             .arm));  // friction is not the arm
+  EXPECT_FALSE(IsPaperArm(three.arm));
+  EXPECT_FALSE(IsPaperArm(
+      ParseConfig(Edited("hole_angle_deg: 300.0", "hole_angle_deg: 290.0"), "m.yaml").arm));
+  EXPECT_FALSE(
+      IsPaperArm(ParseConfig(Edited("link_mass_kg: 0.070", "link_mass_kg: 0.071"), "m.yaml").arm));
+  EXPECT_EQ(DescribeArm(paper.arm), "2 segments of 6 and 6 links (12 joints), 6 driving cables");
+  EXPECT_EQ(DescribeArm(three.arm), "3 segments of 4, 4 and 4 links (12 joints), 9 driving cables");
+  EXPECT_EQ(DescribeProtocol(three.protocol),
+            "θx of every joint 0 → 8° along a quintic over 20 s, held 4 s, back over 20 s, at "
+            "rest 4 s; θy planned 0");
+  EXPECT_EQ(DescribeCase(2, true), "paper case 2 (friction on all cables)");
+  EXPECT_EQ(DescribeCase(1, false), "case 1 (no friction)");
+  EXPECT_EQ(DescribeCase(0, true), "friction as configured");
 }
 
 TEST(Config, ValidateRejectsConfigBuiltInCode) {

@@ -8,9 +8,12 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <string>
+#include <vector>
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
@@ -108,10 +111,12 @@ TEST(Effects, SevenEffectsEachWithNamedBoundedParameters) {
   EXPECT_EQ(names,
             (std::vector<std::string>{"joint_friction", "table_tilt", "actuator_delay", "backlash",
                                       "pretension_creep", "air_drag", "mocap_offset"}));
+  const ArmSize paper_arm{12, 6};
   for (const EffectInfo& e : Effects()) {
-    ASSERT_FALSE(e.parameters.empty()) << e.name;
-    for (const std::string& name : e.parameters) {
-      const ParameterInfo& p = FindParameter(name, "test");
+    const std::vector<std::string> parameters = EffectParameterNames(e.name, paper_arm);
+    ASSERT_FALSE(parameters.empty()) << e.name;
+    for (const std::string& name : parameters) {
+      const ParameterInfo& p = FindParameter(name, "test", paper_arm);
       EXPECT_EQ(p.name, e.name + "." + p.short_name);
       EXPECT_EQ(p.effect, e.name);
       EXPECT_EQ(p.field, nullptr);
@@ -123,7 +128,7 @@ TEST(Effects, SevenEffectsEachWithNamedBoundedParameters) {
   }
   EXPECT_TRUE(FindEffect("mocap_offset", "test").measurement);
   // AllParameters: the model's table first, then every effect parameter.
-  const std::vector<ParameterInfo>& all = AllParameters();
+  const std::vector<ParameterInfo> all = AllParameters(paper_arm);
   ASSERT_GT(all.size(), Parameters().size());
   for (std::size_t k = 0; k < Parameters().size(); ++k)
     EXPECT_EQ(all[k].name, Parameters()[k].name);
@@ -660,6 +665,103 @@ TEST(MocapOffset, MocapOffsetShiftsOnlyMeasuredAngles) {
       parent_distal = poses[i].head<3>() + R * run.model.p_parent_joint(link + 1);
     parent = R;
   }
+}
+
+// The second arm (configs/three-segment.yaml, 12 joints and 9 cables) with
+// its first `segments` segments given `links` links each: 3 and 3 make 9
+// joints, 1 and 8 make 16.
+Config ThreeSegmentArm(int segments, int links) {
+  std::string text = ReadTextFile(std::string(CCSRM_SOURCE_DIR) + "/configs/three-segment.yaml");
+  std::string pattern;
+  for (int k = 0; k + 1 < links; ++k)
+    pattern += std::string(k ? ", " : "") + (k % 2 ? "large" : "small");
+  std::size_t at = 0;
+  for (int s = 0; s < segments; ++s) {
+    at = text.find("links: 4", at);
+    text.replace(at, 8, "links: " + std::to_string(links));
+    const std::size_t open = text.find("connecting_pattern: [", at);
+    const std::size_t close = text.find(']', open);
+    text.replace(open, close + 1 - open, "connecting_pattern: [" + pattern + "]");
+  }
+  return ParseConfig(text,
+                     "arm" + std::to_string(segments) + "x" + std::to_string(links) + ".yaml");
+}
+
+// Issue 32: mocap_offset had joints 1-12 whatever the arm. Its parameters
+// are now the arm's own, at every door that takes a name.
+TEST(MocapOffset, ParametersAreOnePairPerJointOfTheArm) {
+  const Config nine = ThreeSegmentArm(3, 3);
+  const Config sixteen = ThreeSegmentArm(1, 8);
+  ASSERT_EQ(nine.arm.total_links(), 9);
+  ASSERT_EQ(sixteen.arm.total_links(), 16);
+  EXPECT_EQ(nine.parameters.arm, (ArmSize{9, 9}));
+  EXPECT_EQ(EffectParameterNames("mocap_offset", nine.parameters.arm).size(), 18u);
+  EXPECT_EQ(EffectParameterNames("mocap_offset", sixteen.parameters.arm).back(),
+            "mocap_offset.joint16_y_rad");
+  // The paper's arm keeps its 24 names, in their order, and their values.
+  const std::vector<std::string> paper =
+      EffectParameterNames("mocap_offset", LoadConfig(PaperConfigPath()).parameters.arm);
+  ASSERT_EQ(paper.size(), 24u);
+  EXPECT_EQ(paper[0], "mocap_offset.joint1_x_rad");
+  EXPECT_EQ(paper[1], "mocap_offset.joint1_y_rad");
+  EXPECT_EQ(paper[23], "mocap_offset.joint12_y_rad");
+  EXPECT_EQ(FindParameter("mocap_offset.joint1_x_rad", "test", ArmSize{12, 6}).realistic,
+            std::round(std::sin(2.7) * 2e-3 * 1e5) / 1e5);
+
+  // On 16 joints: joint16 exists; --effect mocap_offset covers every joint.
+  ArmParameters p = sixteen.parameters;
+  SetParameter("mocap_offset.joint16_x_rad", 0.01, "--set", &p);
+  EXPECT_EQ(GetParameter(p, "mocap_offset.joint16_x_rad"), 0.01);
+  ArmParameters realistic = sixteen.parameters;
+  ApplyEffectSpec("mocap_offset", "--effect", &realistic);
+  TrajectoryFrame frame;
+  frame.joint_angles.assign(16, Eigen::Vector2d::Zero());
+  const std::vector<Eigen::Vector2d> recorded = RecordedJointAngles(realistic, frame);
+  ASSERT_EQ(recorded.size(), 16u);
+  for (int j = 1; j <= 16; ++j) {
+    for (int a = 0; a < 2; ++a) {
+      const std::string name =
+          "mocap_offset.joint" + std::to_string(j) + (a == 0 ? "_x_rad" : "_y_rad");
+      const double value = FindParameter(name, "test", realistic.arm).realistic;
+      EXPECT_NE(value, 0.0) << name;  // the fixed pattern has no zero up to here
+      EXPECT_EQ(recorded[j - 1][a], value) << name;
+    }
+  }
+
+  // On 9 joints: joint12 is refused at every door, one line naming it.
+  ArmParameters q = nine.parameters;
+  const std::string beyond =
+      "this arm has 9 joints: known: mocap_offset.joint<k>_x_rad, "
+      "mocap_offset.joint<k>_y_rad (k = 1..9, one per joint)";
+  EXPECT_EQ(ErrorOf([&] { SetParameter("mocap_offset.joint12_x_rad", 0.01, "--set", &q); }),
+            "--set: unknown parameter 'mocap_offset.joint12_x_rad' (" + beyond + ")");
+  EXPECT_THAT(ErrorOf([&] { ApplyEffectSpec("mocap_offset:joint12_x_rad=0.01", "--effect", &q); }),
+              HasSubstr("--effect: 'mocap_offset:joint12_x_rad=0.01': unknown parameter "
+                        "'joint12_x_rad' of mocap_offset (this arm has 9 joints: known: "
+                        "joint<k>_x_rad, joint<k>_y_rad (k = 1..9, one per joint))"));
+  EXPECT_THAT(
+      ErrorOf([&] { ApplyParameterYaml("mocap_offset.joint12_y_rad: 0.001\n", "p.yaml", &q); }),
+      HasSubstr("p.yaml: line 1, key 'mocap_offset.joint12_y_rad': unknown parameter "
+                "(this arm has 9 joints"));
+  EXPECT_THAT(
+      ErrorOf([&] { ApplyEffectsYaml("mocap_offset: {joint10_x_rad: 0.001}\n", "e.yaml", &q); }),
+      HasSubstr("e.yaml: line 1, key 'mocap_offset.joint10_x_rad': unknown parameter of "
+                "mocap_offset (this arm has 9 joints"));
+  EXPECT_FALSE(q.EffectOn("mocap_offset"));  // nothing applied
+  // A configuration's own effects section, by file, line and key.
+  std::string text = nine.source_yaml + "effects:\n  mocap_offset: {joint12_x_rad: 0.001}\n";
+  EXPECT_THAT(
+      ErrorOf([&] { ParseConfig(text, "nine.yaml"); }),
+      HasSubstr("nine.yaml: line " + std::to_string(std::count(text.begin(), text.end(), '\n')) +
+                ", key 'effects.mocap_offset.joint12_x_rad': unknown parameter of "
+                "mocap_offset (this arm has 9 joints"));
+  // Its joint 9 is there, and the configuration writes back what it was given.
+  SetParameter("mocap_offset.joint9_y_rad", -0.002, "--set", &q);
+  Config written = nine;
+  written.parameters = q;
+  EXPECT_EQ(
+      GetParameter(ParseConfig(ToYaml(written), "w.yaml").parameters, "mocap_offset.joint9_y_rad"),
+      -0.002);
 }
 
 // ----------------------------------------------------- energy bookkeeping

@@ -27,6 +27,7 @@ inline Config SmallArm(int links) {
   for (int k = 1; k < links - 1; k += 2)
     c.arm.segments[0].connecting_pattern[k] = ConnectingKind::kLargeS;
   c.arm.driving.cables.resize(3);
+  c.parameters.arm = c.arm.size();
   Validate(c);
   return c;
 }

@@ -48,6 +48,53 @@ void CheckAngleRange(const datasets::ExperimentFile& experiment, const std::stri
   }
 }
 
+// CheckInputs on a time base and its length changes, named by their paths.
+void CheckInputArrays(const datasets::Array& time, const datasets::Array& length_change,
+                      const std::string& file, const std::string& time_path,
+                      const std::string& length_path, const sim::ArmModel* arm,
+                      const std::string& arm_source) {
+  if (time.rank() != 1 || time.values.empty()) {
+    ThrowInputError(
+        file, time_path,
+        "has shape " + datasets::ShapeToString(time.shape) + ", expected at least one sample");
+  }
+  for (std::size_t i = 0; i < time.values.size(); ++i) {
+    const double t = time.values[i];
+    if (!std::isfinite(t)) {
+      ThrowInputError(
+          file, time_path,
+          "sample " + std::to_string(i) + " is " + Number(t) + ": the time base must be finite");
+    }
+    if (i > 0 && !(t > time.values[i - 1])) {
+      ThrowInputError(file, time_path,
+                      "not strictly increasing: sample " + std::to_string(i) + " holds " +
+                          Number(t) + " s after " + Number(time.values[i - 1]) + " s");
+    }
+  }
+  const std::size_t samples = time.values.size();
+  if (length_change.rank() != 2 || length_change.shape[0] != samples ||
+      length_change.values.size() != samples * length_change.shape[1]) {
+    ThrowInputError(file, length_path,
+                    "has shape " + datasets::ShapeToString(length_change.shape) +
+                        ", expected N×C with N=" + std::to_string(samples) + " (from " + time_path +
+                        ")");
+  }
+  const std::size_t cables = length_change.shape[1];
+  for (std::size_t i = 0; i < length_change.values.size(); ++i) {
+    if (!std::isfinite(length_change.values[i])) {
+      ThrowInputError(file, length_path,
+                      "sample " + std::to_string(i / cables) + ", cable " +
+                          std::to_string(i % cables + 1) + " is " +
+                          Number(length_change.values[i]) + ": a length change must be finite");
+    }
+  }
+  if (arm != nullptr && cables != 0 && cables != static_cast<std::size_t>(arm->num_cables())) {
+    ThrowInputError(file, length_path,
+                    "has " + std::to_string(cables) + " cable columns, the arm of " + arm_source +
+                        " has " + std::to_string(arm->num_cables()) + " driving cables");
+  }
+}
+
 // The arm of a non-empty config_yaml, and the shapes that depend on it.
 ExperimentArm ParseArm(const datasets::ExperimentFile& experiment, const std::string& file) {
   ExperimentArm arm;
@@ -55,14 +102,7 @@ ExperimentArm ParseArm(const datasets::ExperimentFile& experiment, const std::st
   arm.model = std::make_shared<const sim::ArmModel>(arm.config.arm);
   const sim::ArmModel& model = *arm.model;
 
-  // ValidateExperimentFile made /input/length_change N × C.
-  const std::size_t cables = experiment.input_length_change.shape[1];
-  if (cables != 0 && cables != static_cast<std::size_t>(model.num_cables())) {
-    ThrowInputError(file, "/input/length_change",
-                    "has " + std::to_string(cables) +
-                        " cable columns, the arm of its config_yaml has " +
-                        std::to_string(model.num_cables()) + " driving cables");
-  }
+  CheckInputs(experiment, file, &model, "its config_yaml");
   if (experiment.measured_joint_angles) {
     const datasets::Array& angles = *experiment.measured_joint_angles;
     const std::size_t joints = static_cast<std::size_t>(model.num_joints());
@@ -99,7 +139,11 @@ std::optional<ExperimentArm> CheckExperimentAgainstConfig(
                     "ever seen");
   }
   std::optional<ExperimentArm> arm;
-  if (!experiment.config_yaml.empty()) arm = ParseArm(experiment, file);
+  if (!experiment.config_yaml.empty()) {
+    arm = ParseArm(experiment, file);
+  } else {
+    CheckInputs(experiment, file, nullptr, "");
+  }
   if (experiment.measured_joint_angles) {
     if (!AnyFinite(*experiment.measured_joint_angles)) {
       ThrowInputError(file, kAngles,
@@ -109,6 +153,18 @@ std::optional<ExperimentArm> CheckExperimentAgainstConfig(
     CheckAngleRange(experiment, file);
   }
   return arm;
+}
+
+void CheckInputs(const datasets::ExperimentFile& experiment, const std::string& file,
+                 const sim::ArmModel* arm, const std::string& arm_source) {
+  CheckInputArrays(experiment.input_time, experiment.input_length_change, file, "/input/time",
+                   "/input/length_change", arm, arm_source);
+}
+
+void CheckInputs(const datasets::RunFile& run, const std::string& file, const sim::ArmModel* arm,
+                 const std::string& arm_source) {
+  CheckInputArrays(run.time, run.input_length_change, file, "/time", "/input_length_change", arm,
+                   arm_source);
 }
 
 }  // namespace ccsrm::sim_io

@@ -90,6 +90,20 @@ class Effect {
   virtual void Record(std::vector<Eigen::Vector2d>* /*joint_angles*/) const {}
 };
 
+// Parameters that come one set per joint, or per driving cable, of the arm
+// (mocap_offset: an offset per joint and axis). How many there are is the
+// arm's (ArmParameters::arm), never a constant of the effect.
+struct IndexedParameters {
+  enum class Per { kJoint, kCable };
+  Per per = Per::kJoint;
+  // Their short names with "<k>" for the 1-based index ("joint<k>_x_rad"),
+  // in the order `make` returns them.
+  std::vector<std::string> patterns;
+  // The entries of index k (>= 1), one per pattern, made by EffectParameter
+  // with the short name of that index; the registry fills in the rest.
+  std::function<std::vector<ParameterInfo>(int k)> make;
+};
+
 // One effect's description and factory.
 struct EffectDefinition {
   std::string name;
@@ -97,12 +111,34 @@ struct EffectDefinition {
   bool measurement = false;
   // The residual signals it leaves (EffectInfo::fingerprint).
   std::vector<std::string> fingerprint;
-  // Its parameters with short names ("coulomb_nm") and `field` null; the
-  // registry fills in the full name, `effect` and `short_name`.
+  // Its fixed parameters with short names ("coulomb_nm") and `field` null;
+  // the registry fills in the full name, `effect` and `config_key`.
   std::vector<ParameterInfo> parameters;
+  // Its per-joint and per-cable parameters, after the fixed ones.
+  std::vector<IndexedParameters> indexed;
   // Builds the effect from a run's parameters (read with GetParameter).
   std::function<std::unique_ptr<Effect>(const ArmParameters&)> make;
 };
+
+// Every parameter of `definition` on an arm of `arm`'s size, full names
+// filled in: the fixed ones, then per index k = 1.. the indexed ones.
+std::vector<ParameterInfo> ParametersOnArm(const EffectDefinition& definition, const ArmSize& arm);
+
+// An effect parameter by full name, or null when no effect has it. With
+// `arm` given, an indexed parameter beyond the arm's joints or cables is
+// null too and *beyond says why ("this arm has 9 joints"); without, any
+// index from 1 is taken. The entry lives as long as the program.
+const ParameterInfo* FindEffectParameter(const std::string& name, const ArmSize* arm,
+                                         std::string* beyond);
+
+// The parameters of `definition` for a message: full or short names, the
+// indexed ones by pattern with their range ("joint<k>_x_rad, joint<k>_y_rad
+// (k = 1..9, one per joint)"; "k = 1, 2, ..." without an arm).
+std::string DescribeParameters(const EffectDefinition& definition, const ArmSize* arm,
+                               bool full_names);
+
+// The definition of effect `name`, or null.
+const EffectDefinition* FindEffectDefinition(const std::string& name);
 
 // An effect parameter's entry: short name, SI units, bounds, its default
 // while the effect is on (the neutral value where there is one), its

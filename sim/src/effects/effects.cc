@@ -15,20 +15,23 @@
 namespace ccsrm::sim {
 namespace {
 
-std::string ParameterList(const EffectInfo& effect) {
-  std::string list;
-  for (const std::string& name : effect.parameters) {
-    list += (list.empty() ? "" : ", ") + name.substr(effect.name.size() + 1);
-  }
-  return list;
+// `effect`'s parameters by short name on the parameters' arm, for messages.
+std::string ParameterList(const std::string& effect, const ArmSize& arm) {
+  return internal::DescribeParameters(*internal::FindEffectDefinition(effect), &arm, false);
 }
 
-// The entry of `effect`'s parameter `short_name`, or null.
-const ParameterInfo* EffectParameterInfo(const std::string& effect, const std::string& short_name) {
-  for (const ParameterInfo& p : AllParameters()) {
-    if (p.effect == effect && p.short_name == short_name) return &p;
-  }
-  return nullptr;
+// The entry of `effect`'s parameter `short_name` on `arm`, or null; *beyond
+// says why when it is a per-joint or per-cable parameter the arm lacks.
+const ParameterInfo* EffectParameterInfo(const std::string& effect, const std::string& short_name,
+                                         const ArmSize& arm, std::string* beyond) {
+  return internal::FindEffectParameter(effect + "." + short_name, &arm, beyond);
+}
+
+// "unknown parameter of mocap_offset (this arm has 9 joints: known: ...)".
+std::string UnknownParameterText(const std::string& effect, const std::string& beyond,
+                                 const ArmSize& arm) {
+  return "(" + (beyond.empty() ? std::string("known") : beyond + ": known") + ": " +
+         ParameterList(effect, arm) + ")";
 }
 
 }  // namespace
@@ -60,17 +63,18 @@ void ApplyEffectsNode(const YAML::Node& node, const std::string& file,
     if (!values.IsMap()) {
       ThrowInputError(file, where,
                       "expected a mapping of the effect's parameters to values (" +
-                          ParameterList(FindEffect(effect, file)) + "), or {} for its defaults");
+                          ParameterList(effect, updated.arm) + "), or {} for its defaults");
     }
     for (const auto& value_entry : values) {
       const std::string name = value_entry.first.as<std::string>();
       const std::string value_where =
           line_of(value_entry.first) + ", key '" + key_prefix + effect + "." + name + "'";
-      const ParameterInfo* info = EffectParameterInfo(effect, name);
+      std::string beyond;
+      const ParameterInfo* info = EffectParameterInfo(effect, name, updated.arm, &beyond);
       if (info == nullptr) {
         ThrowInputError(file, value_where,
-                        "unknown parameter of " + effect +
-                            " (known: " + ParameterList(FindEffect(effect, file)) + ")");
+                        "unknown parameter of " + effect + " " +
+                            UnknownParameterText(effect, beyond, updated.arm));
       }
       const double value = ReadYamlNumber(value_entry.second, file, value_where);
       const std::string problem = ParameterValueProblem(*info, value);
@@ -85,11 +89,10 @@ void ApplyEffectsNode(const YAML::Node& node, const std::string& file,
 
 void EnableEffectAtRealisticMagnitude(const std::string& effect, const std::string& where,
                                       ArmParameters* parameters) {
-  const EffectInfo& info = FindEffect(effect, where);
   ArmParameters updated = *parameters;
   updated.EnableEffect(effect, where);
-  for (const std::string& name : info.parameters) {
-    SetParameter(name, FindParameter(name, where).realistic, where, &updated);
+  for (const std::string& name : EffectParameterNames(effect, updated.arm, where)) {
+    SetParameter(name, FindParameter(name, where, updated.arm).realistic, where, &updated);
   }
   *parameters = updated;
 }
@@ -106,14 +109,14 @@ std::string ApplyEffectSpec(const std::string& text, const std::string& where,
     EnableEffectAtRealisticMagnitude(effect, where, parameters);
     return effect;
   }
-  const EffectInfo& info = FindEffect(effect, where);
+  FindEffect(effect, where);
   ArmParameters updated = *parameters;
   updated.EnableEffect(effect, where);
   std::string rest = text.substr(colon + 1);
   if (rest.empty()) {
     ThrowInputError(where, "'" + text + "'",
                     "expected param=value after ':' (parameters of " + effect + ": " +
-                        ParameterList(info) + ")");
+                        ParameterList(effect, updated.arm) + ")");
   }
   std::size_t begin = 0;
   while (begin <= rest.size()) {
@@ -124,14 +127,15 @@ std::string ApplyEffectSpec(const std::string& text, const std::string& where,
     if (equals == std::string::npos || equals == 0) {
       ThrowInputError(where, "'" + text + "'",
                       "expected param=value, found '" + item + "' (parameters of " + effect + ": " +
-                          ParameterList(info) + ")");
+                          ParameterList(effect, updated.arm) + ")");
     }
     const std::string name = item.substr(0, equals);
-    const ParameterInfo* p = EffectParameterInfo(effect, name);
+    std::string beyond;
+    const ParameterInfo* p = EffectParameterInfo(effect, name, updated.arm, &beyond);
     if (p == nullptr) {
       ThrowInputError(where, "'" + text + "'",
-                      "unknown parameter '" + name + "' of " + effect +
-                          " (known: " + ParameterList(info) + ")");
+                      "unknown parameter '" + name + "' of " + effect + " " +
+                          UnknownParameterText(effect, beyond, updated.arm));
     }
     double value = 0.0;
     const std::string problem = ParseNumberText(item.substr(equals + 1), &value);

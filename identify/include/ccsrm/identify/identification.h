@@ -208,19 +208,39 @@ struct UnidentifiableDirection {
 };
 
 // Errors of one joint angle series: one experiment, or all of them.
+//
+// Fit percent, 100 (1 - |sim - meas| / |meas - mean of each series|),
+// compares the error with the axis's own motion, so it means something
+// only on an axis the arm is driven about. On one that barely moves (θy of
+// a joint bent in its plane) the ratio measures noise and by-products, and
+// a fit good to hundredths of a degree can score -12 %. It is defined
+// (finite) only where the axis's motion, the RMS of its measured angles
+// about each series' mean, is at least kFitMotionShare of the joint's
+// larger axis motion and kFitMotionNoiseRatio times its measurement noise;
+// elsewhere it is NaN, and the RMS error is to be read against
+// motion_rms_deg.
 struct ChannelErrors {
   // [joint][axis], axis 0 θx, 1 θy, over the measured frames.
   std::vector<std::array<double, 2>> rms_deg;
-  std::vector<std::array<double, 2>> fit_percent;
+  std::vector<std::array<double, 2>> fit_percent;  // NaN: the axis barely moves
+  std::vector<std::array<double, 2>> motion_rms_deg;
   std::vector<std::array<std::size_t, 2>> samples;
   double rms_deg_overall = 0.0;
-  // 100 (1 - |sim - meas| / |meas - mean of each series|), over every series.
+  // Fit percent over every series whose axis has one defined.
   double fit_percent_overall = 0.0;
 };
 
+// An axis moving less than this share of its joint's larger axis motion is
+// a by-product of the motion, not a motion the arm is driven through.
+inline constexpr double kFitMotionShare = 0.1;
+// An axis moving less than this many standard deviations of its
+// measurement noise is not told apart from the noise.
+inline constexpr double kFitMotionNoiseRatio = 3.0;
+
 // The errors of simulated angles [rad] (one matrix per experiment, laid out
 // as Experiment::measured_rad) against the experiments' measured angles,
-// every experiment together.
+// every experiment together (the noise of a joint: its experiments' mean
+// Experiment::noise_deg).
 ChannelErrors AngleErrors(const std::vector<const Experiment*>& experiments,
                           const std::vector<const Eigen::MatrixXd*>& simulated);
 

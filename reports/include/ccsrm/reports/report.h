@@ -25,7 +25,7 @@ struct ReportOptions {
   PlotOptions plot;
   // Instants [s] at which a run page tabulates joint angles, input tensions,
   // stuck nodes and energy, and draws the tension along each cable. Empty
-  // (the default): for a paper-case run, the protocol's end of ramp,
+  // (the default): for a run of the protocol (case 1-4), its end of ramp,
   // mid-hold and end of return that lie within the run, then its last frame
   // (with the middle of the run added when that leaves fewer than two);
   // otherwise the middle and the end of the run. Each instant is shown at the
@@ -51,8 +51,10 @@ struct ReportSummary {
 };
 
 // The page of a simulation run (`source` names it on the page and in
-// messages). Uses sim::ParseConfig on run.config_yaml for the arm's segments
-// and, for a paper case, the planned motion. Draws nothing: the figures are
+// messages). Uses sim::ParseConfig on run.config_yaml for the arm's segments,
+// the arm and protocol in words and, for a run of the protocol (case 1-4),
+// the planned motion. It cites the paper's cases and figures only when the
+// arm is the paper's (sim::IsPaperArm). Draws nothing: the figures are
 // described, WriteReport renders them. Throws InputError for invalid options
 // or an inconsistent record (datasets::ValidateRunFile).
 Document BuildRunDocument(const datasets::RunFile& run, const std::string& source,

@@ -96,6 +96,9 @@ struct ArmConfig {
   ConnectingCableConfig connecting;
 
   int total_links() const;
+  // Its joints (= links) and driving cables: what sizes the effects'
+  // per-joint and per-cable parameters (ArmParameters::arm).
+  ArmSize size() const;
   // Index (0-based) of the segment that holds link `link` (1-based).
   int segment_of_link(int link) const;
 };
@@ -168,11 +171,21 @@ struct Config {
   ProtocolConfig protocol;
   std::string source_name;  // file name used in error messages
   std::string source_yaml;  // the text it was parsed from
+  // Values far outside what arms of this kind have, which the model can
+  // still run (a hole circle wider than the links are long, a link denser
+  // than steel, a pre-tension beyond any cable's elastic range): one line
+  // each, "<file>: line N, key 'k': <what>: <why>", filled by ParseConfig.
+  // Commands print them; nothing is refused for them.
+  std::vector<std::string> warnings;
 };
 
 // Parses and validates YAML text. `source_name` names the file in errors.
 // Throws InputError "<file>: line N, key 'a.b.c': <problem>" on an unknown
-// key, a missing key or section, a wrong type or a value out of range.
+// key, a missing key or section, a wrong type, a value out of range, or a
+// segment its driving cables cannot bend about both axes (fewer than three
+// cables, two at coincident hole angles, or all within a half-plane: see
+// Validate). Values far outside the range of such arms are
+// Config::warnings.
 Config ParseConfig(const std::string& yaml_text, const std::string& source_name);
 
 // The YAML word of a hole friction treatment ("events", "smoothed", ...).
@@ -187,10 +200,13 @@ Config LoadConfig(const std::string& path);
 // (so a run file's config_yaml reflects any overrides applied in C++).
 std::string ToYaml(const Config& config);
 
-// Checks cross-field consistency of a Config built or modified in C++, and
-// that every physical value of the arm lies in the range any real arm of
-// this kind has (ParseConfig runs the same checks). Throws InputError naming
-// the offending key.
+// Checks cross-field consistency of a Config built or modified in C++, that
+// every physical value of the arm lies in the range any real arm of this
+// kind has, and that every segment's driving cables can bend it about both
+// axes: at least three, no two at coincident hole angles (closer than 1 deg
+// or than one cable diameter on the hole circle, where the holes overlap),
+// not all within a closed half-plane (ParseConfig runs the same checks).
+// Throws InputError naming the offending key and segment.
 void Validate(const Config& config);
 
 // Checks for one part: an arm (ArmModel's constructor: what makes the model

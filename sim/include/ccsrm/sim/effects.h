@@ -41,8 +41,7 @@ struct EffectInfo {
   // "constant", "hold_drift", "hysteresis", "lag". Evidence that points to
   // the effect, reported beside its score; the ranking itself is by score.
   std::vector<std::string> fingerprint;
-  // Its parameters, full names in AllParameters() ("joint_friction.coulomb_nm").
-  std::vector<std::string> parameters;
+  // Its parameters are a function of the arm: EffectParameterNames.
 };
 
 // Every effect, in a fixed order (the order above).
@@ -52,8 +51,17 @@ const std::vector<EffectInfo>& Effects();
 // (known: joint_friction, ...)".
 const EffectInfo& FindEffect(const std::string& name, const std::string& where);
 
-// Switches `effect` on with every parameter at its realistic magnitude
-// (ParameterInfo::realistic), as `ccsrm generate --effect NAME` does.
+// The parameters `effect` has on an arm of `arm`'s size, full names as in
+// AllParameters(arm) ("joint_friction.coulomb_nm"): its fixed ones, then its
+// per-joint or per-cable ones, one set per joint or cable in order
+// (mocap_offset: joint1_x_rad, joint1_y_rad, joint2_x_rad, ...). Throws
+// InputError naming `where` for an unknown effect.
+std::vector<std::string> EffectParameterNames(const std::string& effect, const ArmSize& arm,
+                                              const std::string& where = "effect");
+
+// Switches `effect` on with every parameter it has on the parameters' arm
+// (ArmParameters::arm) at its realistic magnitude (ParameterInfo::realistic),
+// as `ccsrm generate --effect NAME` does: mocap_offset covers every joint.
 // Throws InputError naming `where` for an unknown effect.
 void EnableEffectAtRealisticMagnitude(const std::string& effect, const std::string& where,
                                       ArmParameters* parameters);
@@ -62,8 +70,9 @@ void EnableEffectAtRealisticMagnitude(const std::string& effect, const std::stri
 // "NAME:param=value,param=value" (the effect on, the given parameters set,
 // the others at their defaults) and applies it. `where` names the option in
 // errors ("--effect"). Throws InputError for an unknown effect or
-// parameter, a value that is not a number or out of bounds, or a malformed
-// text. Returns the effect's name.
+// parameter (one the parameters' arm does not have included), a value that
+// is not a number or out of bounds, or a malformed text. Returns the
+// effect's name.
 std::string ApplyEffectSpec(const std::string& text, const std::string& where,
                             ArmParameters* parameters);
 
@@ -73,7 +82,8 @@ std::string ApplyEffectSpec(const std::string& text, const std::string& where,
 // `effects:` section and of `ccsrm generate --effects FILE` (which may also
 // hold it under a top-level `effects:` key). `file` names the file in
 // errors: "<file>: line N, key 'effects.joint_friction.x': unknown
-// parameter ...". Checked whole before anything is applied.
+// parameter ..." (a per-joint parameter of a joint the parameters' arm
+// does not have included). Checked whole before anything is applied.
 void ApplyEffectsYaml(const std::string& yaml_text, const std::string& file,
                       ArmParameters* parameters);
 
@@ -81,7 +91,8 @@ void ApplyEffectsYaml(const std::string& yaml_text, const std::string& file,
 // physical angles (frame.joint_angles) with every measurement effect that
 // is on applied (mocap_offset adds its offsets). Exactly the physical
 // angles when no measurement effect is on. Identification compares
-// measured angles with this.
+// measured angles with this. Precondition: with a measurement effect on,
+// the frame has parameters.arm.joints joints.
 std::vector<Eigen::Vector2d> RecordedJointAngles(const ArmParameters& parameters,
                                                  const TrajectoryFrame& frame);
 

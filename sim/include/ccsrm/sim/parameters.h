@@ -15,6 +15,19 @@
 
 namespace ccsrm::sim {
 
+// How many universal joints and driving cables an arm has: what sizes the
+// effects' per-joint and per-cable parameter lists (mocap_offset has
+// joint<k>_x_rad and joint<k>_y_rad for k = 1..joints). ArmConfig::size()
+// gives an arm's.
+struct ArmSize {
+  int joints = 0;
+  int cables = 0;
+  bool operator==(const ArmSize& other) const {
+    return joints == other.joints && cables == other.cables;
+  }
+  bool operator!=(const ArmSize& other) const { return !(*this == other); }
+};
+
 // Friction, damping and pre-tension. Zero-initialised: fill it from a
 // configuration (Config::parameters) or set every field; Simulate checks it
 // with IsValid. The field names are the SPEC 6 parameter names.
@@ -67,6 +80,14 @@ struct ArmParameters {
   std::map<std::string, double> effect_values;
   std::set<std::string> effects_on;
 
+  // The arm these parameters are for (ParseConfig sets it from the arm). It
+  // decides which per-joint and per-cable effect parameters exist, so that
+  // every door that sets a parameter by name (SetParameter, a
+  // configuration's `effects:`, `--set`, `--params`, `--effect`, truth
+  // files) refuses a name the arm does not have. Zero joints and cables (a
+  // hand-built ArmParameters): no per-joint or per-cable parameter exists.
+  ArmSize arm;
+
   // False (with the table's message in *error) when a value is outside its
   // bounds or not finite, effect parameters included.
   bool IsValid(std::string* error) const;
@@ -103,21 +124,32 @@ struct ParameterInfo {
 // Every entry has a field.
 const std::vector<ParameterInfo>& Parameters();
 
-// Every known parameter name: Parameters(), then the parameters of every
-// effect of Effects() in its order, named "<effect>.<parameter>" (their
-// `field` is null). This is the list identification offers.
-const std::vector<ParameterInfo>& AllParameters();
+// Every parameter an arm of `arm`'s size has: Parameters(), then the
+// parameters of every effect of Effects() in its order, named
+// "<effect>.<parameter>" (their `field` is null), an effect's per-joint and
+// per-cable ones once per joint or cable of the arm. This is the list
+// identification offers.
+std::vector<ParameterInfo> AllParameters(const ArmSize& arm);
 
-// The entry of `name`, a model or an effect parameter. Throws
-// InputError("<where>: unknown parameter 'x' (known: mu, mu_s, ...)") for a
-// name that is not one of AllParameters().
+// The entry of `name` on an arm of `arm`'s size, a model or an effect
+// parameter. Throws InputError("<where>: unknown parameter 'x' (known: mu,
+// mu_s, ...)") for a name that is not one of AllParameters(arm); for a
+// per-joint or per-cable name beyond the arm the message says so ("this arm
+// has 9 joints: mocap_offset.joint<k>_x_rad, ..., k = 1..9").
+const ParameterInfo& FindParameter(const std::string& name, const std::string& where,
+                                   const ArmSize& arm);
+
+// The same before the arm is known (a command line read before its
+// experiments): a per-joint or per-cable name is taken for any index from
+// 1, as on an arm that has it. Where the arm is known, use the form above.
 const ParameterInfo& FindParameter(const std::string& name, const std::string& where);
 
 // "" when `value` is finite and within the parameter's bounds, else the one
 // message every door uses: "parameter 'beta' = 5 is outside [0, 0.1] s".
 std::string ParameterValueProblem(const ParameterInfo& info, double value);
 
-// Reads / writes a parameter by name. SetParameter checks the value against
+// Reads / writes a parameter by name, one of AllParameters(parameters.arm)
+// (FindParameter's message otherwise). SetParameter checks the value against
 // the bounds and throws InputError "<where>: <ParameterValueProblem>" when it
 // is outside them or not finite (the parameters are then unchanged).
 // SetParameter on an effect parameter switches that effect on; GetParameter

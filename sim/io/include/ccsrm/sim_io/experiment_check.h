@@ -10,6 +10,7 @@
 #include <string>
 
 #include "ccsrm/datasets/experiment_file.h"
+#include "ccsrm/datasets/run_file.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
 
@@ -26,10 +27,11 @@ struct ExperimentArm {
 // processing and identification will need:
 //  - /mocap/time has at least 2 frames (a frame rate, a motion);
 //  - /mocap/markers, when it holds any value, holds a finite one;
+//  - its inputs pass CheckInputs (below), against the arm of its
+//    config_yaml when that is not empty;
 //  - config_yaml, when not empty, parses (sim::ParseConfig), and then
-//    /input/length_change has either no cable column (no actuator record) or
-//    one per driving cable of that arm, and /measured/joint_angles (when
-//    present) is F × J × 2 with J the arm's joints;
+//    /measured/joint_angles (when present) is F × J × 2 with J the arm's
+//    joints;
 //  - /measured/joint_angles (when present) holds at least one finite value,
 //    and every value is NaN (lost) or within the mathematical range of the
 //    X–Y Cardan pair of a universal joint: |θx| <= π, |θy| <= π/2 rad.
@@ -39,5 +41,21 @@ struct ExperimentArm {
 // the first problem.
 std::optional<ExperimentArm> CheckExperimentAgainstConfig(
     const datasets::ExperimentFile& experiment, const std::string& file);
+
+// The one check of recorded cable inputs, at every door they come through
+// (CheckExperimentAgainstConfig for an experiment's own; `ccsrm mocap
+// process --inputs FILE` where it reads another file's): the time base
+// (/input/time, or a run's /time) has at least one sample, every time finite
+// and strictly increasing; the length changes (/input/length_change, or a
+// run's /input_length_change) are one row per time with every value finite;
+// and, with `arm` given, they have either no cable column (no actuator
+// record) or one per driving cable of that arm. `file` names the file and
+// `arm_source` where the arm came from ("arm.yaml", "e.h5 (its
+// config_yaml)") in messages. Throws InputError "<file>: <path>: <problem>"
+// on the first problem.
+void CheckInputs(const datasets::ExperimentFile& experiment, const std::string& file,
+                 const sim::ArmModel* arm, const std::string& arm_source);
+void CheckInputs(const datasets::RunFile& run, const std::string& file, const sim::ArmModel* arm,
+                 const std::string& arm_source);
 
 }  // namespace ccsrm::sim_io
