@@ -512,7 +512,8 @@ void ArmDynamics::AddConnectingMoments(double t, const double* memory) {
         // The conduit's frictional memory follows eq. 45's static-to-kinetic
         // target over tau_c_f; with tau_c_f = 0 it is the target (eq. 45).
         const ModifiedCoulombParams& law = large_params->friction;
-        const double speed = std::abs(ConduitSlipVelocity(*large_params, rt_i, rt_j));
+        const double v_tau1 = ConduitSlipVelocity(*large_params, rt_i, rt_j);
+        const double speed = std::abs(v_tau1);
         double target_slope = 0.0;
         const double target = ConduitMemoryTarget(law, speed, &target_slope);
         const bool remembers = parameters_.tau_c_f > 0.0;
@@ -530,8 +531,7 @@ void ArmDynamics::AddConnectingMoments(double t, const double* memory) {
                                                     solver_.stick_velocity_tolerance_mps};
           const int eta_index = pair.presliding + axis;
           const double eta = memory[eta_index];
-          const double v = ConduitSlipVelocity(*large_params, rt_i, rt_j);
-          const ConduitPresliding f = PreslidingConduitFriction(presliding_law, v, z, eta);
+          const ConduitPresliding f = PreslidingConduitFriction(presliding_law, v_tau1, z, eta);
           memory_rate_[eta_index] = f.rate;
           large = LargeSMomentsWithCoefficient(*large_params, th_i, th_j, rt_i, rt_j, f.coefficient,
                                                0.0);

@@ -79,10 +79,10 @@ namespace {
 // Eqs. 46-53 from the friction exponents a1 = mu_m(v_tau1) Theta and
 // a2 = mu_m(v_tau2) Theta; slope is d mu_m / d v_tau1.
 LargeSResult MomentsFromExponents(const LargeSParams& params, double theta_i, double theta_j,
-                                  double theta_i_dot, double theta_j_dot, double a1, double a2,
-                                  double slope) {
+                                  double theta_i_dot, double theta_j_dot, double v1, double a1,
+                                  double a2, double slope) {
   LargeSResult out;
-  out.slip_velocity_1 = ConduitSlipVelocity(params, theta_i_dot, theta_j_dot);
+  out.slip_velocity_1 = v1;
   // Tension factors at the i ends (eqs. 46-47: T_i = (EA dl / l) phi(a)) and
   // at the j ends (T_j = T_i e^{-a} = (EA dl / l) phi(-a)).
   const double phi_1 = CapstanFactor(a1);
@@ -121,14 +121,16 @@ LargeSResult LargeSMoments(const LargeSParams& params, double theta_i, double th
       ModifiedCoulombWithMemory(params.friction, v1, memory, &slope) * params.wrap_angle_rad;
   const double a2 =
       ModifiedCoulombWithMemory(params.friction, -v1, memory, nullptr) * params.wrap_angle_rad;
-  return MomentsFromExponents(params, theta_i, theta_j, theta_i_dot, theta_j_dot, a1, a2, slope);
+  return MomentsFromExponents(params, theta_i, theta_j, theta_i_dot, theta_j_dot, v1, a1, a2,
+                              slope);
 }
 
 LargeSResult LargeSMomentsWithCoefficient(const LargeSParams& params, double theta_i,
                                           double theta_j, double theta_i_dot, double theta_j_dot,
                                           double coefficient, double coefficient_slope) {
   const double a1 = coefficient * params.wrap_angle_rad;
-  return MomentsFromExponents(params, theta_i, theta_j, theta_i_dot, theta_j_dot, a1, -a1,
+  return MomentsFromExponents(params, theta_i, theta_j, theta_i_dot, theta_j_dot,
+                              ConduitSlipVelocity(params, theta_i_dot, theta_j_dot), a1, -a1,
                               coefficient_slope);
 }
 
