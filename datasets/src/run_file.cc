@@ -35,6 +35,7 @@ void VisitArrays(Run& run, Visit&& visit) {
   visit("/input_tension", "N", run.input_tension);
   visit("/input_length_change", "m", run.input_length_change);
   visit("/stuck_nodes", "1", run.stuck_nodes);
+  if (run.slack_elements) visit("/slack_elements", "1", *run.slack_elements);
   for (std::size_t k = 0; k < run.cables.size(); ++k) {
     const std::string base = CablePath(k);
     visit(base + "/tension", "N", run.cables[k].tension);
@@ -105,6 +106,7 @@ void ValidateRunFile(const RunFile& run, const std::string& file) {
   const internal::Dim c = Bound("C", tension[1], "/input_tension");
   ExpectShape(file, "/input_length_change", run.input_length_change, {t, c});
   ExpectShape(file, "/stuck_nodes", run.stuck_nodes, {t, c});
+  if (run.slack_elements) ExpectShape(file, "/slack_elements", *run.slack_elements, {t, c});
 
   if (run.cables.size() != c.extent) {
     ThrowInputError(file, "/cables",
@@ -204,6 +206,7 @@ RunFile ReadRunFile(const std::string& path) {
   // Skeleton first (cable count, optional members), then every array.
   run.cables.resize(CountCableGroups(reader));
   if (reader.Exists("/markers")) run.markers.emplace();
+  if (reader.Exists("/slack_elements")) run.slack_elements.emplace();
   VisitArrays(run, [&](const std::string& dataset, const char* units, Array& array) {
     array = reader.ReadArray(dataset, units);
   });

@@ -1,5 +1,5 @@
 // The page of a simulation run (ccsrm-run/1): summary and solver statistics,
-// joint angles against the plan, input tensions, stick–slip, tension along
+// joint angles against the plan, input tensions, slack cables, stick–slip, tension along
 // the cables at chosen instants, constraint violation and energy. The page
 // names the arm and the protocol as configured; it cites the paper (its
 // cases, its Figs. 16, 18–21 and 22) only for a run of one of the paper's
@@ -13,6 +13,7 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/version.h"
 #include "ccsrm/reports/report.h"
+#include "ccsrm/sim/simulator.h"
 #include "pages.h"
 
 namespace ccsrm::reports {
@@ -373,6 +374,90 @@ Section InputSection(const RunFile& run, const ArmFacts& facts, const Words& wor
   return section;
 }
 
+// Elements at zero tension per frame and cable: the file's /slack_elements,
+// or, in a file written before it, counted from /cables/<k>/tension (where
+// a model that let cables push shows them too).
+Eigen::MatrixXi SlackElements(const RunFile& run) {
+  const std::size_t frames = run.frames(), cables = run.cables.size();
+  Eigen::MatrixXi count(frames, cables);
+  for (std::size_t f = 0; f < frames; ++f) {
+    for (std::size_t k = 0; k < cables; ++k) {
+      if (run.slack_elements) {
+        count(f, k) = static_cast<int>(run.slack_elements->at(f, k));
+        continue;
+      }
+      const datasets::Array& tension = run.cables[k].tension;
+      std::vector<double> row(tension.shape[1]);
+      for (std::size_t e = 0; e < row.size(); ++e) row[e] = tension.at(f, e);
+      count(f, k) = sim::CountSlackElements(row);
+    }
+  }
+  return count;
+}
+
+// Which cable went slack, when and for how long (a cable cannot push: its
+// elements then carry no tension), with the tension the rest of it kept.
+Section SlackSection(const RunFile& run, const ArmFacts& facts) {
+  Section section{"slack", "Slack cables", {}};
+  const std::vector<sim::SlackInterval> intervals =
+      sim::FindSlackIntervals(run.time.values, SlackElements(run));
+  if (intervals.empty()) {
+    section.blocks.push_back(Paragraph{
+        "No driving cable went slack: every element of every cable carried tension in every "
+        "frame.",
+        false});
+    return section;
+  }
+  std::string cables;
+  int previous = 0, distinct = 0;
+  for (const sim::SlackInterval& v : intervals) {
+    if (v.cable == previous) continue;
+    cables += (cables.empty() ? "" : ", ") + std::to_string(v.cable);
+    previous = v.cable;
+    ++distinct;
+  }
+  section.blocks.push_back(Paragraph{
+      std::string(distinct == 1 ? "Cable " : "Cables ") + cables + " went slack: some of " +
+          (distinct == 1 ? "its" : "their") +
+          " elements carried no tension (a cable cannot push; "
+          "docs/model-notes.md row 26). The arm then follows the remaining cables, not the "
+          "plan. A cable is slack where the release at its input outruns what the arm takes up "
+          "(friction holding the cable in its holes, or a motion beyond what the pre-tension "
+          "allows).",
+      true});
+  Table table;
+  table.id = "slack";
+  table.title = "Stretches of time with a slack element";
+  table.caption =
+      "From /slack_elements (or the element tensions): consecutive frames in which at least one "
+      "element of the cable carried no tension; times to the frame spacing. Highest tension: the "
+      "largest element tension of the cable over the stretch, what the rest of it still held.";
+  table.columns = {{"cable", "cable", "", NumberFormat::Integer()},
+                   {"segment", "segment", "", NumberFormat::Integer()},
+                   {"start_s", "from", "s", NumberFormat::Fixed(3)},
+                   {"end_s", "to", "s", NumberFormat::Fixed(3)},
+                   {"duration_s", "for", "s", NumberFormat::Fixed(3)},
+                   {"most_elements", "most slack elements", "", NumberFormat::Integer()},
+                   {"elements", "of elements", "", NumberFormat::Integer()},
+                   {"highest_tension_n", "highest tension", "N", NumberFormat::Fixed(1)}};
+  const std::vector<double>& time = run.time.values;
+  for (const sim::SlackInterval& v : intervals) {
+    const datasets::Array& tension = run.cables[v.cable - 1].tension;
+    double highest = 0.0;
+    for (std::size_t f = 0; f < time.size(); ++f) {
+      if (time[f] < v.start_s || time[f] > v.end_s) continue;
+      for (std::size_t e = 0; e < tension.shape[1]; ++e)
+        highest = std::max(highest, tension.at(f, e));
+    }
+    table.AddRow({Cell::Number(v.cable), Cell::Number(facts.cable_segment[v.cable - 1] + 1.0),
+                  Cell::Number(v.start_s), Cell::Number(v.end_s), Cell::Number(v.duration_s()),
+                  Cell::Number(v.most_elements),
+                  Cell::Number(static_cast<double>(tension.shape[1])), Cell::Number(highest)});
+  }
+  section.blocks.push_back(std::move(table));
+  return section;
+}
+
 Section StickSlipSection(const RunFile& run, const ArmFacts& facts,
                          const std::vector<Instant>& instants) {
   Section section{"stick-slip", "Stick–slip", {}};
@@ -535,6 +620,7 @@ Document BuildRunDocument(const RunFile& run, const std::string& source,
   document.sections.push_back(SummarySection(run, source, facts, words, instants));
   document.sections.push_back(JointAngleSection(run, facts, words, instants));
   document.sections.push_back(InputSection(run, facts, words, instants));
+  document.sections.push_back(SlackSection(run, facts));
   document.sections.push_back(StickSlipSection(run, facts, instants));
   document.sections.push_back(CableTensionSection(run, instants));
   document.sections.push_back(DiagnosticsSection(run, instants));

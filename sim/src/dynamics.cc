@@ -280,8 +280,6 @@ void ArmDynamics::ComputeLinkKinematics(const double* q, const double* qd) {
 // damping and smoothing take out is booked once q_dd is known.
 bool ArmDynamics::AddCableElements(const double* q, const double* qd) {
   double* values = system_.values();
-  const double h = solver_.smoothing_step_s;
-  const double beta = parameters_.beta;
   element_rates_.clear();
   int element = 0;
   for (int c = 0; c < model_.num_cables(); ++c) {
@@ -307,14 +305,19 @@ bool ArmDynamics::AddCableElements(const double* q, const double* qd) {
       for (int a = 0; a < 8; ++a) force_[cols[a]] += f[a];
       tension_[c][e] = terms.tension;
       kinetic_ += terms.kinetic_energy;
-      const double k = terms.taut ? 1.0 : 0.0;
-      elastic_ += 0.5 * ale_.axial_stiffness_n * k * terms.strain * terms.strain * ds;
-      const double beta_p = beta + k * h / 2.0;
-      const double gamma = beta * h / 2.0 + k * h * h / 6.0;
+      elastic_ += ale_.axial_stiffness_n * terms.strain_energy_density * ds;
+      // The power the non-elastic part of the applied stress takes out,
+      // Δs eps_dot (sigma - EA phi): the smoothing and Rayleigh terms, or,
+      // for a stretched element that would push and carries nothing, the
+      // elastic energy it lets go without doing work.
       const double scale = ds * ale_.axial_stiffness_n * terms.strain_rate;
       ElementRate rate;
-      rate.coefficient = scale * (beta_p * terms.strain_rate + gamma * terms.strain_accel_bias);
-      rate.gamma_term = scale * gamma;
+      rate.coefficient =
+          terms.pushing
+              ? -scale * UnilateralElasticStrain(terms.strain, ale_.slack_toe_strain).value
+              : scale * (terms.smoothed_damping_s * terms.strain_rate +
+                         terms.smoothed_inertia_s2 * terms.strain_accel_bias);
+      rate.gamma_term = scale * terms.smoothed_inertia_s2;
       rate.jac = terms.strain_jacobian;
       std::copy(cols, cols + 8, rate.cols);
       element_rates_.push_back(rate);

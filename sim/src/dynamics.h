@@ -188,7 +188,7 @@ class ArmDynamics {
   std::vector<Eigen::Vector2d> theta_, theta_dot_;        // per joint [rad], [rad/s]
   // Per element, what the dissipated power needs once q_dd is known.
   struct ElementRate {
-    double coefficient;  // Δs EA eps_dot (beta' eps_dot + gamma eps_dot_q q_dot)
+    double coefficient;  // Δs EA eps_dot (beta' eps_dot + gamma eps_dot_q q_dot - pushing eps)
     double gamma_term;   // Δs EA gamma eps_dot, times eps_q q_dd
     Eigen::Matrix<double, 1, 8> jac;
     int cols[8];

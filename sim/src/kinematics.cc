@@ -35,6 +35,11 @@ Eigen::Vector3d CardanXyzAngles(const Eigen::Matrix3d& R_PC) {
   return internal::CardanXYZAngles(R_PC);
 }
 
+double JointTiltRad(const Eigen::Vector2d& angles) {
+  const double c = std::cos(angles[0]) * std::cos(angles[1]);
+  return std::acos(std::clamp(c, -1.0, 1.0));
+}
+
 Eigen::Vector3d CableNodePosition(const ArmModel& model, int cable, int node,
                                   const std::vector<LinkPose>& poses) {
   const CableNodeModel& n = model.cables()[cable].nodes[node];

@@ -1,5 +1,6 @@
 #include "ccsrm/sim/model.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "sparse_system.h"
@@ -67,6 +68,21 @@ ArmModel::ArmModel(const ArmConfig& arm_config) : arm_(arm_config) {
       cable.nodes.push_back({distal_kind, i, Eigen::Vector3d(x, y, half - 0.5 * d)});
     }
     cables_.push_back(cable);
+  }
+
+  joint_disk_radius_m_.assign(links_.size(), 0.0);
+  for (const DrivingCableModel& cable : cables_) {
+    int last_link = 0;
+    for (int s = 0; s <= cable.segment; ++s) last_link += arm.segments[s].links;
+    for (int j = 0; j < last_link; ++j)
+      joint_disk_radius_m_[j] = std::max(joint_disk_radius_m_[j], cable.radius_m);
+  }
+  for (std::size_t j = 0; j < links_.size(); ++j) {
+    // A joint no cable passes (a segment without cables is refused by
+    // CheckCableLayout) takes its own segment's hole circle.
+    if (joint_disk_radius_m_[j] == 0.0)
+      joint_disk_radius_m_[j] = arm.segments[links_[j].segment].hole_circle_radius_m;
+    joint_range_rad_.push_back(2.0 * std::atan(d / (2.0 * joint_disk_radius_m_[j])));
   }
 
   int offset = 0;

@@ -72,7 +72,10 @@ PaperRun PreparePaperRun(const PaperRunOptions& o) {
     ThrowInputError("--duration", "", "must be > 0 s");
   }
   ArmModel model(config.arm);
-  CableInputs inputs = PlanCableInputs(model, PaperTrajectory(model, config.protocol), duration);
+  const std::string motion_source =
+      std::isnan(o.amplitude_deg) ? path + ": protocol.amplitude_deg" : std::string("--amplitude");
+  CableInputs inputs = PlanCableInputs(model, PaperTrajectory(model, config.protocol), duration,
+                                       1e-3, motion_source);
   SimulationOptions simulation;
   simulation.duration_s = duration;
   simulation.solver = config.solver;

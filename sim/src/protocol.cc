@@ -3,7 +3,9 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_spline.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "ccsrm/common/error.h"
@@ -90,8 +92,55 @@ void CableInputs::Evaluate(int cable, double t, double* value, double* rate, dou
   *accel = gsl_spline_eval_deriv2(spline, t, nullptr);
 }
 
+namespace {
+
+std::string Format(const char* format, double value) {
+  char text[64];
+  std::snprintf(text, sizeof(text), format, value);
+  return text;
+}
+
+// The planned tilt of every joint against its range (ArmModel::
+// joint_range_rad), over every sample; throws naming the joint that goes
+// furthest beyond, where it first leaves the range and how far it goes.
+void CheckPlannedJointRange(const ArmModel& model, const Eigen::VectorXd& time,
+                            const std::vector<JointAngles>& plan, const std::string& source) {
+  int worst_joint = 0;
+  double worst_excess = 0.0, worst_tilt = 0.0, first_time = 0.0;
+  for (int j = 1; j <= model.num_joints(); ++j) {
+    double peak = 0.0, first = NAN;
+    for (std::size_t k = 0; k < plan.size(); ++k) {
+      const double tilt = JointTiltRad(plan[k][j - 1]);
+      if (tilt > model.joint_range_rad(j) && std::isnan(first)) first = time[k];
+      peak = std::max(peak, tilt);
+    }
+    const double excess = peak - model.joint_range_rad(j);
+    if (excess > worst_excess) {
+      worst_joint = j;
+      worst_excess = excess;
+      worst_tilt = peak;
+      first_time = first;
+    }
+  }
+  if (worst_joint == 0) return;
+  const double deg = 180.0 / M_PI;
+  const int segment = model.link(worst_joint).segment + 1;
+  ThrowInputError(source, "",
+                  "the plan tilts joint " + std::to_string(worst_joint) + " (segment " +
+                      std::to_string(segment) + ") to " + Format("%.1f", worst_tilt * deg) +
+                      " deg (beyond from t = " + Format("%.3g", first_time) +
+                      " s), past its range of " +
+                      Format("%.1f", model.joint_range_rad(worst_joint) * deg) +
+                      " deg where its disks meet (2 atan(d/2R), d = " +
+                      Format("%.3g", model.arm().joint_disk_gap_m * 1e3) +
+                      " mm, R = " + Format("%.3g", model.joint_disk_radius_m(worst_joint) * 1e3) +
+                      " mm the hole circle); ccsrm has no contact between disks");
+}
+
+}  // namespace
+
 CableInputs PlanCableInputs(const ArmModel& model, const JointTrajectory& trajectory,
-                            double duration_s, double sample_step_s) {
+                            double duration_s, double sample_step_s, const std::string& source) {
   CCSRM_CHECK(duration_s > 0.0 && sample_step_s > 0.0);
   const int samples = static_cast<int>(std::ceil(duration_s / sample_step_s - 1e-9)) + 1;
   Eigen::VectorXd time(samples);
@@ -100,10 +149,14 @@ CableInputs PlanCableInputs(const ArmModel& model, const JointTrajectory& trajec
       ForwardKinematics(model, JointAngles(model.num_joints(), Eigen::Vector2d::Zero()));
   Eigen::VectorXd rest_length(model.num_cables());
   for (int c = 0; c < model.num_cables(); ++c) rest_length[c] = CablePathLength(model, c, straight);
+  std::vector<JointAngles> plan(samples);
   for (int k = 0; k < samples; ++k) {
-    const double t = std::min(duration_s, k * sample_step_s);
-    time[k] = t;
-    const std::vector<LinkPose> poses = ForwardKinematics(model, trajectory(t));
+    time[k] = std::min(duration_s, k * sample_step_s);
+    plan[k] = trajectory(time[k]);
+  }
+  CheckPlannedJointRange(model, time, plan, source);
+  for (int k = 0; k < samples; ++k) {
+    const std::vector<LinkPose> poses = ForwardKinematics(model, plan[k]);
     for (int c = 0; c < model.num_cables(); ++c) {
       change(k, c) = rest_length[c] - CablePathLength(model, c, poses);
     }

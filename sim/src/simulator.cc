@@ -1,5 +1,6 @@
 #include "ccsrm/sim/simulator.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +10,7 @@
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/gsl_errors.h"
+#include "ccsrm/sim/kinematics.h"
 #include "dynamics.h"
 #include "effects/effect.h"
 #include "integrator.h"
@@ -46,7 +48,8 @@ class StepLoop {
  public:
   StepLoop(const ArmModel& model, const ArmParameters& parameters, const CableInputs& inputs,
            const SimulationOptions& options)
-      : options_(options),
+      : model_(model),
+        options_(options),
         solver_(options.solver),
         dynamics_(model, parameters, inputs, options.solver),
         integrator_(internal::MakeIntegrator(&dynamics_, solver_)),
@@ -198,6 +201,25 @@ class StepLoop {
       std::snprintf(text, sizeof(text), "constraint violation %.3g above bound %.3g",
                     frame_.constraint_violation, solver_.max_constraint_violation);
       Diverge(text);
+      return;
+    }
+    CheckJointRange();
+  }
+
+  // A joint past its range (ArmModel::joint_range_rad) would need contact
+  // between its disks, which the model does not have, and soon folds a
+  // cable's path through the gap: the run stops there, like a divergence.
+  void CheckJointRange() {
+    for (int j = 1; j <= model_.num_joints(); ++j) {
+      const double tilt = JointTiltRad(frame_.joint_angles[j - 1]);
+      if (tilt <= model_.joint_range_rad(j)) continue;
+      char text[224];
+      std::snprintf(text, sizeof(text),
+                    "joint %d tilted to %.2f deg, past its range of %.2f deg where its disks "
+                    "meet (ccsrm has no contact between disks)",
+                    j, tilt * 180.0 / M_PI, model_.joint_range_rad(j) * 180.0 / M_PI);
+      Diverge(text);
+      return;
     }
   }
 
@@ -217,9 +239,17 @@ class StepLoop {
     s.largest_threshold_raise_n = stick_slip_->largest_threshold_raise_n();
     s.max_constraint_violation = sampler_.max_constraint_violation();
     result.trajectory = sampler_.Take();
+    const Trajectory& trajectory = result.trajectory;
+    Eigen::MatrixXi slack(static_cast<Eigen::Index>(trajectory.size()), model_.num_cables());
+    for (std::size_t f = 0; f < trajectory.size(); ++f) {
+      for (int c = 0; c < model_.num_cables(); ++c)
+        slack(f, c) = CountSlackElements(trajectory.frames[f].element_tension[c]);
+    }
+    s.slack = FindSlackIntervals(trajectory.time, slack);
     return result;
   }
 
+  const ArmModel& model_;
   const SimulationOptions& options_;
   const SolverConfig& solver_;
   const Clock::time_point wall_start_ = Clock::now();
@@ -315,7 +345,56 @@ std::string SimulationSummary::FullReport() const {
   std::snprintf(line, sizeof(line), "  max constraint violation:  %.3g\n",
                 max_constraint_violation);
   out << line;
+  out << "  slack cables:              ";
+  if (slack.empty()) out << "none\n";
+  // Long runs can slacken a cable many times; the run file has them all.
+  constexpr std::size_t kListed = 8;
+  for (std::size_t i = 0; i < slack.size() && i < kListed; ++i) {
+    const SlackInterval& v = slack[i];
+    out << (i == 0 ? "" : "                             ");
+    if (v.end_s > v.start_s) {
+      std::snprintf(line, sizeof(line), "cable %d slack from %.3f s to %.3f s (%.3g s)", v.cable,
+                    v.start_s, v.end_s, v.duration_s());
+    } else {
+      std::snprintf(line, sizeof(line), "cable %d slack at %.3f s (one frame)", v.cable, v.start_s);
+    }
+    out << line << ", up to " << v.most_elements << " element" << (v.most_elements == 1 ? "" : "s")
+        << "\n";
+  }
+  if (slack.size() > kListed) {
+    out << "                             and " << slack.size() - kListed
+        << " more stretches (the run file's /slack_elements)\n";
+  }
   return out.str();
+}
+
+int CountSlackElements(const std::vector<double>& element_tension) {
+  int count = 0;
+  for (double tension : element_tension) count += tension <= 0.0 ? 1 : 0;
+  return count;
+}
+
+std::vector<SlackInterval> FindSlackIntervals(const std::vector<double>& time,
+                                              const Eigen::MatrixXi& slack_elements) {
+  CCSRM_CHECK(static_cast<Eigen::Index>(time.size()) == slack_elements.rows());
+  std::vector<SlackInterval> intervals;
+  for (Eigen::Index c = 0; c < slack_elements.cols(); ++c) {
+    bool open = false;
+    for (Eigen::Index f = 0; f < slack_elements.rows(); ++f) {
+      const int count = slack_elements(f, c);
+      if (count <= 0) {
+        open = false;
+        continue;
+      }
+      if (!open) {
+        intervals.push_back({static_cast<int>(c) + 1, time[f], time[f], 0});
+        open = true;
+      }
+      intervals.back().end_s = time[f];
+      intervals.back().most_elements = std::max(intervals.back().most_elements, count);
+    }
+  }
+  return intervals;
 }
 
 SimulationResult Simulate(const ArmModel& model, const ArmParameters& parameters,

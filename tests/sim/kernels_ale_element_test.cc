@@ -41,6 +41,16 @@ ElementState RandomState(std::mt19937* rng, double strain) {
   return st;
 }
 
+// As RandomState, moving a thousand times slower (0.1 mm/s). At 0.1 m/s an
+// element 0.1 m long shortens at eps_dot ~ 1 /s, faster than its damping
+// lets it relax from eps ~ 1e-3, and then carries nothing (the unilateral
+// law); the checks of eqs. 13 and 20 as printed need it carrying.
+ElementState SlowState(std::mt19937* rng, double strain) {
+  ElementState st = RandomState(rng, strain);
+  st.q_dot *= 1e-3;
+  return st;
+}
+
 // Gauss-Legendre, 3 points: exact for polynomials of degree <= 5 in zeta.
 constexpr double kGaussX[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
 constexpr double kGaussW[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
@@ -215,28 +225,87 @@ TEST(AleElement, StrainAccelerationBiasMatchesFiniteDifferences) {
 }
 
 TEST(AleElement, SlackElementCarriesNoTension) {
+  // A cable cannot push (docs/model-notes.md row 26): a compressed element
+  // carries nothing, however fast it moves, and has no elastic mass.
   std::mt19937 rng(7);
   for (double h : {0.0, 0.01}) {
     const AleElementParams p = CableParams(1e-3, h);
-    const ElementState st = RandomState(&rng, -1e-3);  // compressed
-    const AleElementTerms t = EvaluateAleElement(p, st.q, Vector8d::Zero());
-    EXPECT_LT(t.strain, 0.0);
-    EXPECT_FALSE(t.taut);
-    EXPECT_EQ(t.tension, 0.0);
-    EXPECT_EQ(t.elastic_force.norm(), 0.0);
-    EXPECT_EQ(AleStrainEnergy(p, st.q), 0.0);
-    // Slack: gamma = beta h / 2 only (k = 0).
-    EXPECT_NEAR(t.elastic_mass.trace(),
-                (st.q(7) - st.q(6)) * p.axial_stiffness_n * 0.5 * p.rayleigh_beta_s * h *
-                    t.strain_jacobian.squaredNorm(),
-                1e-12);
+    for (double speed : {0.0, 1.0, 100.0}) {
+      const ElementState st = RandomState(&rng, -1e-3);  // compressed
+      const AleElementTerms t = EvaluateAleElement(p, st.q, speed * st.q_dot);
+      EXPECT_LT(t.strain, 0.0);
+      EXPECT_FALSE(t.taut);
+      EXPECT_EQ(t.tension, 0.0);
+      EXPECT_EQ(t.elastic_force.norm(), 0.0);
+      EXPECT_EQ(t.elastic_mass.norm(), 0.0);
+      EXPECT_EQ(AleStrainEnergy(p, st.q), 0.0);
+    }
   }
+}
+
+TEST(AleElement, StretchedElementUnloadingFasterThanItRelaxesCarriesNothing) {
+  // eq. 13 with the element shortening at 1 m/s per 0.1 m: EA (eps + beta
+  // eps_dot) < 0, a push; the unilateral law applies no force instead.
+  const AleElementParams p = CableParams(1e-3, 0.01);
+  Vector8d q, q_dot = Vector8d::Zero();
+  q << 0, 0, 0, 0, 0, 0.1003, 0.0, 0.1;  // eps = 3e-3 (the paper's pre-tension strain)
+  q_dot(5) = -1.0;
+  const AleElementTerms t = EvaluateAleElement(p, q, q_dot);
+  EXPECT_TRUE(t.taut);
+  EXPECT_LT(t.strain + p.rayleigh_beta_s * t.strain_rate, 0.0);  // eq. 13 would push
+  EXPECT_TRUE(t.pushing);
+  EXPECT_EQ(t.tension, 0.0);
+  EXPECT_EQ(t.elastic_force.norm(), 0.0);
+  // The smoothing's added mass stays: it only resists strain acceleration,
+  // and keeps the inertia the integrator sees from jumping.
+  EXPECT_GT(t.elastic_mass.norm(), 0.0);
+  // Slowly: eq. 13 as printed.
+  const AleElementTerms slow = EvaluateAleElement(p, q, 1e-3 * q_dot);
+  EXPECT_FALSE(slow.pushing);
+  EXPECT_EQ(slow.tension,
+            p.axial_stiffness_n * (slow.strain + p.rayleigh_beta_s * slow.strain_rate));
+}
+
+TEST(AleElement, TighteningElementTakesUpItsStiffnessAndDampingWithoutAJump) {
+  // Across eps = 0 and the toe, the force is continuous (phi is C1): a sweep of the strain through
+  // both shows no step larger than the sweep's own increments make.
+  const AleElementParams p = CableParams(1e-3, 0.01);
+  const double toe = p.slack_toe_strain;
+  EXPECT_EQ(UnilateralElasticStrain(-1e-6, toe).value, 0.0);
+  EXPECT_EQ(UnilateralElasticStrain(0.0, toe).slope, 0.0);
+  EXPECT_EQ(UnilateralElasticStrain(toe, toe).value, toe);
+  EXPECT_EQ(UnilateralElasticStrain(toe, toe).slope, 1.0);
+  EXPECT_DOUBLE_EQ(UnilateralElasticStrain(0.5 * toe, toe).value, 0.375 * toe);
+  EXPECT_DOUBLE_EQ(UnilateralElasticStrain(0.5 * toe, toe).slope, 1.25);
+  // The potential is continuous where the toe meets eq. 13.
+  EXPECT_NEAR(UnilateralElasticStrain(toe * (1 - 1e-12), toe).energy,
+              UnilateralElasticStrain(toe, toe).energy, 1e-18);  // 2.5e-10 of it
+  Vector8d q_dot = Vector8d::Zero();
+  // Lengthening at eps_dot ~ 0.1 /s: once engaged, the damping and
+  // smoothing stress EA (beta + h/2) eps_dot is about 20 N.
+  q_dot(5) = 0.01;
+  double previous = 0.0;
+  double largest_step = 0.0;
+  const int n = 20000;
+  for (int i = 0; i <= n; ++i) {
+    const double strain = -0.5 * toe + 2.0 * toe * i / n;
+    Vector8d q;
+    q << 0, 0, 0, 0, 0, 0.1 * std::sqrt(1.0 + 2.0 * strain), 0.0, 0.1;
+    const double force = EvaluateAleElement(p, q, q_dot).elastic_force.norm();
+    if (i > 0) largest_step = std::max(largest_step, std::abs(force - previous));
+    previous = force;
+  }
+  // One increment of strain (1e-8) is at most 0.5 mN of elastic force (the
+  // toe's stiffness peaks at 4/3 EA), and the toe's largest curvature
+  // 4/e_t takes up the ~20 N over it at 8 mN per increment. A jump would
+  // be the whole 20 N.
+  EXPECT_LT(largest_step, 0.05);
 }
 
 TEST(AleElement, TautElementTensionIsEq13) {
   std::mt19937 rng(8);
   const AleElementParams p = CableParams(1e-3, 0.01);
-  const ElementState st = RandomState(&rng, 2e-3);
+  const ElementState st = SlowState(&rng, 2e-3);
   const AleElementTerms t = EvaluateAleElement(p, st.q, st.q_dot);
   EXPECT_TRUE(t.taut);
   EXPECT_NEAR(t.tension, p.axial_stiffness_n * (t.strain + p.rayleigh_beta_s * t.strain_rate),
@@ -275,7 +344,7 @@ TEST(AleElement, UnsmoothedForceIsEq6) {
 TEST(AleElement, SmoothingTermsVanishAsStepGoesToZero) {
   std::mt19937 rng(11);
   const double beta = 1e-3;
-  const ElementState st = RandomState(&rng, 1e-3);
+  const ElementState st = SlowState(&rng, 1e-3);
   const Vector8d f0 = EvaluateAleElement(CableParams(beta, 0.0), st.q, st.q_dot).elastic_force;
   // M_elastic is proportional to gamma = beta h / 2 + k h^2 / 6 and the extra
   // force to (k h / 2) eps_dot + gamma eps_dot_q q_dot: both O(h) with
@@ -313,7 +382,7 @@ TEST(AleElement, SmoothedForceMatchesTimeAveragedStrain) {
   std::mt19937 rng(12);
   const double beta = 1e-3, h = 0.01;
   const AleElementParams p = CableParams(beta, h);
-  const ElementState st = RandomState(&rng, 1e-3);
+  const ElementState st = SlowState(&rng, 1e-3);
   Vector8d q_ddot;
   for (int i = 0; i < 8; ++i) q_ddot(i) = std::sin(1.0 + i);
   const AleElementTerms t = EvaluateAleElement(p, st.q, st.q_dot);

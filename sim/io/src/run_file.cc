@@ -16,6 +16,7 @@ datasets::RunFile ToRunFile(const sim::ArmModel& model, const sim::SimulationRes
   run.input_tension = Array({T, C});
   run.input_length_change = Array({T, C});
   run.stuck_nodes = Array({T, C});
+  run.slack_elements = Array({T, C});
   run.constraint_violation = Array({T});
   run.energy = Array({T, 3});
   run.cables.resize(C);
@@ -50,6 +51,7 @@ datasets::RunFile ToRunFile(const sim::ArmModel& model, const sim::SimulationRes
         stuck += o.hole_stuck[c][h];
       }
       run.stuck_nodes.at(f, c) = stuck;
+      run.slack_elements->at(f, c) = sim::CountSlackElements(o.element_tension[c]);
     }
     run.constraint_violation.at(f) = o.constraint_violation;
     run.energy.at(f, 0) = o.kinetic_energy;

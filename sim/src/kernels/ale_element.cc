@@ -1,5 +1,7 @@
 #include "ale_element.h"
 
+#include <algorithm>
+
 #include "ccsrm/common/error.h"
 
 namespace ccsrm::sim::internal {
@@ -55,6 +57,16 @@ double KineticEnergy(double rho_a, const Kinematics& k, const Vector8d& q_dot) {
 
 }  // namespace
 
+UnilateralStrain UnilateralElasticStrain(double strain, double toe_strain) {
+  if (strain <= 0.0) return {0.0, 0.0, 0.0};
+  if (strain >= toe_strain) {
+    return {strain, 1.0, 0.5 * strain * strain - toe_strain * toe_strain / 12.0};
+  }
+  const double x = strain / toe_strain;
+  return {toe_strain * x * x * (2.0 - x), x * (4.0 - 3.0 * x),
+          toe_strain * toe_strain * x * x * x * (2.0 / 3.0 - 0.25 * x)};
+}
+
 Eigen::Matrix<double, 3, 8> AleShapeMatrix(const Vector8d& q, double zeta) {
   const double ds = q(7) - q(6);
   CCSRM_CHECK(ds > 0.0);
@@ -89,24 +101,44 @@ AleElementTerms EvaluateAleElement(const AleElementParams& params, const Vector8
   // d/dt (r'.r'_dot) with q'' = 0: |r'_dot|^2 + r'.(-2 r'_dot Δs_dot / Δs).
   out.strain_accel_bias = k.r_s_dot.squaredNorm() - 2.0 * out.strain_rate * k.ds_dot * inv_ds;
 
-  // Tension only when stretched (k of eq. 6); tension of eq. 13.
+  // The unilateral law (docs/model-notes.md row 26): eq. 13's elastic term
+  // k eps becomes phi(eps), zero when slack and joined to eps by a short
+  // toe, and the Rayleigh and smoothing terms take the tangent stiffness
+  // phi' in place of k (Rayleigh damping is proportional to it); a cable
+  // that would push instead carries nothing. Beyond the toe phi = eps and
+  // phi' = 1: eqs. 13 and 20 as printed, to the last bit.
   out.taut = out.strain > 0.0;
-  const double kk = out.taut ? 1.0 : 0.0;
+  const UnilateralStrain u = UnilateralElasticStrain(out.strain, params.slack_toe_strain);
   const double ea = params.axial_stiffness_n;
-  const double beta = params.rayleigh_beta_s;
-  out.tension = ea * (kk * out.strain + beta * out.strain_rate);
+  const double beta = u.slope * params.rayleigh_beta_s;
+  const double tension = ea * (u.value + beta * out.strain_rate);
 
   // Model smoothing (eqs. 17-20). With h = 0: beta' = beta, gamma = 0, and
   // Q'_e reduces to eq. 6's Q_e = Δs eps_q^T T.
   const double h = params.smoothing_step_s;
-  const double beta_p = beta + 0.5 * kk * h;
-  const double gamma = 0.5 * beta * h + kk * h * h / 6.0;
-  const double smoothed_stress =
-      ea * (kk * out.strain + beta_p * out.strain_rate + gamma * out.strain_accel_bias);
-  // Integrands are constant in zeta, so (Δs/2) ∫ d zeta = Δs.
-  out.elastic_force = -(k.ds * smoothed_stress) * out.strain_jacobian.transpose();
-  out.elastic_mass.noalias() =
-      (k.ds * ea * gamma) * out.strain_jacobian.transpose() * out.strain_jacobian;
+  out.smoothed_damping_s = beta + 0.5 * u.slope * h;
+  out.smoothed_inertia_s2 = 0.5 * beta * h + u.slope * h * h / 6.0;
+  const double explicit_stress = ea * (u.value + out.smoothed_damping_s * out.strain_rate +
+                                       out.smoothed_inertia_s2 * out.strain_accel_bias);
+  // A slack element carries nothing. One unloading faster than its damping
+  // lets it relax would push: its explicit stress is held at zero, while
+  // the smoothing's added mass (eq. 20, a part of the averaged stress that
+  // only resists strain acceleration) stays, so that the inertia the
+  // integrator sees does not jump when it starts or stops.
+  out.pushing = out.taut && (tension < 0.0 || explicit_stress < 0.0);
+  out.strain_energy_density = u.energy;
+  out.tension = out.taut && !out.pushing ? tension : 0.0;
+  if (!out.taut) {
+    out.smoothed_damping_s = 0.0;
+    out.smoothed_inertia_s2 = 0.0;
+    out.elastic_force.setZero();
+    out.elastic_mass.setZero();
+  } else {
+    // Integrands are constant in zeta, so (Δs/2) ∫ d zeta = Δs.
+    out.elastic_force = -(k.ds * std::max(0.0, explicit_stress)) * out.strain_jacobian.transpose();
+    out.elastic_mass.noalias() = (k.ds * ea * out.smoothed_inertia_s2) *
+                                 out.strain_jacobian.transpose() * out.strain_jacobian;
+  }
 
   // Additional inertia (eqs. 4, 6). Writing out eq. 4 with the derivatives of
   // N_r gives r''_s = -2 w r'_dot, w(zeta) = N1 s1_dot + N2 s2_dot, so
@@ -126,8 +158,9 @@ double AleStrainEnergy(const AleElementParams& params, const Vector8d& q) {
   const double ds = q(7) - q(6);
   CCSRM_CHECK(ds > 0.0);
   const double strain = 0.5 * ((q.segment<3>(3) - q.segment<3>(0)).squaredNorm() / (ds * ds) - 1.0);
-  if (strain <= 0.0) return 0.0;  // k = 0: a slack element stores no energy
-  return 0.5 * params.axial_stiffness_n * strain * strain * ds;
+  // A slack element stores no energy.
+  return params.axial_stiffness_n *
+         UnilateralElasticStrain(strain, params.slack_toe_strain).energy * ds;
 }
 
 double AleKineticEnergy(const AleElementParams& params, const Vector8d& q, const Vector8d& q_dot) {

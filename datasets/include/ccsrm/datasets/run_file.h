@@ -54,13 +54,16 @@ struct RunFile {
   std::string status_message;
 
   // --- Datasets --------------------------------------------------------------
-  Array time;                       // /time, T, s: strictly increasing, finite, T >= 1.
-  Array joint_angles;               // /joint_angles, T × J × 2 (θx, θy), rad.
-  Array joint_rates;                // /joint_rates, T × J × 2, rad/s.
-  Array link_pose;                  // /link_pose, T × L × 7 (x, y, z, e0..e3), m and 1.
-  Array input_tension;              // /input_tension, T × C, N.
-  Array input_length_change;        // /input_length_change, T × C, m (positive = pulled).
-  Array stuck_nodes;                // /stuck_nodes, T × C, 1 (stuck hole nodes per cable).
+  Array time;                 // /time, T, s: strictly increasing, finite, T >= 1.
+  Array joint_angles;         // /joint_angles, T × J × 2 (θx, θy), rad.
+  Array joint_rates;          // /joint_rates, T × J × 2, rad/s.
+  Array link_pose;            // /link_pose, T × L × 7 (x, y, z, e0..e3), m and 1.
+  Array input_tension;        // /input_tension, T × C, N.
+  Array input_length_change;  // /input_length_change, T × C, m (positive = pulled).
+  Array stuck_nodes;          // /stuck_nodes, T × C, 1 (stuck hole nodes per cable).
+  // Extension, optional on reading (files before it): /slack_elements, T × C,
+  // 1: elements of each cable that carry no tension (sim::CountSlackElements).
+  std::optional<Array> slack_elements;
   std::vector<CableRecord> cables;  // C entries, /cables/1 .. /cables/C.
   Array constraint_violation;       // /diagnostics/constraint_violation, T, mixed (‖Φ‖).
   Array energy;                     // /diagnostics/energy, T × 3 (kinetic, elastic,

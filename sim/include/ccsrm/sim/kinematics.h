@@ -34,6 +34,10 @@ Eigen::Vector2d UniversalJointAngles(const Eigen::Matrix3d& R_PC);
 // joint keeps the twist at zero (used as a consistency check on measured poses).
 Eigen::Vector3d CardanXyzAngles(const Eigen::Matrix3d& R_PC);
 
+// Tilt [rad] of a universal joint at (θx, θy): the angle between the parent's
+// and the child's z axes, acos(cos θx cos θy).
+double JointTiltRad(const Eigen::Vector2d& angles);
+
 // World position of cable node `node` of cable `cable` (0-based) for the
 // given link poses.
 Eigen::Vector3d CableNodePosition(const ArmModel& model, int cable, int node,

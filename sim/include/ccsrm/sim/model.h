@@ -81,6 +81,17 @@ class ArmModel {
   int node_offset(int cable, int node) const { return node_offsets_[cable][node]; }
   int link_offset(int link) const { return link_offsets_[link - 1]; }  // 1-based
 
+  // The largest tilt [rad] of joint i (1-based), the angle between the two
+  // links' axes (JointTiltRad), before its disks meet: 2 atan(d / 2R), with
+  // d the disk gap and R the widest hole circle of the cables through it
+  // (the disks are at least that wide, so the true range is no larger).
+  // Beyond it a cable's path through the gap folds back; ccsrm has no
+  // contact between disks, so a plan beyond it is refused and a run that
+  // reaches it stops (docs/model-notes.md row 26).
+  double joint_range_rad(int joint) const { return joint_range_rad_[joint - 1]; }
+  // The hole circle radius R [m] that sets joint i's range.
+  double joint_disk_radius_m(int joint) const { return joint_disk_radius_m_[joint - 1]; }
+
   // Joint i (1-based) in the frame of link i-1 (in W for i = 1) and of link i.
   Eigen::Vector3d p_parent_joint(int joint) const;
   Eigen::Vector3d p_child_joint(int joint) const;
@@ -95,6 +106,7 @@ class ArmModel {
   std::vector<ConnectingPairModel> pairs_;
   std::vector<std::vector<int>> node_offsets_;
   std::vector<int> link_offsets_;
+  std::vector<double> joint_range_rad_, joint_disk_radius_m_;
   int num_coordinates_ = 0;
   std::shared_ptr<const internal::SparseLayout> sparse_layout_;  // immutable, shared by copies
 };

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "ccsrm/sim/config.h"
@@ -54,8 +55,12 @@ class CableInputs {
 
 // Plans the inputs for a joint trajectory by pure kinematics: samples the
 // trajectory every `sample_step_s` over [0, duration_s] and records
-// L(0) − L(t) for every cable.
+// L(0) − L(t) for every cable. Throws InputError, labelled `source` (the
+// option or file the motion came from), when a planned joint tilts beyond
+// its range (ArmModel::joint_range_rad): past it the paths through the gap
+// fold and the plan means nothing.
 CableInputs PlanCableInputs(const ArmModel& model, const JointTrajectory& trajectory,
-                            double duration_s, double sample_step_s = 1e-3);
+                            double duration_s, double sample_step_s = 1e-3,
+                            const std::string& source = "planned motion");
 
 }  // namespace ccsrm::sim

@@ -81,6 +81,28 @@ struct Trajectory {
 
 enum class SimulationStatus { kCompleted, kDiverged, kCancelled };
 
+// A stretch of time in which a driving cable was slack: at least one of its
+// elements carried no tension (a cable cannot push; docs/model-notes.md row
+// 26). Times are those of the frames, so a stretch is known to the frame
+// spacing.
+struct SlackInterval {
+  int cable = 0;          // 1-based
+  double start_s = 0.0;   // first frame of the stretch with a slack element
+  double end_s = 0.0;     // last such frame
+  int most_elements = 0;  // most of its elements slack at once
+  double duration_s() const { return end_s - start_s; }
+};
+
+// The elements of one cable in one frame that carry no tension (<= 0 N, so
+// that a record from a model that let cables push counts them too).
+int CountSlackElements(const std::vector<double>& element_tension);
+
+// The stretches of consecutive frames in which slack_elements(f, c) > 0, per
+// cable in order of cable then time. `time` holds the frame times (one per
+// row of slack_elements, frames by cables).
+std::vector<SlackInterval> FindSlackIntervals(const std::vector<double>& time,
+                                              const Eigen::MatrixXi& slack_elements);
+
 struct SimulationSummary {
   SimulationStatus status = SimulationStatus::kCompleted;
   bool completed() const { return status == SimulationStatus::kCompleted; }
@@ -97,6 +119,8 @@ struct SimulationSummary {
   std::int64_t failed_releases = 0;
   double largest_threshold_raise_n = 0.0;
   double max_constraint_violation = 0.0;  // largest |Phi| over the sampled frames
+  // Where a driving cable went slack (FindSlackIntervals over the frames).
+  std::vector<SlackInterval> slack;
 
   // One line; and the one-screen summary of SPEC 3.
   std::string BriefReport() const;
