@@ -37,15 +37,19 @@ function(ccsrm_add_test name)
     CCSRM_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     CCSRM_SHARED_DIR="${CCSRM_SHARED_DIR}"
     CCSRM_BINARY_DIR="${PROJECT_BINARY_DIR}")
+  # Scratch folders (std::filesystem::temp_directory_path) under the build
+  # tree, so that two checkouts testing at once never share one.
+  set(scratch "${PROJECT_BINARY_DIR}/test-tmp")
+  file(MAKE_DIRECTORY "${scratch}")
+  set(properties ENVIRONMENT "TMPDIR=${scratch}")
+  if(ARG_LABELS)
+    list(APPEND properties LABELS "${ARG_LABELS}")
+  endif()
   if(ARG_ONE_PROCESS)
     add_test(NAME ${name} COMMAND ${name})
-    if(ARG_LABELS)
-      set_tests_properties(${name} PROPERTIES LABELS "${ARG_LABELS}")
-    endif()
-  elseif(ARG_LABELS)
-    gtest_discover_tests(${name} TEST_PREFIX "${name}." DISCOVERY_TIMEOUT 60
-      PROPERTIES LABELS "${ARG_LABELS}")
+    set_tests_properties(${name} PROPERTIES ${properties})
   else()
-    gtest_discover_tests(${name} TEST_PREFIX "${name}." DISCOVERY_TIMEOUT 60)
+    gtest_discover_tests(${name} TEST_PREFIX "${name}." DISCOVERY_TIMEOUT 60
+      PROPERTIES ${properties})
   endif()
 endfunction()
