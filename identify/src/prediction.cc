@@ -1,5 +1,7 @@
 #include "ccsrm/identify/prediction.h"
 
+#include <gsl/gsl_cdf.h>
+#include <yaml-cpp/yaml.h>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -8,7 +10,9 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/yaml_document.h"
 #include "ccsrm/sim/effects.h"
+#include "statistics.h"
 
 namespace ccsrm::identify {
 namespace {
@@ -129,6 +133,12 @@ PredictionModel LoadPredictionModel(const std::string& path) {
   model.kind = "parameter file";
   model.values = read.values;
   if (model.values.empty()) ThrowInputError(path, "", "gives no parameter value");
+  // A truth file's effects are part of the model it describes.
+  const YAML::Node root = ParseYamlDocument(text, path);
+  if (root.IsMap() && root["parameters"] && root["effects"] && root["effects"].IsMap() &&
+      root["effects"].size() > 0) {
+    model.effects.push_back({text, path});
+  }
   return model;
 }
 
@@ -139,6 +149,10 @@ bool PredictionOptions::IsValid(std::string* error) const {
   }
   if (!(above_noise_ratio > 0.0) || !std::isfinite(above_noise_ratio)) {
     *error = "above_noise_ratio must be > 0";
+    return false;
+  }
+  if (!(significance > 0.0 && significance < 1.0)) {
+    *error = "significance must be in (0, 1)";
     return false;
   }
   return true;
@@ -230,8 +244,8 @@ PredictionSummary Predict(const std::vector<Experiment>& recordings, const Predi
     for (const auto& [name, value] : model.values) {
       sim::SetParameter(name, value, model.source + ", on the arm of " + x.path, &p);
     }
-    if (!model.effects_yaml.empty())
-      sim::ApplyEffectsYaml(model.effects_yaml, model.effects_file, &p);
+    for (const PredictionModel::Effects& e : model.effects)
+      sim::ApplyEffectsYaml(e.yaml, e.file, &p);
     if (!p.IsValid(&error)) ThrowInputError(model.source, "parameters", error);
     parameters.push_back(std::move(p));
   }
@@ -281,20 +295,53 @@ PredictionSummary Predict(const std::vector<Experiment>& recordings, const Predi
     }
     summary.recordings.push_back(std::move(r));
   }
+  // Every channel's weighted residual, its size and whether it is noise.
+  struct Channel {
+    ChannelAboveNoise c;
+    bool large = false;
+  };
+  std::vector<Channel> channels;
   for (std::size_t e = 0; e < recordings.size(); ++e) {
     RecordingPrediction& r = summary.recordings[e];
-    r.errors = ComputePredictionErrors({&recordings[e]}, {&r.predicted_rad});
-    all.push_back(&recordings[e]);
+    const Experiment& x = recordings[e];
+    r.errors = ComputePredictionErrors({&x}, {&r.predicted_rad});
+    all.push_back(&x);
     predicted.push_back(&r.predicted_rad);
-    for (int j = 0; j < recordings[e].joints; ++j) {
+    for (int j = 0; j < x.joints; ++j) {
       const std::size_t jj = static_cast<std::size_t>(j);
       for (int a = 0; a < 2; ++a) {
-        const double rms = r.errors.channels.rms_deg[jj][static_cast<std::size_t>(a)];
-        const double noise = recordings[e].noise_deg[jj];
-        if (rms > options.above_noise_ratio * noise) {
-          summary.above_noise.push_back({r.name, j + 1, a, rms, noise});
+        std::vector<double> weighted;
+        double sum = 0.0;
+        for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
+          const double m = x.measured_rad(f, 2 * j + a);
+          if (!std::isfinite(m)) continue;
+          const double w = (r.predicted_rad(f, 2 * j + a) - m) * kDeg / x.noise_deg[jj];
+          weighted.push_back(w);
+          sum += w * w;
         }
+        if (weighted.empty()) continue;
+        Channel ch;
+        ch.c.recording = r.name;
+        ch.c.joint = j + 1;
+        ch.c.axis = a;
+        ch.c.rms_deg = r.errors.channels.rms_deg[jj][static_cast<std::size_t>(a)];
+        ch.c.noise_deg = x.noise_deg[jj];
+        const double n = static_cast<double>(weighted.size());
+        ch.c.effective_samples = internal::EffectiveSampleSize({weighted});
+        // A run that ended early leaves NaN: never noise.
+        ch.c.p_value = std::isfinite(sum) ? gsl_cdf_chisq_Q(sum * ch.c.effective_samples / n,
+                                                            ch.c.effective_samples)
+                                          : 0.0;
+        ch.large = !(ch.c.rms_deg <= options.above_noise_ratio * ch.c.noise_deg);
+        channels.push_back(ch);
       }
+    }
+  }
+  summary.significance = options.significance;
+  summary.channels = channels.size();
+  for (const Channel& ch : channels) {
+    if (ch.large && ch.c.p_value < options.significance / static_cast<double>(channels.size())) {
+      summary.above_noise.push_back(ch.c);
     }
   }
   summary.errors = ComputePredictionErrors(all, predicted);

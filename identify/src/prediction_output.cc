@@ -62,16 +62,15 @@ std::string EffectList(const std::vector<std::string>& effects) {
 }  // namespace
 
 std::string PredictionSummary::BriefReport() const {
-  char text[512];
+  char text[640];
   std::snprintf(text, sizeof(text),
                 "prediction of %zu recording%s with %s (effects: %s): RMS %s deg, max %s deg, "
-                "weighted RMS %s (1 = the noise floor); %zu channel%s above %.3g x noise%s",
+                "weighted RMS %s (1 = the noise floor); %zu of %zu channels above the noise%s",
                 recordings.size(), recordings.size() == 1 ? "" : "s", model.source.c_str(),
                 EffectList(effects).c_str(),
                 Format("%.4f", errors.channels.rms_deg_overall).c_str(),
                 Format("%.4f", errors.max_abs_deg_overall).c_str(),
-                Format("%.3f", errors.weighted_rms).c_str(), above_noise.size(),
-                above_noise.size() == 1 ? "" : "s", above_noise_ratio,
+                Format("%.3f", errors.weighted_rms).c_str(), above_noise.size(), channels,
                 completed ? "" : (" (a run did not complete: " + message + ")").c_str());
   return text;
 }
@@ -85,7 +84,7 @@ std::string PredictionSummary::FullReport() const {
     out << ", fitted:";
     for (const std::string& name : model.free) out << " " << name;
   }
-  if (!model.effects_file.empty()) out << "; effects added from " << model.effects_file;
+  for (const PredictionModel::Effects& e : model.effects) out << "; effects from " << e.file;
   out << "\n  " << simulations << " simulations on " << threads << " thread"
       << (threads == 1 ? "" : "s") << ", " << Format("%.1f", wall_time_s) << " s\n\n";
   out << "  joint   RMS θx [deg]   RMS θy [deg]   max θx [deg]   max θy [deg]   noise [deg]   "
@@ -114,11 +113,15 @@ std::string PredictionSummary::FullReport() const {
         << (r.angles_from_pipeline ? ", angles from the mocap pipeline" : "")
         << (r.run.summary.completed() ? "" : ", run: " + r.run.summary.message) << "\n";
   }
+  char rule[200];
+  std::snprintf(rule, sizeof(rule),
+                "RMS above %.3g times its noise, and beyond chance: p < %.3g over the %zu channels",
+                above_noise_ratio, significance, channels);
   if (above_noise.empty()) {
-    out << "  every channel is within " << Format("%.3g", above_noise_ratio)
-        << " times its noise: the model predicts these recordings to the noise floor\n";
+    out << "  no channel stands above the noise (" << rule
+        << "): the model predicts these recordings to the noise floor\n";
   } else {
-    out << "  above " << Format("%.3g", above_noise_ratio) << " times the noise:";
+    out << "  above the noise (" << rule << "):";
     for (std::size_t k = 0; k < above_noise.size(); ++k) {
       const ChannelAboveNoise& c = above_noise[k];
       if (k == 16) {
@@ -151,13 +154,17 @@ nlohmann::json ToJson(const PredictionSummary& s) {
                             {"wall_time_s", r.run.summary.wall_time_s},
                             {"real_time_factor", r.run.summary.real_time_factor}}}});
   }
+  nlohmann::json effects_files = nlohmann::json::array();
+  for (const PredictionModel::Effects& e : s.model.effects) effects_files.push_back(e.file);
   nlohmann::json above = nlohmann::json::array();
   for (const ChannelAboveNoise& c : s.above_noise) {
     above.push_back({{"recording", c.recording},
                      {"joint", c.joint},
                      {"axis", c.axis == 0 ? "x" : "y"},
                      {"rms_deg", Number(c.rms_deg)},
-                     {"noise_deg", Number(c.noise_deg)}});
+                     {"noise_deg", Number(c.noise_deg)},
+                     {"effective_samples", Number(c.effective_samples)},
+                     {"p_value", Number(c.p_value)}});
   }
   return {{"schema", "ccsrm-prediction/1"},
           {"model",
@@ -165,8 +172,7 @@ nlohmann::json ToJson(const PredictionSummary& s) {
             {"kind", s.model.kind},
             {"free", s.model.free},
             {"values", values},
-            {"effects_file", s.model.effects_file.empty() ? nlohmann::json(nullptr)
-                                                          : nlohmann::json(s.model.effects_file)}}},
+            {"effects_files", effects_files}}},
           {"effects", s.effects},
           {"completed", s.completed},
           {"message", s.message},
@@ -175,6 +181,8 @@ nlohmann::json ToJson(const PredictionSummary& s) {
           {"weighted_rms", Number(s.errors.weighted_rms)},
           {"errors", ErrorsJson(s.errors)},
           {"above_noise_ratio", s.above_noise_ratio},
+          {"significance", s.significance},
+          {"channels", s.channels},
           {"above_noise", above},
           {"threads", s.threads},
           {"simulations", s.simulations},

@@ -172,8 +172,7 @@ TEST_F(PredictionTest, AMissingEffectShowsOnTheChannelsItTouches) {
               0.1 * std::hypot(2e-3 * kDeg, kNoiseDeg));
   // The model given the effect (--effects) predicts it to the floor again.
   PredictionModel with = model;
-  with.effects_yaml = "mocap_offset: {joint3_x_rad: 0.003, joint9_y_rad: 0.002}";
-  with.effects_file = "effects.yaml";
+  with.effects.push_back({"mocap_offset: {joint3_x_rad: 0.003, joint9_y_rad: 0.002}", "e.yaml"});
   const PredictionSummary fixed = Predict(news, with, Options());
   EXPECT_EQ(fixed.effects, std::vector<std::string>{"mocap_offset"});
   EXPECT_TRUE(fixed.above_noise.empty()) << fixed.FullReport();

@@ -41,10 +41,14 @@ struct PredictionModel {
   // of another arm is refused. fit.json's `arm` (joints and driving cables),
   // else the number of joints of its error table; unset for a parameter file.
   std::optional<sim::ArmSize> arm;
-  // Effects added on top (`ccsrm predict --effects FILE`): the YAML of
-  // sim::ApplyEffectsYaml and the file it came from; empty: none.
-  std::string effects_yaml;
-  std::string effects_file;
+  // Effects switched on over the values, in order: each the YAML of
+  // sim::ApplyEffectsYaml and the file it came from (a truth file's
+  // `effects:`, then `ccsrm predict --effects FILE`). Default: none.
+  struct Effects {
+    std::string yaml;
+    std::string file;
+  };
+  std::vector<Effects> effects;
 };
 
 // Reads the model from `path`: a fit.json (schema ccsrm-fit/1, as `ccsrm
@@ -52,8 +56,9 @@ struct PredictionModel {
 // final/fit.json), a fit folder (its fit.json), a loop folder or its
 // loop.json (the final model: final/fit.json beside it), or a parameter
 // YAML file in the format of `ccsrm identify --params` (`name: value` or
-// `name: {value, free, bounds}`; a truth file's `parameters:`; free flags and
-// bounds mean nothing here). Throws InputError "<file>: <key>: <problem>":
+// `name: {value, free, bounds}`; free flags and bounds mean nothing here), or
+// a truth file of `ccsrm generate` (its `parameters:`, and its `effects:`
+// into `effects`). Throws InputError "<file>: <key>: <problem>":
 // a missing file, JSON that does not parse, another schema, a parameter
 // entry without a finite value, an unknown parameter name or a value out
 // of its bounds.
@@ -65,15 +70,25 @@ struct PredictionOptions {
   // Another backend (null: threads on this machine). It must have been given
   // the same recordings, in the same order.
   std::shared_ptr<SimulationBackend> backend;
-  // A channel (recording, joint, axis) whose RMS error exceeds this many
-  // times its measurement noise is listed as above the noise. Default 1.5,
-  // the loop's threshold for an unexplained channel
-  // (LoopOptions::unexplained_noise_ratio).
+  // A channel (recording, joint, axis) is listed as above the noise when
+  // both hold: its RMS error exceeds above_noise_ratio times its
+  // measurement noise (default 1.5, the loop's threshold for an unexplained
+  // channel, LoopOptions::unexplained_noise_ratio: a size worth naming), and
+  // its residual is not noise by chance: mocap residuals are filtered, so a
+  // channel's N frames carry N_eff independent samples (N over the
+  // residual's integrated autocorrelation time), and Σ r² N_eff / N of the
+  // weighted residuals r is then a chi-square of N_eff degrees of freedom;
+  // its p-value must be below `significance` over the number of channels
+  // (Bonferroni; default 0.01 family-wise, the loop's score_significance).
+  // On a few seconds of 1 Hz-filtered mocap a channel has N_eff of about 7,
+  // and its RMS alone scatters by a quarter around the noise.
   double above_noise_ratio = 1.5;
+  double significance = 0.01;
   // Called after each finished run, one call at a time; may be empty.
   RunFinishedCallback on_run;
 
-  // False with the reason: threads < 1, above_noise_ratio not > 0.
+  // False with the reason: threads < 1, above_noise_ratio not > 0,
+  // significance outside (0, 1).
   bool IsValid(std::string* error) const;
 };
 
@@ -103,6 +118,8 @@ struct ChannelAboveNoise {
   int axis = 0;   // 0 θx, 1 θy
   double rms_deg = 0.0;
   double noise_deg = 0.0;
+  double effective_samples = 0.0;  // N_eff of its residual
+  double p_value = 0.0;            // of its chi-square as noise
 };
 
 struct RecordingPrediction {
@@ -123,6 +140,8 @@ struct PredictionSummary {
   PredictionErrors errors;  // every recording together
   std::vector<ChannelAboveNoise> above_noise;
   double above_noise_ratio = 0.0;
+  double significance = 0.0;  // family-wise, over `channels`
+  std::size_t channels = 0;   // tested: recordings x joints x 2 with a measured sample
   int threads = 0;
   std::int64_t simulations = 0;
   double wall_time_s = 0.0;
