@@ -25,15 +25,16 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr const char* kFitSchema = "ccsrm-fit/1";
 constexpr const char* kLoopSchema = "ccsrm-loop/1";
 
-// The parsed JSON of `path`, or nullopt when its text is not JSON (then it
-// is read as YAML). Throws InputError for a file that starts like JSON
-// ('{') but does not parse.
+// The parsed JSON of `path`, or nullopt when it is YAML. A file named
+// *.json must be JSON; another is JSON when it parses as JSON (YAML's flow
+// mappings also start with '{').
 std::optional<json> ParseJsonFile(const std::string& path, const std::string& text) {
-  const std::size_t first = text.find_first_not_of(" \t\r\n");
-  if (first == std::string::npos || text[first] != '{') return std::nullopt;
   json parsed = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (parsed.is_discarded()) ThrowInputError(path, "", "is not valid JSON");
-  return parsed;
+  if (!parsed.is_discarded() && parsed.is_object()) return parsed;
+  if (fs::path(path).extension() == ".json") {
+    ThrowInputError(path, "", "is not a JSON object (expected a fit.json, ccsrm-fit/1)");
+  }
+  return std::nullopt;
 }
 
 std::string SchemaOf(const json& j) {

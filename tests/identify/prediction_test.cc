@@ -205,6 +205,29 @@ TEST_F(PredictionTest, WritesTheFolderAndReadsAParameterFileToo) {
                              "residual_thetax1_deg,measured_thetay1_deg"));
 }
 
+TEST_F(PredictionTest, ReadsTheModelFromAFitOrLoopFolderAndAnOlderFitJson) {
+  // A loop folder's model is its final fit (final/fit.json beside loop.json).
+  const fs::path loop = Scratch("loop");
+  fs::create_directories(loop / "final");
+  fs::copy_file(*fit_json_, loop / "final" / "fit.json");
+  WriteTextFileAtomically((loop / "loop.json").string(), R"({"schema": "ccsrm-loop/1"})");
+  for (const fs::path& source : {loop, loop / "loop.json", loop / "final"}) {
+    const PredictionModel model = LoadPredictionModel(source.string());
+    EXPECT_EQ(model.source, (loop / "final" / "fit.json").string()) << source;
+    EXPECT_DOUBLE_EQ(model.values.at("T_p"), fitted_tp_) << source;
+  }
+  // A fit.json written before fits recorded their arm: the joints of its
+  // error table still tell the arm (its cables unknown).
+  nlohmann::json old = nlohmann::json::parse(ReadTextFile(*fit_json_));
+  old.erase("arm");
+  const std::string old_fit = (loop / "old.json").string();
+  WriteTextFileAtomically(old_fit, old.dump());
+  const PredictionModel model = LoadPredictionModel(old_fit);
+  ASSERT_TRUE(model.arm.has_value());
+  EXPECT_EQ(model.arm->joints, 12);
+  EXPECT_EQ(model.arm->cables, 0);
+}
+
 TEST_F(PredictionTest, RefusesAModelOfAnotherArmOrUnknownParameters) {
   const std::vector<Experiment> news = {Recording(Truth(), 7, NewMotion(), "new_plus3")};
   PredictionModel model = LoadPredictionModel(*fit_json_);
