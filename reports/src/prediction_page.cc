@@ -150,6 +150,29 @@ Section RecordingSection(const PredictionRecording& r, std::size_t index, bool s
       "Errors that follow the motion rather than scatter around 0 are what the model does not "
       "predict.",
       ""});
+  // This recording's own errors: pooled tables hide which recording an
+  // error belongs to.
+  Table table;
+  table.id = "errors_" + stem;
+  table.title = "Errors per joint: " + r.name;
+  table.caption = "pred.json 'recordings[" + std::to_string(index) +
+                  "].errors': RMS and largest |predicted − measured| of this recording, its "
+                  "noise per joint, and RMS over noise (about 1 at the noise floor).";
+  table.columns = {{"joint", "joint", "", NumberFormat::Integer()},
+                   {"rms_x_deg", "RMS θx", "deg", kRms},
+                   {"max_x_deg", "largest θx", "deg", kRms},
+                   {"rms_y_deg", "RMS θy", "deg", kRms},
+                   {"max_y_deg", "largest θy", "deg", kRms},
+                   {"noise_deg", "noise", "deg", kRms},
+                   {"rms_over_noise_x", "RMS/noise θx", "", kRatio},
+                   {"rms_over_noise_y", "RMS/noise θy", "", kRatio}};
+  for (const auto& j : r.errors.per_joint) {
+    table.AddRow({Cell::Number(j.joint), Cell::Number(j.rms_deg[0]), Cell::Number(j.max_abs_deg[0]),
+                  Cell::Number(j.rms_deg[1]), Cell::Number(j.max_abs_deg[1]),
+                  Cell::Number(j.noise_deg), Cell::Number(j.rms_over_noise[0]),
+                  Cell::Number(j.rms_over_noise[1])});
+  }
+  section.blocks.push_back(std::move(table));
   return section;
 }
 
