@@ -154,6 +154,14 @@ TEST_F(PredictCommand, PredictsANewMotionAtTheFloorAndShowsWhereATiltIsMissing) 
                            "Above the noise", "figures/angles_x_new_1.png", "T_p"}) {
     EXPECT_THAT(html, HasSubstr(text));
   }
+  // --config: the arm's configuration as the user keeps it (here the file
+  // the recordings were generated from) gives the same prediction.
+  const Outcome with_config =
+      RunCcsrm("predict --data " + Path("new.h5") + " --params " + Path("fit") + " --config " +
+               kArm + " --threads 2 --quiet --out " + Path("pred_config"));
+  ASSERT_EQ(with_config.status, 0) << with_config.all();
+  EXPECT_NEAR(ReadJson(*dir_ / "pred_config" / "pred.json")["weighted_rms"].get<double>(),
+              clean["errors"]["weighted_rms"].get<double>(), 1e-9);
   // A second run replaces its own folder; the inputs stay as they were.
   EXPECT_EQ(RunCcsrm("predict --data " + Path("new.h5") + " --params " + Path("fit/fit.json") +
                      " --threads 2 --quiet --out " + Path("pred"))
