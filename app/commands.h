@@ -17,4 +17,5 @@ void AddReportCommand(CLI::App& root);
 void AddDerivativesCommand(CLI::App& root);
 void AddIdentifyCommand(CLI::App& root);
 void AddLoopCommand(CLI::App& root);
+void AddPredictCommand(CLI::App& root);
 }  // namespace ccsrm::app

@@ -5,6 +5,7 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/sim/config.h"
 #include "ccsrm/sim/parameters.h"
 #include "option_checks.h"
 
@@ -28,9 +29,15 @@ void ApplyFitOptions(const std::optional<std::string>& free, const std::string& 
 }
 
 std::vector<identify::Experiment> LoadExperiments(const std::vector<std::string>& paths,
-                                                  double noise_deg, const char* role) {
+                                                  double noise_deg, const char* role,
+                                                  const std::string& config) {
   identify::ExperimentLoadOptions load;
   if (noise_deg > 0.0) load.noise_deg = noise_deg;
+  if (!config.empty()) {
+    load.config_yaml = ReadTextFile(config);
+    load.config_source = config;
+    sim::ParseConfig(load.config_yaml, config);  // its own errors first, naming it
+  }
   std::vector<identify::Experiment> experiments;
   for (const std::string& path : paths) {
     experiments.push_back(identify::LoadExperiment(path, load));
@@ -66,7 +73,11 @@ void PrintFitProgress(identify::IdentificationOptions* options, const std::strin
                 p.wall_time_s, values.c_str());
     std::fflush(stdout);
   };
-  options->on_run = [](std::size_t finished, std::size_t total, const identify::RunResult& r) {
+  options->on_run = RunProgress();
+}
+
+identify::RunFinishedCallback RunProgress() {
+  return [](std::size_t finished, std::size_t total, const identify::RunResult& r) {
     std::fprintf(stderr, "\r  simulation %zu / %zu (%.1f s wall)", finished, total,
                  r.summary.wall_time_s);
     if (finished == total) std::fprintf(stderr, "\r%-60s\r", "");

@@ -17,11 +17,17 @@ void ApplyFitOptions(const std::optional<std::string>& free, const std::string& 
 
 // Loads each experiment and prints one line about it (and the mocap
 // pipeline's when it computed the angles). `role` prefixes the line
-// ("experiment", "held out").
+// ("experiment", "held out"). With `config` (a configuration file), every
+// experiment uses that arm instead of its own config_yaml
+// (ExperimentLoadOptions::config_yaml).
 std::vector<identify::Experiment> LoadExperiments(const std::vector<std::string>& paths,
-                                                  double noise_deg, const char* role);
+                                                  double noise_deg, const char* role,
+                                                  const std::string& config = "");
 
 // Per-iteration and per-simulation progress lines of a fit.
 void PrintFitProgress(identify::IdentificationOptions* options, const std::string& indent);
+
+// The per-simulation progress line ("simulation 3 / 8"), on stderr.
+identify::RunFinishedCallback RunProgress();
 
 }  // namespace ccsrm::app

@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   ccsrm::app::AddDerivativesCommand(root);
   ccsrm::app::AddIdentifyCommand(root);
   ccsrm::app::AddLoopCommand(root);
+  ccsrm::app::AddPredictCommand(root);
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -89,6 +89,13 @@ OutputKind LoopFolderOutput() {
           [](const std::string& p) { return FolderJsonHasSchema(p, "loop.json", "ccsrm-loop/1"); }};
 }
 
+OutputKind PredictionFolderOutput() {
+  return {"ccsrm prediction folder (pred.json, ccsrm-prediction/1)", true,
+          [](const std::string& p) {
+            return FolderJsonHasSchema(p, "pred.json", "ccsrm-prediction/1");
+          }};
+}
+
 OutputKind RenderFolderOutput() {
   return {"ccsrm camera render folder (cameras.yaml, ccsrm-cameras/1)", true,
           [](const std::string& p) {

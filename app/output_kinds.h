@@ -16,10 +16,11 @@ OutputKind C3dFileOutput();         // mocap export, cameras reconstruct
 // A YAML file whose top level has `schema: <schema>` (rigid bodies, camera
 // files, the truth of generate).
 OutputKind YamlFileOutput(const std::string& schema, const std::string& description);
-OutputKind CameraFileOutput();       // cameras rig, calibrate: ccsrm-cameras/1
-OutputKind DerivativesJsonOutput();  // derivatives --json
-OutputKind FitFolderOutput();        // identify: fit.json, schema ccsrm-fit/1
-OutputKind LoopFolderOutput();       // loop: loop.json, schema ccsrm-loop/1
+OutputKind CameraFileOutput();        // cameras rig, calibrate: ccsrm-cameras/1
+OutputKind DerivativesJsonOutput();   // derivatives --json
+OutputKind FitFolderOutput();         // identify: fit.json, schema ccsrm-fit/1
+OutputKind LoopFolderOutput();        // loop: loop.json, schema ccsrm-loop/1
+OutputKind PredictionFolderOutput();  // predict: pred.json, schema ccsrm-prediction/1
 // cameras render: cameras.yaml (ccsrm-cameras/1) with its videos.
 OutputKind RenderFolderOutput();
 // cameras render-board: the checkerboard images (PNG files only).

@@ -63,6 +63,27 @@ Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::s
                           const ExperimentLoadOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError(path, "noise", error);
+  if (!options.config_yaml.empty()) {
+    // The configuration given replaces the file's, but not for another arm.
+    const sim::Config given = sim::ParseConfig(options.config_yaml, options.config_source);
+    if (!recorded.config_yaml.empty()) {
+      const sim::Config own =
+          sim::ParseConfig(recorded.config_yaml, path + ": attribute 'config_yaml'");
+      const sim::ArmSize a = own.arm.size(), b = given.arm.size();
+      if (a != b) {
+        ThrowInputError(path, "attribute 'config_yaml'",
+                        "describes an arm of " + std::to_string(a.joints) + " joints and " +
+                            std::to_string(a.cables) + " driving cables, " + options.config_source +
+                            " one of " + std::to_string(b.joints) + " and " +
+                            std::to_string(b.cables));
+      }
+    }
+    datasets::ExperimentFile replaced = recorded;
+    replaced.config_yaml = options.config_yaml;
+    ExperimentLoadOptions rest = options;
+    rest.config_yaml.clear();
+    return MakeExperiment(replaced, path, rest);
+  }
   // The check of every door (config_yaml, cable columns, the measured
   // angles' shape and range) before any work. Without measured angles the
   // mocap pipeline runs, with default settings, and its output is checked

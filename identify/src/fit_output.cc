@@ -5,6 +5,7 @@
 #include <set>
 #include <sstream>
 
+#include "angles_table.h"
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/datasets/run_file.h"
@@ -42,26 +43,6 @@ nlohmann::json ChannelJson(const ChannelErrors& e) {
           {"fit_percent", Number(e.fit_percent_overall)},
           {"per_joint", joints},
           {"axes", {"theta_x", "theta_y"}}};
-}
-
-// Unique, file-safe stems for the experiments' output files.
-std::vector<std::string> OutputStems(const IdentificationSummary& summary) {
-  std::vector<std::string> stems;
-  std::set<std::string> used;
-  for (const ExperimentFit& fit : summary.experiments) {
-    std::string stem;
-    for (char c : fit.name) {
-      stem += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.')
-                  ? c
-                  : '_';
-    }
-    if (stem.empty()) stem = "experiment";
-    std::string unique = stem;
-    for (int k = 2; used.count(unique) != 0; ++k) unique = stem + "_" + std::to_string(k);
-    used.insert(unique);
-    stems.push_back(unique);
-  }
-  return stems;
 }
 
 }  // namespace
@@ -216,7 +197,14 @@ nlohmann::json ToJson(const IdentificationSummary& s) {
                              {"wall_time_s", e.run.summary.wall_time_s},
                              {"real_time_factor", e.run.summary.real_time_factor}}}});
   }
+  nlohmann::json arm = nullptr;
+  if (!s.experiments.empty()) {
+    // The arm the values were fitted on: a prediction refuses another one.
+    const sim::ArmSize& size = s.experiments.front().parameters.arm;
+    arm = {{"joints", size.joints}, {"driving_cables", size.cables}};
+  }
   return {{"schema", "ccsrm-fit/1"},
+          {"arm", arm},
           {"converged", s.converged()},
           {"termination", TerminationName(s.termination)},
           {"message", s.message},
@@ -255,7 +243,9 @@ std::vector<std::string> WriteFitDirectory(const IdentificationSummary& summary,
   AtomicOutputDirectory out(directory);
   const fs::path tmp(out.temp_path());
   std::vector<std::string> written;
-  const std::vector<std::string> stems = OutputStems(summary);
+  std::vector<std::string> names;
+  for (const ExperimentFit& fit : summary.experiments) names.push_back(fit.name);
+  const std::vector<std::string> stems = internal::OutputStems(names);
   nlohmann::json json = ToJson(summary);
   for (std::size_t e = 0; e < experiments.size(); ++e) {
     const ExperimentFit& fit = summary.experiments[e];
@@ -271,36 +261,22 @@ std::vector<std::string> WriteFitDirectory(const IdentificationSummary& summary,
     } else {
       json["experiments"][e]["run_file"] = nullptr;
     }
-    std::ostringstream csv;
-    csv << "# " << fit.name << ": measured and fitted joint angles [deg] at the measured frames; "
-        << "residual = fitted - measured; empty where not measured\n";
-    csv << "time_s";
-    for (int j = 1; j <= x.joints; ++j) {
-      for (const char* axis : {"x", "y"}) {
-        csv << ",measured_theta" << axis << j << "_deg,fitted_theta" << axis << j
-            << "_deg,residual_theta" << axis << j << "_deg";
-      }
-    }
-    csv << "\n";
-    char value[64];
-    for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
-      std::snprintf(value, sizeof(value), "%.6f", x.frame_time_s[static_cast<std::size_t>(f)]);
-      csv << value;
-      for (Eigen::Index c = 0; c < x.measured_rad.cols(); ++c) {
-        const double m = x.measured_rad(f, c) * kDeg;
-        const double s = fit.simulated_rad.rows() > f ? fit.simulated_rad(f, c) * kDeg : NAN;
-        for (double v : {m, s, s - m}) {
-          if (std::isfinite(v)) {
-            std::snprintf(value, sizeof(value), ",%.6f", v);
-            csv << value;
-          } else {
-            csv << ",";
-          }
-        }
-      }
-      csv << "\n";
-    }
-    WriteTextFileAtomically((tmp / (stems[e] + ".angles.csv")).string(), csv.str());
+    const auto measured = [&x](Eigen::Index f, Eigen::Index c) {
+      return x.measured_rad(f, c) * kDeg;
+    };
+    const auto fitted = [&fit](Eigen::Index f, Eigen::Index c) {
+      return fit.simulated_rad.rows() > f ? fit.simulated_rad(f, c) * kDeg : NAN;
+    };
+    const std::string csv = internal::AnglesCsvText(
+        fit.name +
+            ": measured and fitted joint angles [deg] at the measured frames; residual = fitted - "
+            "measured; empty where not measured",
+        x.frame_time_s, x.joints,
+        {{"measured", measured},
+         {"fitted", fitted},
+         {"residual",
+          [&](Eigen::Index f, Eigen::Index c) { return fitted(f, c) - measured(f, c); }}});
+    WriteTextFileAtomically((tmp / (stems[e] + ".angles.csv")).string(), csv);
     written.push_back((fs::path(directory) / (stems[e] + ".angles.csv")).string());
   }
   WriteTextFileAtomically((tmp / "fit.json").string(), json.dump(2) + "\n");

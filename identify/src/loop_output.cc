@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "angles_table.h"
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/identify/loop.h"
 
@@ -244,38 +245,19 @@ std::vector<std::string> WriteLoopDirectory(const LoopSummary& summary,
     fs::create_directory(tmp / "holdout");
     for (std::size_t e = 0; e < holdout.size(); ++e) {
       const Experiment& x = holdout[e];
-      std::ostringstream csv;
-      csv << "# " << x.name
-          << ": held-out joint angles [deg]: measured, the declared model's and the final "
-             "model's; empty where not measured\n";
-      csv << "time_s";
-      for (int j = 1; j <= x.joints; ++j) {
-        for (const char* axis : {"x", "y"}) {
-          csv << ",measured_theta" << axis << j << "_deg,declared_theta" << axis << j
-              << "_deg,final_theta" << axis << j << "_deg";
-        }
-      }
-      csv << "\n";
-      char value[64];
-      for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
-        std::snprintf(value, sizeof(value), "%.6f", x.frame_time_s[static_cast<std::size_t>(f)]);
-        csv << value;
-        for (Eigen::Index c = 0; c < x.measured_rad.cols(); ++c) {
-          for (const Eigen::MatrixXd* m :
-               {&x.measured_rad, &summary.holdout_declared_rad[e], &summary.holdout_final_rad[e]}) {
-            const double v = f < m->rows() ? (*m)(f, c) * kDeg : NAN;
-            if (std::isfinite(v)) {
-              std::snprintf(value, sizeof(value), ",%.6f", v);
-              csv << value;
-            } else {
-              csv << ",";
-            }
-          }
-        }
-        csv << "\n";
-      }
+      const auto degrees = [](const Eigen::MatrixXd& m) {
+        return [&m](Eigen::Index f, Eigen::Index c) { return f < m.rows() ? m(f, c) * kDeg : NAN; };
+      };
+      const std::string csv = internal::AnglesCsvText(
+          x.name +
+              ": held-out joint angles [deg]: measured, the declared model's and the final "
+              "model's; empty where not measured",
+          x.frame_time_s, x.joints,
+          {{"measured", degrees(x.measured_rad)},
+           {"declared", degrees(summary.holdout_declared_rad[e])},
+           {"final", degrees(summary.holdout_final_rad[e])}});
       const std::string name = x.name.empty() ? "holdout" + std::to_string(e + 1) : x.name;
-      WriteTextFileAtomically((tmp / "holdout" / (name + ".angles.csv")).string(), csv.str());
+      WriteTextFileAtomically((tmp / "holdout" / (name + ".angles.csv")).string(), csv);
       written.push_back((fs::path(directory) / "holdout" / (name + ".angles.csv")).string());
     }
   }

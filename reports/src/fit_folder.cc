@@ -71,35 +71,6 @@ void ReadAnglesFile(const std::string& file, FitExperiment* e) {
   e->residual_deg = std::move(angles.series[2]);
 }
 
-// The segments of the arm the experiment was fitted with, from the fitted
-// run's stored configuration.
-void ReadSegments(const std::string& run_file, FitExperiment* e) {
-  const std::size_t joints = e->measured_deg.shape[1];
-  std::string config_yaml;
-  if (e->run_file.empty()) {
-    e->problems.push_back("Experiment " + e->name +
-                          ": fit.json names no fitted run file (the fitted run failed), so the "
-                          "arm's segments are unknown: its joints are shown in one panel.");
-  } else {
-    try {
-      config_yaml = datasets::ReadRunFile(run_file).config_yaml;
-    } catch (const std::exception& error) {
-      e->problems.push_back("Experiment " + e->name + ": the fitted run file cannot be read (" +
-                            error.what() + "): its joints are shown in one panel.");
-    }
-  }
-  if (config_yaml.empty()) {
-    e->segments = {{"All joints (1–" + std::to_string(joints) + ")", 1, static_cast<int>(joints)}};
-    return;
-  }
-  ArmFacts facts =
-      ReadArmFacts(config_yaml, run_file + ": attribute 'config_yaml'", joints, 0, nullptr);
-  e->segments = std::move(facts.segments);
-  for (std::string& problem : facts.problems) {
-    e->problems.push_back("Experiment " + e->name + ": " + problem);
-  }
-}
-
 FitExperiment ReadExperiment(const JsonReader& in, const json& entry, std::size_t index,
                              const fs::path& folder) {
   const std::string at = "experiments[" + std::to_string(index) + "]";
@@ -135,11 +106,40 @@ FitExperiment ReadExperiment(const JsonReader& in, const json& entry, std::size_
     in.Fail(at, "noise_deg, start and fitted must have one entry per joint of " + e.angles_file +
                     " (" + std::to_string(joints) + ")");
   }
-  ReadSegments((folder / e.run_file).string(), &e);
+  e.segments = SegmentsOfRun(folder.string(), e.run_file, joints, "Experiment " + e.name,
+                             "fit.json", "fitted", &e.problems);
   return e;
 }
 
 }  // namespace
+
+std::vector<JointGroup> SegmentsOfRun(const std::string& folder, const std::string& run_file,
+                                      std::size_t joints, const std::string& subject,
+                                      const std::string& json_name, const std::string& run_word,
+                                      std::vector<std::string>* problems) {
+  const std::string path = (fs::path(folder) / run_file).string();
+  std::string config_yaml;
+  if (run_file.empty()) {
+    problems->push_back(subject + ": " + json_name + " names no " + run_word + " run file (the " +
+                        run_word +
+                        " run failed), so the arm's segments are unknown: its joints are shown "
+                        "in one panel.");
+  } else {
+    try {
+      config_yaml = datasets::ReadRunFile(path).config_yaml;
+    } catch (const std::exception& error) {
+      problems->push_back(subject + ": the " + run_word + " run file cannot be read (" +
+                          error.what() + "): its joints are shown in one panel.");
+    }
+  }
+  if (config_yaml.empty()) {
+    return {{"All joints (1–" + std::to_string(joints) + ")", 1, static_cast<int>(joints)}};
+  }
+  ArmFacts facts =
+      ReadArmFacts(config_yaml, path + ": attribute 'config_yaml'", joints, 0, nullptr);
+  for (std::string& problem : facts.problems) problems->push_back(subject + ": " + problem);
+  return std::move(facts.segments);
+}
 
 bool LooksLikeFitFolder(const std::string& folder) {
   std::error_code ec;

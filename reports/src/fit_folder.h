@@ -98,6 +98,16 @@ struct FitFolder {
   std::vector<FitExperiment> experiments;
 };
 
+// The segments of the arm a stored run (`run_file` in `folder`, as a JSON
+// file `json_name` names it) was made on, from the run's configuration;
+// one group of every joint, with the reason added to `problems` ("<subject>:
+// ..."), when the name is empty (the `run_word` run failed) or the file
+// cannot be read.
+std::vector<JointGroup> SegmentsOfRun(const std::string& folder, const std::string& run_file,
+                                      std::size_t joints, const std::string& subject,
+                                      const std::string& json_name, const std::string& run_word,
+                                      std::vector<std::string>* problems);
+
 // True when `folder` is a folder holding a fit.json (of any schema): what
 // `ccsrm report` takes for a fit folder.
 bool LooksLikeFitFolder(const std::string& folder);

@@ -154,64 +154,6 @@ Section SummarySection(const FitFolder& fit) {
 
 // ------------------------------------------------- measured against fitted
 
-// One panel per segment: joint k of a segment in palette::Indexed(k), its
-// measured angle as a thin dashed line and its fitted angle solid on top.
-Figure AnglesFigure(const std::string& name, const FitExperiment& e, int c) {
-  Figure figure;
-  figure.name = name;
-  figure.panel_width_px = 1100;
-  figure.panel_height_px = 300;
-  const std::size_t axis = static_cast<std::size_t>(c);
-  for (const internal::JointGroup& group : e.segments) {
-    Panel panel;
-    panel.title = group.title + ": solid fitted, dashed measured";
-    panel.x = internal::TimeAxis();
-    panel.y = Axis{AxisName(c), "deg"};
-    for (int k = 1; k <= group.joints; ++k) {
-      const std::size_t j = static_cast<std::size_t>(group.first_joint + k - 2);
-      Series measured{"", e.time_s, internal::ComponentOf(e.measured_deg, j, axis),
-                      palette::Indexed(k), SeriesStyle::kDashed};
-      measured.line_width = 1.2;
-      panel.series.push_back(std::move(measured));
-    }
-    for (int k = 1; k <= group.joints; ++k) {
-      const std::size_t j = static_cast<std::size_t>(group.first_joint + k - 2);
-      panel.series.push_back(Series{"joint " + std::to_string(j + 1), e.time_s,
-                                    internal::ComponentOf(e.fitted_deg, j, axis),
-                                    palette::Indexed(k)});
-    }
-    figure.panels.push_back(std::move(panel));
-  }
-  return figure;
-}
-
-// Residuals (fitted − measured) per segment, θx left and θy right.
-Figure ResidualFigure(const std::string& name, const FitExperiment& e) {
-  Figure figure;
-  figure.name = name;
-  figure.columns = 2;
-  figure.panel_width_px = 640;
-  figure.panel_height_px = 300;
-  for (const internal::JointGroup& group : e.segments) {
-    for (int c = 0; c < 2; ++c) {
-      Panel panel;
-      panel.title = group.title + ": " + AxisName(c);
-      panel.x = internal::TimeAxis();
-      panel.y = Axis{std::string("residual ") + AxisName(c), "deg"};
-      for (int k = 1; k <= group.joints; ++k) {
-        const std::size_t j = static_cast<std::size_t>(group.first_joint + k - 2);
-        Series s{"joint " + std::to_string(j + 1), e.time_s,
-                 internal::ComponentOf(e.residual_deg, j, static_cast<std::size_t>(c)),
-                 palette::Indexed(k)};
-        s.line_width = 1.2;
-        panel.series.push_back(std::move(s));
-      }
-      figure.panels.push_back(std::move(panel));
-    }
-  }
-  return figure;
-}
-
 Section ExperimentAnglesSection(const FitExperiment& e, std::size_t index, bool several) {
   const std::string stem = FigureStem(several ? e.name + "_" + std::to_string(index + 1) : e.name);
   Section section{"angles-" + stem,
@@ -225,7 +167,9 @@ Section ExperimentAnglesSection(const FitExperiment& e, std::size_t index, bool 
       false});
   for (int c = 0; c < 2; ++c) {
     section.blocks.push_back(FigureBlock{
-        AnglesFigure("angles_" + std::string(c == 0 ? "x_" : "y_") + stem, e, c),
+        internal::MeasuredAgainstSimulatedFigure(
+            "angles_" + std::string(c == 0 ? "x_" : "y_") + stem, e.time_s, e.measured_deg,
+            e.fitted_deg, c, e.segments, "fitted"),
         std::string(AxisName(c)) + ": measured and fitted",
         std::string(c == 0 ? "Bending angle θx" : "Out-of-plane angle θy") +
             " of every joint, one panel per segment, joints in order from the root (colours as "
@@ -234,7 +178,8 @@ Section ExperimentAnglesSection(const FitExperiment& e, std::size_t index, bool 
         ""});
   }
   section.blocks.push_back(FigureBlock{
-      ResidualFigure("residuals_" + stem, e), "Residuals over time",
+      internal::ResidualsFigure("residuals_" + stem, e.time_s, e.residual_deg, e.segments),
+      "Residuals over time",
       "Fitted minus measured angle of every joint (the residual of the fit before it is divided "
       "by the noise), θx left, θy right, one row per segment. Residuals that follow the motion "
       "rather than scatter around 0 are what the model does not explain.",

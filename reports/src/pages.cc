@@ -186,4 +186,61 @@ std::string FigureStem(const std::string& name) {
   return out;
 }
 
+Figure MeasuredAgainstSimulatedFigure(const std::string& name, const std::vector<double>& time,
+                                      const datasets::Array& measured,
+                                      const datasets::Array& simulated, int c,
+                                      const std::vector<JointGroup>& segments,
+                                      const std::string& simulated_word) {
+  Figure figure;
+  figure.name = name;
+  figure.panel_width_px = 1100;
+  figure.panel_height_px = 300;
+  const std::size_t axis = static_cast<std::size_t>(c);
+  for (const JointGroup& group : segments) {
+    Panel panel;
+    panel.title = group.title + ": solid " + simulated_word + ", dashed measured";
+    panel.x = TimeAxis();
+    panel.y = Axis{AxisName(c), "deg"};
+    for (int k = 1; k <= group.joints; ++k) {
+      const std::size_t j = static_cast<std::size_t>(group.first_joint + k - 2);
+      Series m{"", time, ComponentOf(measured, j, axis), palette::Indexed(k), SeriesStyle::kDashed};
+      m.line_width = 1.2;
+      panel.series.push_back(std::move(m));
+    }
+    for (int k = 1; k <= group.joints; ++k) {
+      const std::size_t j = static_cast<std::size_t>(group.first_joint + k - 2);
+      panel.series.push_back(Series{"joint " + std::to_string(j + 1), time,
+                                    ComponentOf(simulated, j, axis), palette::Indexed(k)});
+    }
+    figure.panels.push_back(std::move(panel));
+  }
+  return figure;
+}
+
+Figure ResidualsFigure(const std::string& name, const std::vector<double>& time,
+                       const datasets::Array& residual, const std::vector<JointGroup>& segments) {
+  Figure figure;
+  figure.name = name;
+  figure.columns = 2;
+  figure.panel_width_px = 640;
+  figure.panel_height_px = 300;
+  for (const JointGroup& group : segments) {
+    for (int c = 0; c < 2; ++c) {
+      Panel panel;
+      panel.title = group.title + ": " + AxisName(c);
+      panel.x = TimeAxis();
+      panel.y = Axis{std::string("residual ") + AxisName(c), "deg"};
+      for (int k = 1; k <= group.joints; ++k) {
+        const std::size_t j = static_cast<std::size_t>(group.first_joint + k - 2);
+        Series s{"joint " + std::to_string(j + 1), time,
+                 ComponentOf(residual, j, static_cast<std::size_t>(c)), palette::Indexed(k)};
+        s.line_width = 1.2;
+        panel.series.push_back(std::move(s));
+      }
+      figure.panels.push_back(std::move(panel));
+    }
+  }
+  return figure;
+}
+
 }  // namespace ccsrm::reports::internal

@@ -40,6 +40,22 @@ Figure JointAngleFigure(const std::string& name, const std::vector<double>& time
                         const std::vector<JointGroup>& segments,
                         const std::optional<datasets::Array>& plan);
 
+// Measured against simulated joint angles (fit and prediction pages): one
+// panel per segment, joint k of a segment in palette::Indexed(k), its
+// measured angle as a thin dashed line and its simulated angle solid on top.
+// `measured` and `simulated` are T × J × 2 [deg] on `time`; `simulated_word`
+// names the simulated angles in the panel titles ("fitted", "predicted").
+Figure MeasuredAgainstSimulatedFigure(const std::string& name, const std::vector<double>& time,
+                                      const datasets::Array& measured,
+                                      const datasets::Array& simulated, int component,
+                                      const std::vector<JointGroup>& segments,
+                                      const std::string& simulated_word);
+
+// Residuals (simulated − measured, T × J × 2 [deg]) per segment, θx left
+// and θy right.
+Figure ResidualsFigure(const std::string& name, const std::vector<double>& time,
+                       const datasets::Array& residual, const std::vector<JointGroup>& segments);
+
 // One panel per segment of per-cable values against time (cable k in
 // palette::Indexed(k)); `values` is T × C.
 Figure CableFigure(const std::string& name, const std::vector<double>& time,

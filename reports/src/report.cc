@@ -16,6 +16,7 @@
 #include "ccsrm/datasets/inspect.h"
 #include "fit_folder.h"
 #include "loop_folder.h"
+#include "prediction_folder.h"
 
 namespace ccsrm::reports {
 namespace {
@@ -125,26 +126,31 @@ ReportSummary MakeReport(const std::string& input, const std::string& output_fol
   if (!fs::exists(input, ec)) ThrowInputError(input, "", "no such file");
   const bool folder = fs::is_directory(input, ec);
   const std::string name = fs::path(input).filename().string();
-  if (!folder && (name == "fit.json" || name == "loop.json")) {
+  if (!folder && (name == "fit.json" || name == "loop.json" || name == "pred.json")) {
     const fs::path parent = fs::path(input).parent_path();
     ThrowInputError(input, "",
-                    std::string(name == "fit.json" ? "a fit" : "a loop") +
+                    std::string(name == "fit.json"    ? "a fit"
+                                : name == "loop.json" ? "a loop"
+                                                      : "a prediction") +
                         " is reported from its folder: ccsrm report --in " +
                         (parent.empty() ? std::string(".") : parent.string()));
   }
   // A loop folder holds fit folders but no fit.json of its own.
   const bool loop = folder && internal::LooksLikeLoopFolder(input);
-  if (folder && !loop && !internal::LooksLikeFitFolder(input)) {
+  const bool prediction = folder && !loop && internal::LooksLikePredictionFolder(input);
+  if (folder && !loop && !prediction && !internal::LooksLikeFitFolder(input)) {
     ThrowInputError(input, "",
-                    "not a fit or loop folder (no fit.json or loop.json); expected a ccsrm-run/1 "
-                    "or ccsrm-dataset/1 file, or a folder written by ccsrm identify or ccsrm "
-                    "loop");
+                    "not a fit, loop or prediction folder (no fit.json, loop.json or pred.json); "
+                    "expected a ccsrm-run/1 or ccsrm-dataset/1 file, or a folder written by ccsrm "
+                    "identify, ccsrm loop or ccsrm predict");
   }
   CheckOutputFolder(output_folder, input);
   Document document;
   if (folder) {
     FindGnuplot(options.plot);
-    document = loop ? BuildLoopDocument(input, options) : BuildFitDocument(input, options);
+    document = loop         ? BuildLoopDocument(input, options)
+               : prediction ? BuildPredictionDocument(input, options)
+                            : BuildFitDocument(input, options);
   } else {
     const datasets::AnyFile file = datasets::ReadAnyFile(input);
     FindGnuplot(options.plot);

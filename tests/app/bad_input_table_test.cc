@@ -286,6 +286,9 @@ const std::vector<BadInput>& Rows() {
        "identify --data {d}/processed.h5 --params {d}/pdup.yaml --out {d}/fit",
        {"{d}/pdup.yaml", "mu", "duplicate"}},
       {"overrides",
+       "predict --data {d}/processed.h5 --params {d}/prange.yaml --out {d}/pred",
+       {"{d}/prange.yaml", "mu"}},
+      {"overrides",
        "report --in {d}/run.h5 --instants -5 --out {d}/report",
        {"--instants", "-5"}},  // 8
       {"overrides", "report --in {d}/run.h5 --instants 1e4 --out {d}/report", {"--instants"}},
@@ -323,6 +326,16 @@ const std::vector<BadInput>& Rows() {
        {"{d}/cut5.h5", "/measured/joint_angles"}},  // 9
       {"hdf5", "dataset inspect {d}/cut5.h5", {"{d}/cut5.h5", "/measured/joint_angles"}},
       {"hdf5", "dataset inspect {d}/notes.h5", {"{d}/notes.h5", "HDF5"}},
+      // Prediction (issue 25): the same door as identification.
+      {"hdf5",
+       "predict --data {d}/five.h5 --params {d}/p.yaml --out {d}/pred",
+       {"{d}/five.h5", "/input/length_change"}},
+      {"hdf5",
+       "predict --data {d}/run.h5 --params {d}/p.yaml --out {d}/pred",
+       {"{d}/run.h5", "ccsrm-dataset"}},
+      {"hdf5",
+       "predict --data {d}/processed.h5 --params {d}/run.h5 --out {d}/pred",
+       {"{d}/run.h5"}},
       {"hdf5",
        "mocap process --in {d}/exp.h5 --inputs {d}/five.h5 --out {d}/x.h5",
        {"{d}/five.h5", "/input/length_change"}},  // 5
@@ -358,6 +371,12 @@ const std::vector<BadInput>& Rows() {
       {"outputs",
        "loop --data {d}/processed.h5 --out {d}/mine",
        {"{d}/mine", "--out", "not a ccsrm loop folder"}},  // 1
+      {"outputs",
+       "predict --data {d}/processed.h5 --params {d}/p.yaml --out {d}/mine",
+       {"{d}/mine", "--out", "not a ccsrm prediction folder"}},
+      {"outputs",
+       "predict --data {d}/processed.h5 --params {d}/p.yaml --out {d}",
+       {"{d}", "--out", "holds the input"}},
       {"outputs",
        "report --in {d}/run.h5 --out {d}/mine",
        {"{d}/mine", "--out", "not a ccsrm report"}},

@@ -227,8 +227,9 @@ TEST(ReportCli, BadInputGetsOneLineAndExitStatus2) {
                      "missing.h5: no such file");
   ExpectOneLineError(
       RunCcsrm("report --in " + dir.string() + " --out " + out),
-      "not a fit or loop folder (no fit.json or loop.json); expected a ccsrm-run/1 "
-      "or ccsrm-dataset/1 file, or a folder written by ccsrm identify or ccsrm loop");
+      "not a fit, loop or prediction folder (no fit.json, loop.json or pred.json); expected a "
+      "ccsrm-run/1 or ccsrm-dataset/1 file, or a folder written by ccsrm identify, ccsrm loop or "
+      "ccsrm predict");
   fs::create_directories(dir / "fit");
   ccsrm::WriteTextFileAtomically((dir / "fit" / "fit.json").string(),
                                  "{\"schema\": \"ccsrm-run/1\"}");

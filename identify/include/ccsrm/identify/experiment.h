@@ -29,6 +29,14 @@ struct ExperimentLoadOptions {
   // flattened must not give one joint a weight thousands of times the
   // others'. Default: a tenth of the 0.03 deg floor.
   double min_noise_deg = 0.003;
+  // The arm's nominal configuration to use instead of the file's own
+  // config_yaml (`ccsrm predict --config FILE`, as `ccsrm mocap process
+  // --config` stores one): its YAML text, and the file it came from for
+  // messages. Empty (the default): the file's config_yaml. The experiment is
+  // then checked against this arm, and a file whose own config_yaml
+  // describes an arm of other joints or driving cables is refused.
+  std::string config_yaml;
+  std::string config_source;
 
   bool IsValid(std::string* error) const;
 };

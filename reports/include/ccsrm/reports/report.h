@@ -38,7 +38,7 @@ struct ReportOptions {
 struct ReportSummary {
   std::string input;   // the file reported on
   std::string output;  // the report folder
-  std::string kind;    // "run", "experiment", "fit" or "loop"
+  std::string kind;    // "run", "experiment", "fit", "loop" or "prediction"
   std::string title;
   int figures = 0;
   int tables = 0;
@@ -92,6 +92,17 @@ Document BuildFitDocument(const std::string& folder, const ReportOptions& option
 // angles file. A missing declared/, final/ or held-out file is a notice.
 Document BuildLoopDocument(const std::string& folder, const ReportOptions& options);
 
+// The page of a prediction folder written by `ccsrm predict` (pred.json of
+// schema ccsrm-prediction/1; per recording <name>.angles.csv and
+// <name>.pred.h5): measured against predicted angles and the prediction
+// error per recording, the error per joint and axis against the
+// measurement noise, the channels above it, the model's parameters and the
+// recordings. Every number as pred.json and the angles files give it.
+// Throws InputError for invalid options, "<folder>: not a prediction folder
+// (no pred.json)", a pred.json of another schema, or a missing key or
+// malformed file (naming the file and the key or line).
+Document BuildPredictionDocument(const std::string& folder, const ReportOptions& options);
+
 // Renders every figure of `document` with gnuplot into <folder>/figures,
 // then writes <folder>/index.html and <folder>/summary.json, all inside a
 // temporary folder beside the target that replaces it only when complete
@@ -105,7 +116,7 @@ void WriteReport(Document* document, const std::string& folder, const ReportOpti
 // What `ccsrm report` does: checks the options, that gnuplot is there and
 // that the output may be written (as WriteReport; and the input must not lie
 // inside it), reads `input` once (a ccsrm-run/1 or ccsrm-dataset/1 file,
-// a fit folder or a loop folder), builds its page and writes it. Throws
+// a fit, loop or prediction folder), builds its page and writes it. Throws
 // InputError naming the path for a missing input, a folder with neither
 // fit.json nor loop.json, or a file of another kind; PlotError as
 // WriteReport.

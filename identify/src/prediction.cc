@@ -1,0 +1,355 @@
+#include "ccsrm/identify/prediction.h"
+
+#include <gsl/gsl_cdf.h>
+#include <yaml-cpp/yaml.h>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/common/error.h"
+#include "ccsrm/common/yaml_document.h"
+#include "ccsrm/sim/effects.h"
+#include "statistics.h"
+
+namespace ccsrm::identify {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr double kDeg = 180.0 / M_PI;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* kFitSchema = "ccsrm-fit/1";
+constexpr const char* kLoopSchema = "ccsrm-loop/1";
+
+// The parsed JSON of `path`, or nullopt when it is YAML. A file named
+// *.json must be JSON; another is JSON when it parses as JSON (YAML's flow
+// mappings also start with '{').
+std::optional<json> ParseJsonFile(const std::string& path, const std::string& text) {
+  json parsed = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (!parsed.is_discarded() && parsed.is_object()) return parsed;
+  if (fs::path(path).extension() == ".json") {
+    ThrowInputError(path, "", "is not a JSON object (expected a fit.json, ccsrm-fit/1)");
+  }
+  return std::nullopt;
+}
+
+std::string SchemaOf(const json& j) {
+  return j.is_object() && j.contains("schema") && j["schema"].is_string()
+             ? j["schema"].get<std::string>()
+             : std::string();
+}
+
+// A fit.json (ccsrm-fit/1): every parameter's value, the free ones, the arm.
+PredictionModel ModelFromFit(const json& fit, const std::string& path) {
+  PredictionModel model;
+  model.source = path;
+  model.kind = kFitSchema;
+  if (!fit.contains("parameters") || !fit["parameters"].is_object() || fit["parameters"].empty()) {
+    ThrowInputError(path, "key 'parameters'", "missing or not a mapping of parameter names");
+  }
+  for (const auto& [name, entry] : fit["parameters"].items()) {
+    const std::string at = "key 'parameters." + name + "'";
+    // FindParameter's message names the known parameters.
+    const sim::ParameterInfo& info = sim::FindParameter(name, path + ": " + at);
+    if (!entry.is_object() || !entry.contains("value") || !entry["value"].is_number()) {
+      ThrowInputError(path, at + ".value", "missing or not a number");
+    }
+    const double value = entry["value"].get<double>();
+    const std::string problem = sim::ParameterValueProblem(info, value);
+    if (!problem.empty()) ThrowInputError(path, at + ".value", problem);
+    model.values[name] = value;
+  }
+  if (fit.contains("free") && fit["free"].is_array()) {
+    for (const json& name : fit["free"]) {
+      if (name.is_string()) model.free.push_back(name.get<std::string>());
+    }
+  }
+  // The arm: recorded by fits since issue 25; before, only the number of
+  // joints of the error table tells it.
+  if (fit.contains("arm") && fit["arm"].is_object()) {
+    const json& arm = fit["arm"];
+    if (!arm.contains("joints") || !arm["joints"].is_number_integer() ||
+        !arm.contains("driving_cables") || !arm["driving_cables"].is_number_integer()) {
+      ThrowInputError(path, "key 'arm'", "expected {joints, driving_cables} (integers)");
+    }
+    model.arm = sim::ArmSize{arm["joints"].get<int>(), arm["driving_cables"].get<int>()};
+  } else if (fit.contains("errors") && fit["errors"].is_object() &&
+             fit["errors"].contains("per_joint") && fit["errors"]["per_joint"].is_array()) {
+    model.arm = sim::ArmSize{static_cast<int>(fit["errors"]["per_joint"].size()), 0};
+  }
+  return model;
+}
+
+PredictionModel LoadFitJson(const std::string& path) {
+  const std::string text = ReadTextFile(path);
+  const std::optional<json> parsed = ParseJsonFile(path, text);
+  if (!parsed) ThrowInputError(path, "", "is not JSON: expected a fit.json (ccsrm-fit/1)");
+  const std::string schema = SchemaOf(*parsed);
+  if (schema != kFitSchema) {
+    ThrowInputError(path, "key 'schema'",
+                    "is '" + schema + "', expected " + kFitSchema +
+                        " (the fit.json of ccsrm identify, or final/fit.json of ccsrm loop)");
+  }
+  return ModelFromFit(*parsed, path);
+}
+
+}  // namespace
+
+PredictionModel LoadPredictionModel(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    const fs::path folder(path);
+    if (fs::is_regular_file(folder / "fit.json", ec))
+      return LoadFitJson((folder / "fit.json").string());
+    if (fs::is_regular_file(folder / "loop.json", ec)) {
+      return LoadFitJson((folder / "final" / "fit.json").string());
+    }
+    ThrowInputError(path, "",
+                    "is a folder holding neither fit.json (ccsrm identify) nor loop.json (ccsrm "
+                    "loop)");
+  }
+  const std::string text = ReadTextFile(path);
+  if (const std::optional<json> parsed = ParseJsonFile(path, text)) {
+    const std::string schema = SchemaOf(*parsed);
+    if (schema == kLoopSchema) {
+      // The loop's final model is the fit folder beside its loop.json.
+      return LoadFitJson((fs::path(path).parent_path() / "final" / "fit.json").string());
+    }
+    if (schema != kFitSchema) {
+      ThrowInputError(path, "key 'schema'",
+                      "is '" + schema + "', expected " + kFitSchema + " or " + kLoopSchema);
+    }
+    return ModelFromFit(*parsed, path);
+  }
+  // A parameter file, read by the one reader of identify's --params.
+  IdentificationOptions read;
+  read.values.clear();
+  ApplyParameterFile(text, path, &read);
+  PredictionModel model;
+  model.source = path;
+  model.kind = "parameter file";
+  model.values = read.values;
+  if (model.values.empty()) ThrowInputError(path, "", "gives no parameter value");
+  // A truth file's effects are part of the model it describes.
+  const YAML::Node root = ParseYamlDocument(text, path);
+  if (root.IsMap() && root["parameters"] && root["effects"] && root["effects"].IsMap() &&
+      root["effects"].size() > 0) {
+    model.effects.push_back({text, path});
+  }
+  return model;
+}
+
+bool PredictionOptions::IsValid(std::string* error) const {
+  if (threads < 1) {
+    *error = "threads must be >= 1";
+    return false;
+  }
+  if (!(above_noise_ratio > 0.0) || !std::isfinite(above_noise_ratio)) {
+    *error = "above_noise_ratio must be > 0";
+    return false;
+  }
+  if (!(significance > 0.0 && significance < 1.0)) {
+    *error = "significance must be in (0, 1)";
+    return false;
+  }
+  return true;
+}
+
+PredictionErrors ComputePredictionErrors(const std::vector<const Experiment*>& recordings,
+                                         const std::vector<const Eigen::MatrixXd*>& predicted) {
+  CCSRM_CHECK(!recordings.empty() && recordings.size() == predicted.size());
+  PredictionErrors out;
+  out.channels = AngleErrors(recordings, predicted);
+  const int joints = recordings.front()->joints;
+  out.max_abs_deg.assign(static_cast<std::size_t>(joints), {0.0, 0.0});
+  out.noise_deg.assign(static_cast<std::size_t>(joints), 0.0);
+  std::vector<int> counted(static_cast<std::size_t>(joints), 0);
+  double weighted_sq = 0.0;
+  std::size_t samples = 0;
+  for (std::size_t e = 0; e < recordings.size(); ++e) {
+    const Experiment& x = *recordings[e];
+    CCSRM_CHECK(x.joints == joints && predicted[e]->rows() == x.measured_rad.rows() &&
+                predicted[e]->cols() == x.measured_rad.cols());
+    for (int j = 0; j < joints; ++j) {
+      const std::size_t jj = static_cast<std::size_t>(j);
+      out.noise_deg[jj] += x.noise_deg[jj];
+      ++counted[jj];
+      for (int a = 0; a < 2; ++a) {
+        for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
+          const double m = x.measured_rad(f, 2 * j + a);
+          if (!std::isfinite(m)) continue;
+          // A run that ended early leaves NaN: the error is then unknown.
+          const double d = ((*predicted[e])(f, 2 * j + a) - m) * kDeg;
+          double& largest = out.max_abs_deg[jj][static_cast<std::size_t>(a)];
+          if (!std::isfinite(d)) {
+            largest = kNaN;
+          } else if (std::isfinite(largest)) {
+            largest = std::max(largest, std::abs(d));
+          }
+          const double r = d / x.noise_deg[jj];  // identification's residual
+          weighted_sq += r * r;
+          ++samples;
+        }
+      }
+    }
+  }
+  out.max_abs_deg_overall = 0.0;
+  for (int j = 0; j < joints; ++j) {
+    const std::size_t jj = static_cast<std::size_t>(j);
+    if (counted[jj] > 0) out.noise_deg[jj] /= counted[jj];
+    for (int a = 0; a < 2; ++a) {
+      const double v = out.max_abs_deg[jj][static_cast<std::size_t>(a)];
+      if (out.channels.samples[jj][static_cast<std::size_t>(a)] == 0) {
+        out.max_abs_deg[jj][static_cast<std::size_t>(a)] = kNaN;
+      } else if (!std::isfinite(v) || !std::isfinite(out.max_abs_deg_overall)) {
+        out.max_abs_deg_overall = kNaN;
+      } else {
+        out.max_abs_deg_overall = std::max(out.max_abs_deg_overall, v);
+      }
+    }
+  }
+  out.weighted_rms = samples > 0 ? std::sqrt(weighted_sq / static_cast<double>(samples)) : kNaN;
+  return out;
+}
+
+PredictionSummary Predict(const std::vector<Experiment>& recordings, const PredictionModel& model,
+                          const PredictionOptions& options) {
+  const auto clock_start = std::chrono::steady_clock::now();
+  std::string error;
+  if (!options.IsValid(&error)) ThrowInputError("prediction", "options", error);
+  if (recordings.empty()) ThrowInputError("prediction", "recordings", "none given");
+
+  // Every recording's parameters, checked before the first simulation: its
+  // nominal configuration with the model's values (and effects) set over it.
+  std::vector<sim::ArmParameters> parameters;
+  for (const Experiment& x : recordings) {
+    sim::ArmParameters p = x.config.parameters;
+    if (model.arm) {
+      const bool joints_differ = model.arm->joints != p.arm.joints;
+      const bool cables_differ = model.arm->cables != 0 && model.arm->cables != p.arm.cables;
+      if (joints_differ || cables_differ) {
+        const std::string cables =
+            model.arm->cables != 0 ? " and " + std::to_string(model.arm->cables) + " driving cables"
+                                   : "";
+        ThrowInputError(x.path, "arm",
+                        "has " + std::to_string(p.arm.joints) + " joints and " +
+                            std::to_string(p.arm.cables) + " driving cables, but " + model.source +
+                            " was fitted on an arm of " + std::to_string(model.arm->joints) +
+                            " joints" + cables);
+      }
+    }
+    for (const auto& [name, value] : model.values) {
+      sim::SetParameter(name, value, model.source + ", on the arm of " + x.path, &p);
+    }
+    for (const PredictionModel::Effects& e : model.effects)
+      sim::ApplyEffectsYaml(e.yaml, e.file, &p);
+    if (!p.IsValid(&error)) ThrowInputError(model.source, "parameters", error);
+    parameters.push_back(std::move(p));
+  }
+  for (const Experiment& x : recordings) {
+    if (x.joints != recordings.front().joints) {
+      ThrowInputError(x.path, "joints",
+                      "the recordings' arms differ (" + std::to_string(x.joints) + " against " +
+                          std::to_string(recordings.front().joints) + " joints of " +
+                          recordings.front().path + ")");
+    }
+  }
+
+  std::unique_ptr<SimulationBackend> own_backend;
+  SimulationBackend* backend = options.backend.get();
+  if (backend == nullptr) {
+    own_backend = MakeThreadBackend(&recordings, options.threads);
+    backend = own_backend.get();
+  }
+  std::vector<RunRequest> requests;
+  for (std::size_t e = 0; e < recordings.size(); ++e) {
+    requests.push_back({e, parameters[e], /*keep_trajectory=*/true, {}});
+  }
+  std::vector<RunResult> results = backend->RunBatch(requests, options.on_run);
+
+  PredictionSummary summary;
+  summary.model = model;
+  summary.effects = parameters.front().EnabledEffects();
+  summary.threads = backend->parallelism();
+  summary.simulations = static_cast<std::int64_t>(requests.size());
+  summary.above_noise_ratio = options.above_noise_ratio;
+  std::vector<const Experiment*> all;
+  std::vector<const Eigen::MatrixXd*> predicted;
+  for (std::size_t e = 0; e < recordings.size(); ++e) {
+    const Experiment& x = recordings[e];
+    RecordingPrediction r;
+    r.name = x.name;
+    r.path = x.path;
+    r.angles_from_pipeline = x.angles_from_pipeline;
+    r.noise_source = x.noise_source;
+    r.parameters = parameters[e];
+    r.run.summary = results[e].summary;
+    r.run.trajectory = std::move(results[e].trajectory);
+    r.predicted_rad = std::move(results[e].angles_rad);
+    if (!r.run.summary.completed() && summary.completed) {
+      summary.completed = false;
+      summary.message = x.name + ": " + r.run.summary.message;
+    }
+    summary.recordings.push_back(std::move(r));
+  }
+  // Every channel's weighted residual, its size and whether it is noise.
+  struct Channel {
+    ChannelAboveNoise c;
+    bool large = false;
+  };
+  std::vector<Channel> channels;
+  for (std::size_t e = 0; e < recordings.size(); ++e) {
+    RecordingPrediction& r = summary.recordings[e];
+    const Experiment& x = recordings[e];
+    r.errors = ComputePredictionErrors({&x}, {&r.predicted_rad});
+    all.push_back(&x);
+    predicted.push_back(&r.predicted_rad);
+    for (int j = 0; j < x.joints; ++j) {
+      const std::size_t jj = static_cast<std::size_t>(j);
+      for (int a = 0; a < 2; ++a) {
+        std::vector<double> weighted;
+        double sum = 0.0;
+        for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
+          const double m = x.measured_rad(f, 2 * j + a);
+          if (!std::isfinite(m)) continue;
+          const double w = (r.predicted_rad(f, 2 * j + a) - m) * kDeg / x.noise_deg[jj];
+          weighted.push_back(w);
+          sum += w * w;
+        }
+        if (weighted.empty()) continue;
+        Channel ch;
+        ch.c.recording = r.name;
+        ch.c.joint = j + 1;
+        ch.c.axis = a;
+        ch.c.rms_deg = r.errors.channels.rms_deg[jj][static_cast<std::size_t>(a)];
+        ch.c.noise_deg = x.noise_deg[jj];
+        const double n = static_cast<double>(weighted.size());
+        ch.c.effective_samples = internal::EffectiveSampleSize({weighted});
+        // A run that ended early leaves NaN: never noise.
+        ch.c.p_value = std::isfinite(sum) ? gsl_cdf_chisq_Q(sum * ch.c.effective_samples / n,
+                                                            ch.c.effective_samples)
+                                          : 0.0;
+        ch.large = !(ch.c.rms_deg <= options.above_noise_ratio * ch.c.noise_deg);
+        channels.push_back(ch);
+      }
+    }
+  }
+  summary.significance = options.significance;
+  summary.channels = channels.size();
+  for (const Channel& ch : channels) {
+    if (ch.large && ch.c.p_value < options.significance / static_cast<double>(channels.size())) {
+      summary.above_noise.push_back(ch.c);
+    }
+  }
+  summary.errors = ComputePredictionErrors(all, predicted);
+  if (summary.completed) summary.message = "every run completed";
+  summary.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+  return summary;
+}
+
+}  // namespace ccsrm::identify

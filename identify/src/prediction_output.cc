@@ -1,0 +1,244 @@
+// The prediction summary as text, JSON (ccsrm-prediction/1) and a folder.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "angles_table.h"
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/common/error.h"
+#include "ccsrm/datasets/run_file.h"
+#include "ccsrm/identify/prediction.h"
+#include "ccsrm/sim_io/run_file.h"
+
+namespace ccsrm::identify {
+namespace {
+
+constexpr double kDeg = 180.0 / M_PI;
+
+std::string Format(const char* format, double value) {
+  if (!std::isfinite(value)) return "-";
+  char text[64];
+  std::snprintf(text, sizeof(text), format, value);
+  return text;
+}
+
+// JSON has no NaN: unknown numbers are null.
+nlohmann::json Number(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
+}
+
+nlohmann::json Pair(const std::array<double, 2>& v) { return {Number(v[0]), Number(v[1])}; }
+
+nlohmann::json ErrorsJson(const PredictionErrors& e) {
+  const ChannelErrors& c = e.channels;
+  nlohmann::json joints = nlohmann::json::array();
+  for (std::size_t j = 0; j < c.rms_deg.size(); ++j) {
+    const double noise = e.noise_deg[j];
+    joints.push_back(
+        {{"joint", j + 1},
+         {"rms_deg", Pair(c.rms_deg[j])},
+         {"max_abs_deg", Pair(e.max_abs_deg[j])},
+         {"noise_deg", Number(noise)},
+         {"rms_over_noise", {Number(c.rms_deg[j][0] / noise), Number(c.rms_deg[j][1] / noise)}},
+         {"fit_percent", Pair(c.fit_percent[j])},
+         {"motion_rms_deg", Pair(c.motion_rms_deg[j])},
+         {"samples", {c.samples[j][0], c.samples[j][1]}}});
+  }
+  return {{"rms_deg", Number(c.rms_deg_overall)},
+          {"max_abs_deg", Number(e.max_abs_deg_overall)},
+          {"weighted_rms", Number(e.weighted_rms)},
+          {"fit_percent", Number(c.fit_percent_overall)},
+          {"per_joint", joints},
+          {"axes", {"theta_x", "theta_y"}}};
+}
+
+std::string EffectList(const std::vector<std::string>& effects) {
+  std::string out;
+  for (const std::string& e : effects) out += (out.empty() ? "" : ", ") + e;
+  return out.empty() ? "none" : out;
+}
+
+}  // namespace
+
+std::string PredictionSummary::BriefReport() const {
+  char text[640];
+  std::snprintf(text, sizeof(text),
+                "prediction of %zu recording%s with %s (effects: %s): RMS %s deg, max %s deg, "
+                "weighted RMS %s (1 = the noise floor); %zu of %zu channels above the noise%s",
+                recordings.size(), recordings.size() == 1 ? "" : "s", model.source.c_str(),
+                EffectList(effects).c_str(),
+                Format("%.4f", errors.channels.rms_deg_overall).c_str(),
+                Format("%.4f", errors.max_abs_deg_overall).c_str(),
+                Format("%.3f", errors.weighted_rms).c_str(), above_noise.size(), channels,
+                completed ? "" : (" (a run did not complete: " + message + ")").c_str());
+  return text;
+}
+
+std::string PredictionSummary::FullReport() const {
+  std::ostringstream out;
+  out << BriefReport() << "\n";
+  out << "  model: " << model.source << " (" << model.kind << "), " << model.values.size()
+      << " parameter values";
+  if (!model.free.empty()) {
+    out << ", fitted:";
+    for (const std::string& name : model.free) out << " " << name;
+  }
+  for (const PredictionModel::Effects& e : model.effects) out << "; effects from " << e.file;
+  out << "\n  " << simulations << " simulations on " << threads << " thread"
+      << (threads == 1 ? "" : "s") << ", " << Format("%.1f", wall_time_s) << " s\n\n";
+  out << "  joint   RMS θx [deg]   RMS θy [deg]   max θx [deg]   max θy [deg]   noise [deg]   "
+         "RMS/noise θx  RMS/noise θy\n";
+  const PredictionErrors& e = errors;
+  for (std::size_t j = 0; j < e.channels.rms_deg.size(); ++j) {
+    char line[256];
+    std::snprintf(line, sizeof(line), "  %5zu   %-14s %-14s %-14s %-14s %-13s %-13s %s\n", j + 1,
+                  Format("%.4f", e.channels.rms_deg[j][0]).c_str(),
+                  Format("%.4f", e.channels.rms_deg[j][1]).c_str(),
+                  Format("%.4f", e.max_abs_deg[j][0]).c_str(),
+                  Format("%.4f", e.max_abs_deg[j][1]).c_str(),
+                  Format("%.4f", e.noise_deg[j]).c_str(),
+                  Format("%.2f", e.channels.rms_deg[j][0] / e.noise_deg[j]).c_str(),
+                  Format("%.2f", e.channels.rms_deg[j][1] / e.noise_deg[j]).c_str());
+    out << line;
+  }
+  out << "\n";
+  for (const RecordingPrediction& r : recordings) {
+    double noise = 0.0;
+    for (double s : r.errors.noise_deg) noise += s / static_cast<double>(r.errors.noise_deg.size());
+    out << "  " << r.name << ": RMS " << Format("%.4f", r.errors.channels.rms_deg_overall)
+        << " deg, max " << Format("%.4f", r.errors.max_abs_deg_overall) << " deg, weighted RMS "
+        << Format("%.3f", r.errors.weighted_rms) << ", noise " << Format("%.4f", noise) << " deg ("
+        << r.noise_source << ")"
+        << (r.angles_from_pipeline ? ", angles from the mocap pipeline" : "")
+        << (r.run.summary.completed() ? "" : ", run: " + r.run.summary.message) << "\n";
+  }
+  char rule[200];
+  std::snprintf(rule, sizeof(rule),
+                "RMS above %.3g times its noise, and beyond chance: p < %.3g over the %zu channels",
+                above_noise_ratio, significance, channels);
+  if (above_noise.empty()) {
+    out << "  no channel stands above the noise (" << rule
+        << "): the model predicts these recordings to the noise floor\n";
+  } else {
+    out << "  above the noise (" << rule << "):";
+    for (std::size_t k = 0; k < above_noise.size(); ++k) {
+      const ChannelAboveNoise& c = above_noise[k];
+      if (k == 16) {
+        out << " ... and " << above_noise.size() - 16 << " more";
+        break;
+      }
+      out << (k == 0 ? " " : "; ") << c.recording << " joint " << c.joint
+          << (c.axis == 0 ? " θx " : " θy ") << Format("%.4f", c.rms_deg) << " deg ("
+          << Format("%.1f", c.rms_deg / c.noise_deg) << "x)";
+    }
+    out << "\n";
+  }
+  return out.str();
+}
+
+nlohmann::json ToJson(const PredictionSummary& s) {
+  nlohmann::json values = nlohmann::json::object();
+  for (const auto& [name, value] : s.model.values) values[name] = value;
+  nlohmann::json recordings = nlohmann::json::array();
+  for (const RecordingPrediction& r : s.recordings) {
+    recordings.push_back({{"name", r.name},
+                          {"path", r.path},
+                          {"angles_from_pipeline", r.angles_from_pipeline},
+                          {"noise_deg", r.errors.noise_deg},
+                          {"noise_source", r.noise_source},
+                          {"errors", ErrorsJson(r.errors)},
+                          {"run",
+                           {{"status", r.run.summary.completed() ? "completed" : "failed"},
+                            {"message", r.run.summary.message},
+                            {"wall_time_s", r.run.summary.wall_time_s},
+                            {"real_time_factor", r.run.summary.real_time_factor}}}});
+  }
+  nlohmann::json effects_files = nlohmann::json::array();
+  for (const PredictionModel::Effects& e : s.model.effects) effects_files.push_back(e.file);
+  nlohmann::json above = nlohmann::json::array();
+  for (const ChannelAboveNoise& c : s.above_noise) {
+    above.push_back({{"recording", c.recording},
+                     {"joint", c.joint},
+                     {"axis", c.axis == 0 ? "x" : "y"},
+                     {"rms_deg", Number(c.rms_deg)},
+                     {"noise_deg", Number(c.noise_deg)},
+                     {"effective_samples", Number(c.effective_samples)},
+                     {"p_value", Number(c.p_value)}});
+  }
+  return {{"schema", "ccsrm-prediction/1"},
+          {"model",
+           {{"source", s.model.source},
+            {"kind", s.model.kind},
+            {"free", s.model.free},
+            {"values", values},
+            {"effects_files", effects_files}}},
+          {"effects", s.effects},
+          {"completed", s.completed},
+          {"message", s.message},
+          {"rms_deg", Number(s.errors.channels.rms_deg_overall)},
+          {"max_abs_deg", Number(s.errors.max_abs_deg_overall)},
+          {"weighted_rms", Number(s.errors.weighted_rms)},
+          {"errors", ErrorsJson(s.errors)},
+          {"above_noise_ratio", s.above_noise_ratio},
+          {"significance", s.significance},
+          {"channels", s.channels},
+          {"above_noise", above},
+          {"threads", s.threads},
+          {"simulations", s.simulations},
+          {"wall_time_s", Number(s.wall_time_s)},
+          {"recordings", recordings}};
+}
+
+std::vector<std::string> WritePredictionDirectory(const PredictionSummary& summary,
+                                                  const std::vector<Experiment>& recordings,
+                                                  const std::string& directory) {
+  CCSRM_CHECK(summary.recordings.size() == recordings.size());
+  namespace fs = std::filesystem;
+  AtomicOutputDirectory out(directory);
+  const fs::path tmp(out.temp_path());
+  std::vector<std::string> written;
+  std::vector<std::string> names;
+  for (const RecordingPrediction& r : summary.recordings) names.push_back(r.name);
+  const std::vector<std::string> stems = internal::OutputStems(names);
+  nlohmann::json json = ToJson(summary);
+  for (std::size_t e = 0; e < recordings.size(); ++e) {
+    const RecordingPrediction& r = summary.recordings[e];
+    const Experiment& x = recordings[e];
+    json["recordings"][e]["run_file"] = stems[e] + ".pred.h5";
+    json["recordings"][e]["angles_file"] = stems[e] + ".angles.csv";
+    if (r.run.trajectory.size() > 0) {
+      sim::Config config = x.config;
+      config.parameters = r.parameters;
+      const datasets::RunFile run =
+          sim_io::ToRunFile(*x.model, r.run, {"custom", sim::ToYaml(config)});
+      datasets::WriteRunFile((tmp / (stems[e] + ".pred.h5")).string(), run);
+      written.push_back((fs::path(directory) / (stems[e] + ".pred.h5")).string());
+    } else {
+      json["recordings"][e]["run_file"] = nullptr;
+    }
+    const auto measured = [&x](Eigen::Index f, Eigen::Index c) {
+      return x.measured_rad(f, c) * kDeg;
+    };
+    const auto predicted = [&r](Eigen::Index f, Eigen::Index c) {
+      return r.predicted_rad.rows() > f ? r.predicted_rad(f, c) * kDeg : NAN;
+    };
+    const std::string csv = internal::AnglesCsvText(
+        r.name +
+            ": measured and predicted joint angles [deg] at the measured frames; residual = "
+            "predicted - measured; empty where not measured",
+        x.frame_time_s, x.joints,
+        {{"measured", measured},
+         {"predicted", predicted},
+         {"residual",
+          [&](Eigen::Index f, Eigen::Index c) { return predicted(f, c) - measured(f, c); }}});
+    WriteTextFileAtomically((tmp / (stems[e] + ".angles.csv")).string(), csv);
+    written.push_back((fs::path(directory) / (stems[e] + ".angles.csv")).string());
+  }
+  WriteTextFileAtomically((tmp / "pred.json").string(), json.dump(2) + "\n");
+  written.insert(written.begin(), (fs::path(directory) / "pred.json").string());
+  out.Commit();
+  return written;
+}
+
+}  // namespace ccsrm::identify
