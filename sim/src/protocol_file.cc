@@ -141,9 +141,10 @@ class ProtocolReader {
   }
 
   void ReadParameters(const YAML::Node& node) {
-    if (!node.IsDefined()) return;
-    if (!node.IsMap()) Fail(node, "parameters", "expected a mapping of name: number");
-    for (const auto& entry : node) {
+    if (node.IsDefined() && !node.IsMap()) {
+      Fail(node, "parameters", "expected a mapping of name: number");
+    }
+    for (const auto& entry : node.IsDefined() ? node : YAML::Node(YAML::NodeType::Map)) {
       const std::string name = entry.first.Scalar();
       const std::string key = "parameters." + name;
       if (!KnownUnit(UnitOf(name))) {
