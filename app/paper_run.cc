@@ -22,8 +22,10 @@ void AddPaperRunOptions(CLI::App* command, sim::PaperRunOptions* args) {
                    "connecting cables only (default: friction as configured)")
       ->check(CLI::Range(1, 4));
   command
-      ->add_option("--amplitude", args->amplitude_deg,
-                   "Planned joint amplitude [deg] (default: protocol.amplitude_deg)")
+      ->add_option(
+          "--amplitude", args->amplitude_deg,
+          "Planned joint amplitude [deg]: the paper protocol's (default: protocol.amplitude_deg), "
+          "or a --protocol file's amplitude_deg parameter")
       ->check(InRange(-60.0, 60.0, "deg"));  // protocol.amplitude_deg
   command
       ->add_option("--duration", args->duration_s,
