@@ -24,8 +24,7 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 const std::string kPaper = std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml";
-const std::string kPaperProtocol =
-    std::string(CCSRM_SOURCE_DIR) + "/configs/protocols/paper.yaml";
+const std::string kPaperProtocol = std::string(CCSRM_SOURCE_DIR) + "/configs/protocols/paper.yaml";
 
 // The default test run's version checks the same claims on a protocol three
 // times faster (6 s ramps, 16 s in all). The arm then rings by about 0.1 deg
