@@ -37,6 +37,7 @@ namespace fs = std::filesystem;
 
 struct GenerateArgs {
   sim::PaperRunOptions run;  // its named parameters are the truth
+  MotionArgs motion;
   double noise_mm = 0.2;
   double resolution_mm = 0.0;
   std::uint64_t seed = 1;
@@ -115,8 +116,18 @@ std::string OutputStem(const std::string& out) {
   return out.substr(0, out.size() - suffix.size());
 }
 
-std::string TruthYaml(const GenerateArgs& a, const sim::Config& truth, double duration_s,
-                      const mocap::VirtualRecordingOptions& recording,
+// The planned amplitude [deg] of the run's protocol: the configuration's
+// for the paper protocol by default, a protocol file's amplitude_deg
+// parameter, NaN when there is none (another protocol, recorded inputs).
+double PlannedAmplitudeDeg(const sim::PaperRun& run, const sim::Config& truth) {
+  if (run.default_protocol) return truth.protocol.amplitude_rad * 180.0 / M_PI;
+  if (!run.protocol) return NAN;
+  const auto it = run.protocol->parameters.find("amplitude_deg");
+  return it == run.protocol->parameters.end() ? NAN : it->second * 180.0 / M_PI;
+}
+
+std::string TruthYaml(const GenerateArgs& a, const sim::PaperRun& run, const sim::Config& truth,
+                      double duration_s, const mocap::VirtualRecordingOptions& recording,
                       const mocap::VirtualExperiment& generated) {
   YAML::Emitter out;
   out.SetDoublePrecision(12);  // 0.05, not 0.050000000000000003
@@ -129,7 +140,16 @@ std::string TruthYaml(const GenerateArgs& a, const sim::Config& truth, double du
   out << YAML::Key << "case" << YAML::Value
       << (a.run.case_number != 0 ? std::to_string(a.run.case_number)
                                  : std::string("as configured"));
-  out << YAML::Key << "amplitude_deg" << YAML::Value << truth.protocol.amplitude_rad * 180.0 / M_PI;
+  const double amplitude_deg = PlannedAmplitudeDeg(run, truth);
+  if (!std::isnan(amplitude_deg)) {
+    out << YAML::Key << "amplitude_deg" << YAML::Value << amplitude_deg;
+  }
+  if (!run.default_protocol && run.protocol) {
+    out << YAML::Key << "protocol" << YAML::Value << run.protocol->source_name;
+  }
+  if (!run.inputs_source.empty()) {
+    out << YAML::Key << "inputs" << YAML::Value << run.inputs_source;
+  }
   out << YAML::Key << "duration_s" << YAML::Value << duration_s;
   out << YAML::Key << "seed" << YAML::Value << a.seed;
   out << YAML::Key << "parameters" << YAML::Comment("true values, SPEC 6 names");
@@ -170,6 +190,18 @@ std::string TruthYaml(const GenerateArgs& a, const sim::Config& truth, double du
   return std::string(out.c_str()) + "\n";
 }
 
+// "amplitude 6 deg" (the paper protocol), "protocol 'two-axis'", or
+// "recorded inputs from FILE".
+std::string MotionWords(const sim::PaperRun& run, const sim::Config& truth) {
+  char text[64];
+  if (run.default_protocol) {
+    std::snprintf(text, sizeof(text), "amplitude %.4g deg", PlannedAmplitudeDeg(run, truth));
+    return text;
+  }
+  if (run.protocol) return "protocol '" + run.protocol->name + "'";
+  return "recorded inputs from " + run.inputs_source;
+}
+
 int RunGenerate(const GenerateArgs& a) {
   if (a.list_effects) {
     ListEffects(a.json, a.run.config_path);
@@ -180,7 +212,8 @@ int RunGenerate(const GenerateArgs& a) {
   const std::string truth_yaml_path = stem + ".truth.yaml";
   const std::string truth_h5_path = stem + ".truth.h5";
   // Check the output paths before spending minutes on the run.
-  const std::vector<std::string> inputs = {a.run.config_path, a.run.params_path, a.effects_path};
+  const std::vector<std::string> inputs = {a.run.config_path, a.run.params_path, a.effects_path,
+                                           a.run.protocol_path, a.motion.inputs_path};
   CheckOut(a.out, ExperimentFileOutput(), inputs);
   CheckOut(truth_yaml_path, YamlFileOutput("ccsrm-truth/1", "ccsrm truth file"), inputs);
   CheckOut(truth_h5_path, RunFileOutput(), inputs);
@@ -191,7 +224,7 @@ int RunGenerate(const GenerateArgs& a) {
   // The nominal configuration goes into the experiment as given; the truth
   // is that configuration with the case, amplitude and parameters applied.
   // Effects join the truth only.
-  const sim::PaperRun run = sim::PreparePaperRun(a.run);
+  const sim::PaperRun run = PrepareRun(a.run, a.motion);
   PrintConfigWarnings(run.config);
   sim::Config truth = run.config;
   if (!a.effects_path.empty()) {
@@ -249,18 +282,17 @@ int RunGenerate(const GenerateArgs& a) {
   }
   // Wall time is the one thing a rerun changes: keep it out of the truth file
   // so that the same seed gives the same files (it is printed below).
-  datasets::RunFile truth_run =
-      sim_io::ToRunFile(run.model, result, {case_name, sim::ToYaml(truth)});
+  datasets::RunFile truth_run = sim_io::ToRunFile(
+      run.model, result, {case_name, sim::ToYaml(truth), ProtocolYamlOf(run), run.inputs_source});
   const double wall_time_s = truth_run.wall_time_s;
   truth_run.wall_time_s = 0.0;
 
   char description[512];
   std::snprintf(description, sizeof(description),
-                "generated by ccsrm generate: case %s, amplitude %.4g deg, %.4g s, marker noise "
+                "generated by ccsrm generate: case %s, %s, %.4g s, marker noise "
                 "%.3g mm, occlusions %s, seed %llu",
-                case_name.c_str(), truth.protocol.amplitude_rad * 180.0 / M_PI, duration,
-                a.noise_mm, a.no_occlusions ? "off" : "on",
-                static_cast<unsigned long long>(a.seed));
+                case_name.c_str(), MotionWords(run, truth).c_str(), duration, a.noise_mm,
+                a.no_occlusions ? "off" : "on", static_cast<unsigned long long>(a.seed));
   options.description = description;
   // Motion capture sees the links as the measurement effects (mocap_offset)
   // make them look; the truth keeps the physical run.
@@ -287,10 +319,12 @@ int RunGenerate(const GenerateArgs& a) {
     }
   }
 
+  generated.experiment.protocol_yaml = ProtocolYamlOf(run);
+  generated.experiment.inputs_file = run.inputs_source;
   datasets::WriteExperimentFile(a.out, generated.experiment);
   datasets::WriteRunFile(truth_h5_path, generated.truth);
   WriteTextFileAtomically(truth_yaml_path,
-                          TruthYaml(a, truth, duration, options.recording, generated));
+                          TruthYaml(a, run, truth, duration, options.recording, generated));
 
   std::printf("%s", sim::DescribeRun(run).c_str());
   std::printf("simulated %.4g s (case %s) in %.2f s wall\n", duration, case_name.c_str(),
@@ -319,6 +353,7 @@ void AddGenerateCommand(CLI::App& root) {
   auto a = std::make_shared<GenerateArgs>();
   AddPaperRunOptions(cmd, &a->run);
   AddParameterOptions(cmd, &a->run);
+  AddMotionOptions(cmd, &a->run, &a->motion);
   cmd->add_option("--noise-mm", a->noise_mm, "Marker noise, standard deviation [mm]")
       ->capture_default_str();
   cmd->add_option("--resolution-mm", a->resolution_mm,

@@ -22,14 +22,16 @@ namespace {
 
 struct SimulateArgs {
   sim::PaperRunOptions run;
+  MotionArgs motion;
   std::string out;
   bool quiet = false;
 };
 
 int RunSimulate(const SimulateArgs& a) {
   // Check the output path before spending minutes on the run.
-  CheckOut(a.out, RunFileOutput(), {a.run.config_path, a.run.params_path});
-  const sim::PaperRun run = sim::PreparePaperRun(a.run);
+  CheckOut(a.out, RunFileOutput(),
+           {a.run.config_path, a.run.params_path, a.run.protocol_path, a.motion.inputs_path});
+  const sim::PaperRun run = PrepareRun(a.run, a.motion);
   PrintConfigWarnings(run.config);
   sim::SimulationOptions options = run.simulation;
   if (!a.quiet) {
@@ -44,8 +46,9 @@ int RunSimulate(const SimulateArgs& a) {
       sim::Simulate(run.model, run.config.parameters, run.inputs, options);
   const std::string case_name =
       a.run.case_number != 0 ? std::to_string(a.run.case_number) : "custom";
-  datasets::WriteRunFile(
-      a.out, sim_io::ToRunFile(run.model, result, {case_name, sim::ToYaml(run.config)}));
+  datasets::WriteRunFile(a.out, sim_io::ToRunFile(run.model, result,
+                                                  {case_name, sim::ToYaml(run.config),
+                                                   ProtocolYamlOf(run), run.inputs_source}));
   std::printf("%s", sim::DescribeRun(run).c_str());
   std::printf("%s", result.summary.FullReport().c_str());
   std::printf("  output:                    %s (%zu frames)\n", a.out.c_str(),
@@ -66,6 +69,7 @@ void AddSimulateCommand(CLI::App& root) {
   auto a = std::make_shared<SimulateArgs>();
   AddPaperRunOptions(cmd, &a->run);
   AddParameterOptions(cmd, &a->run);
+  AddMotionOptions(cmd, &a->run, &a->motion);
   cmd->add_option("--output-rate", a->run.output_rate_hz,
                   "Output frames per second (default: solver.output_rate_hz)");
   cmd->add_option("--out", a->out, "Output run file (.h5)")->required();

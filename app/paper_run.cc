@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "ccsrm/sim_io/recorded_inputs.h"
 #include "option_checks.h"
 
 namespace ccsrm::app {
@@ -21,8 +22,10 @@ void AddPaperRunOptions(CLI::App* command, sim::PaperRunOptions* args) {
                    "connecting cables only (default: friction as configured)")
       ->check(CLI::Range(1, 4));
   command
-      ->add_option("--amplitude", args->amplitude_deg,
-                   "Planned joint amplitude [deg] (default: protocol.amplitude_deg)")
+      ->add_option(
+          "--amplitude", args->amplitude_deg,
+          "Planned joint amplitude [deg]: the paper protocol's (default: protocol.amplitude_deg), "
+          "or a --protocol file's amplitude_deg parameter")
       ->check(InRange(-60.0, 60.0, "deg"));  // protocol.amplitude_deg
   command
       ->add_option("--duration", args->duration_s,
@@ -59,6 +62,47 @@ void AddParameterOptions(CLI::App* command, sim::PaperRunOptions* args) {
   command->add_option("--params", args->params_path,
                       "YAML file of parameter values (name: value, or a truth file's "
                       "'parameters:')");
+}
+
+void AddMotionOptions(CLI::App* command, sim::PaperRunOptions* args, MotionArgs* motion) {
+  CLI::Option* protocol = command->add_option(
+      "--protocol", args->protocol_path,
+      "Protocol file (ccsrm-protocol/1, docs/protocols.md); default: the bundled "
+      "protocols/paper.yaml with the configuration's protocol: section");
+  CLI::Option* inputs = command->add_option(
+      "--inputs", motion->inputs_path,
+      "Recorded input lengths instead of a protocol: an experiment (/input) or run file, or a "
+      "CSV/TSV table with a header (time_s or time_ms, cable1_m or cable1_mm, ...)");
+  protocol->excludes(inputs);
+  command
+      ->add_option("--inputs-time-unit", motion->time_unit,
+                   "Unit of a table's time column named just 'time'")
+      ->check(CLI::IsMember({"s", "ms"}));
+  command
+      ->add_option("--inputs-length-unit", motion->length_unit,
+                   "Unit of a table's cable columns named just 'cable<k>'")
+      ->check(CLI::IsMember({"m", "mm"}));
+  command
+      ->add_option("--max-input-gap", args->recorded_input_options.max_gap_s,
+                   "Longest interval between two recorded samples [s]; a longer gap is refused")
+      ->capture_default_str()
+      ->check(Above(0.0, "s"));
+}
+
+sim::PaperRun PrepareRun(sim::PaperRunOptions options, const MotionArgs& motion) {
+  if (!motion.inputs_path.empty()) {
+    options.recorded_input_options.time_unit = motion.time_unit;
+    options.recorded_input_options.length_unit = motion.length_unit;
+    options.recorded_inputs =
+        sim_io::ReadRecordedInputs(motion.inputs_path, options.recorded_input_options);
+  }
+  return sim::PreparePaperRun(options);
+}
+
+std::string ProtocolYamlOf(const sim::PaperRun& run) {
+  // The default (the paper protocol of the configuration's protocol:
+  // section) is recorded by config_yaml itself, as in every earlier file.
+  return run.protocol && !run.default_protocol ? run.protocol->ToYaml() : std::string();
 }
 
 void PrintConfigWarnings(const sim::Config& config) {

@@ -19,6 +19,23 @@ void AddConfigOption(CLI::App* command, std::string* config_path);
 // table of sim/parameters.h) applied after the case.
 void AddParameterOptions(CLI::App* command, sim::PaperRunOptions* options);
 
+// What drives the arm, for `simulate` and `generate`: --protocol FILE or
+// --inputs FILE (exclusive), with the units and gap limit of a table of
+// inputs.
+struct MotionArgs {
+  std::string inputs_path;  // --inputs
+  std::string time_unit;    // --inputs-time-unit
+  std::string length_unit;  // --inputs-length-unit
+};
+void AddMotionOptions(CLI::App* command, sim::PaperRunOptions* options, MotionArgs* motion);
+
+// sim::PreparePaperRun, with --inputs read first (sim_io::ReadRecordedInputs).
+sim::PaperRun PrepareRun(sim::PaperRunOptions options, const MotionArgs& motion);
+
+// What a run file or experiment records of the motion that drove it:
+// protocol_yaml (the protocol, its parameters as used) or inputs_file.
+std::string ProtocolYamlOf(const sim::PaperRun& run);
+
 // Prints the configuration's warnings (sim::Config::warnings: values far
 // outside the range of such arms) on stderr, "ccsrm: warning: ..." each.
 void PrintConfigWarnings(const sim::Config& config);

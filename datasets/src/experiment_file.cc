@@ -197,6 +197,10 @@ void WriteExperimentFile(const std::string& path, const ExperimentFile& experime
     writer.WriteStringAttribute("created",
                                 experiment.created.empty() ? UtcTimestamp() : experiment.created);
     writer.WriteStringAttribute("config_yaml", experiment.config_yaml);
+    if (!experiment.protocol_yaml.empty())
+      writer.WriteStringAttribute("protocol_yaml", experiment.protocol_yaml);
+    if (!experiment.inputs_file.empty())
+      writer.WriteStringAttribute("inputs_file", experiment.inputs_file);
     // Created explicitly so that a file without rigid bodies still has it.
     writer.CreateGroup(kRigidBodies);
     VisitArrays(experiment, [&](const std::string& dataset, const char* units, const Array& array) {
@@ -227,6 +231,11 @@ ExperimentFile ReadExperimentFile(const std::string& path) {
   experiment.source = ParseSource(reader, reader.ReadStringAttribute("source"));
   experiment.created = reader.ReadStringAttribute("created");
   experiment.config_yaml = reader.ReadStringAttribute("config_yaml");
+  // Optional: files written before protocols were recorded have neither.
+  if (reader.HasRootAttribute("protocol_yaml"))
+    experiment.protocol_yaml = reader.ReadStringAttribute("protocol_yaml");
+  if (reader.HasRootAttribute("inputs_file"))
+    experiment.inputs_file = reader.ReadStringAttribute("inputs_file");
 
   // Skeleton first (rigid bodies, optional members), then every array.
   for (const std::string& name : reader.ListGroup(kRigidBodies)) {

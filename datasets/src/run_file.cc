@@ -171,6 +171,8 @@ void WriteRunFile(const std::string& path, const RunFile& run) {
     writer.WriteStringAttribute("status", RunStatusName(run.status));
     writer.WriteStringAttribute("status_message", run.status_message);
     writer.WriteStringAttribute("config_yaml", run.config_yaml);
+    if (!run.protocol_yaml.empty()) writer.WriteStringAttribute("protocol_yaml", run.protocol_yaml);
+    if (!run.inputs_file.empty()) writer.WriteStringAttribute("inputs_file", run.inputs_file);
     writer.WriteStringAttribute("created", run.created.empty() ? UtcTimestamp() : run.created);
     writer.WriteStringAttribute("ccsrm_version", run.ccsrm_version);
     writer.WriteDoubleAttribute("wall_time_s", run.wall_time_s);
@@ -196,6 +198,11 @@ RunFile ReadRunFile(const std::string& path) {
   run.status = ParseStatus(reader, reader.ReadStringAttribute("status"));
   run.status_message = reader.ReadStringAttribute("status_message");
   run.config_yaml = reader.ReadStringAttribute("config_yaml");
+  // Optional: files written before protocols were recorded have neither.
+  if (reader.HasRootAttribute("protocol_yaml"))
+    run.protocol_yaml = reader.ReadStringAttribute("protocol_yaml");
+  if (reader.HasRootAttribute("inputs_file"))
+    run.inputs_file = reader.ReadStringAttribute("inputs_file");
   run.created = reader.ReadStringAttribute("created");
   run.ccsrm_version = reader.ReadStringAttribute("ccsrm_version");
   run.wall_time_s = reader.ReadDoubleAttribute("wall_time_s");

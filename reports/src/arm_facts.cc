@@ -29,7 +29,8 @@ void FallBack(std::size_t joints, std::size_t cables, ArmFacts* facts) {
 }  // namespace
 
 ArmFacts ReadArmFacts(const std::string& config_yaml, const std::string& source, std::size_t joints,
-                      std::size_t cables, const std::vector<double>* plan_times) {
+                      std::size_t cables, const std::vector<double>* plan_times,
+                      const std::string& protocol_yaml) {
   ArmFacts facts;
   sim::Config config;
   try {
@@ -67,10 +68,32 @@ ArmFacts ReadArmFacts(const std::string& config_yaml, const std::string& source,
   facts.arm_words = sim::DescribeArm(arm);
   facts.protocol_words = sim::DescribeProtocol(p);
   facts.paper_arm = sim::IsPaperArm(arm);
+  std::optional<sim::Protocol> protocol;
+  if (!protocol_yaml.empty()) {
+    try {
+      protocol = sim::ParseProtocol(protocol_yaml, "the stored protocol_yaml", config.arm);
+    } catch (const InputError& e) {
+      facts.protocol.reset();
+      facts.problems.push_back(std::string("The stored protocol does not parse (") + e.what() +
+                               "): no plan is drawn.");
+      return facts;
+    }
+    facts.protocol_words = sim::DescribeProtocolFile(*protocol);
+    const std::map<std::string, double>& v = protocol->parameters;
+    const bool paper_shape = v.count("amplitude_deg") && v.count("ramp_s") && v.count("hold_s") &&
+                             v.count("return_s") && v.count("rest_s");
+    if (paper_shape) {
+      facts.protocol = ProtocolPhases{v.at("amplitude_deg") * kDegPerRad, v.at("ramp_s"),
+                                      v.at("hold_s"), v.at("return_s"), v.at("rest_s")};
+    } else {
+      facts.protocol.reset();
+    }
+  }
   if (plan_times == nullptr || joints == 0) return facts;
   try {
     const sim::ArmModel model(config.arm);
-    const sim::JointTrajectory plan = sim::PaperTrajectory(model, config.protocol);
+    const sim::JointTrajectory plan =
+        protocol ? protocol->Trajectory() : sim::PaperTrajectory(model, config.protocol);
     datasets::Array angles({plan_times->size(), joints, 2});
     for (std::size_t i = 0; i < plan_times->size(); ++i) {
       const sim::JointAngles q = plan((*plan_times)[i]);

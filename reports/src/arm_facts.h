@@ -56,8 +56,14 @@ struct ArmFacts {
 // given, also plans the paper's protocol at those times (sim::ArmModel,
 // sim::PaperTrajectory). Never throws for a bad configuration: the problem
 // is reported in `problems` and the facts fall back as documented above.
+//
+// With `protocol_yaml` (a run's protocol_yaml attribute: the protocol that
+// drove it), the plan and the protocol's words come from that protocol
+// (sim::ParseProtocol on the stored arm); its phases only when it has the
+// paper protocol's five parameters (configs/protocols/paper.yaml).
 ArmFacts ReadArmFacts(const std::string& config_yaml, const std::string& source, std::size_t joints,
-                      std::size_t cables, const std::vector<double>* plan_times);
+                      std::size_t cables, const std::vector<double>* plan_times,
+                      const std::string& protocol_yaml = "");
 
 // The friction case of a run file's `case` attribute ("1".."4"), 0 for any
 // other ("custom"), and its words: "paper case 2 (friction on all cables)"

@@ -269,7 +269,7 @@ Section SummarySection(const RunFile& run, const std::string& source, const ArmF
         "This run diverged (" + run.status_message + "); the page shows the frames up to then.",
         true});
   }
-  if (!words.protocol_case) {
+  if (!words.protocol_case && run.protocol_yaml.empty()) {
     section.blocks.push_back(
         Paragraph{"The run's case is '" + run.case_name +
                       "', not one of the cases 1–4 of the protocol: the planned motion is not "
@@ -300,6 +300,26 @@ Section SummarySection(const RunFile& run, const std::string& source, const ArmF
   return section;
 }
 
+// Simulated minus planned angles, θx and θy, for a run that recorded its
+// protocol (protocol_yaml): how closely the arm followed a planned motion
+// in both axes, at a scale the angle figures cannot show.
+void AddPlanErrorFigures(const RunFile& run, const ArmFacts& facts, Section* section) {
+  datasets::Array error = run.joint_angles;
+  for (std::size_t i = 0; i < error.values.size(); ++i) error.values[i] -= facts.plan->values[i];
+  for (int axis = 0; axis < 2; ++axis) {
+    const std::string name = axis == 0 ? "θx" : "θy";
+    section->blocks.push_back(FigureBlock{
+        internal::JointAngleFigure(axis == 0 ? "plan_error_theta_x" : "plan_error_theta_y",
+                                   run.time.values, error, axis, facts.segments, std::nullopt),
+        "Error to the plan, " + name,
+        "Simulated minus planned " + name +
+            " of every joint, one panel per segment; the plan is "
+            "the run's own protocol (" +
+            facts.protocol_words + ").",
+        ""});
+  }
+}
+
 Section JointAngleSection(const RunFile& run, const ArmFacts& facts, const Words& words,
                           const std::vector<Instant>& instants) {
   Section section{"joint-angles", "Joint angles", {}};
@@ -313,14 +333,15 @@ Section JointAngleSection(const RunFile& run, const ArmFacts& facts, const Words
       "segment, joints in order from the root" +
           layout + plan,
       ""});
-  section.blocks.push_back(
-      FigureBlock{internal::JointAngleFigure("theta_y", run.time.values, run.joint_angles, 1,
-                                             facts.segments, facts.plan),
-                  "θy against time",
-                  std::string("Out-of-plane angle θy of every joint") +
-                      (words.protocol_case ? " (the protocol plans 0)" : "") +
-                      ", same layout and colours." + plan,
-                  ""});
+  section.blocks.push_back(FigureBlock{
+      internal::JointAngleFigure("theta_y", run.time.values, run.joint_angles, 1, facts.segments,
+                                 facts.plan),
+      "θy against time",
+      std::string("Out-of-plane angle θy of every joint") +
+          (words.protocol_case && run.protocol_yaml.empty() ? " (the protocol plans 0)" : "") +
+          ", same layout and colours." + plan,
+      ""});
+  if (facts.plan && !run.protocol_yaml.empty()) AddPlanErrorFigures(run, facts, &section);
   section.blocks.push_back(JointAnglesAtInstants(run, facts, instants, 0));
   section.blocks.push_back(JointAnglesAtInstants(run, facts, instants, 1));
   return section;
@@ -420,7 +441,7 @@ Section SlackSection(const RunFile& run, const ArmFacts& facts) {
       std::string(distinct == 1 ? "Cable " : "Cables ") + cables + " went slack: some of " +
           (distinct == 1 ? "its" : "their") +
           " elements carried no tension (a cable cannot push; "
-          "docs/model-notes.md row 26). The arm then follows the remaining cables, not the "
+          "docs/model-notes.md row 27). The arm then follows the remaining cables, not the "
           "plan. A cable is slack where the release at its input outruns what the arm takes up "
           "(friction holding the cable in its holes, or a motion beyond what the pre-tension "
           "allows).",
@@ -603,9 +624,11 @@ Document BuildRunDocument(const RunFile& run, const std::string& source,
   datasets::ValidateRunFile(run, source);
   const std::vector<double>& time = run.time.values;
   const bool protocol_case = internal::CaseNumber(run.case_name) != 0;
+  // A run that recorded its protocol can be planned again whatever its case.
+  const bool plannable = protocol_case || !run.protocol_yaml.empty();
   const ArmFacts facts = internal::ReadArmFacts(
       run.config_yaml, source + ": attribute 'config_yaml'", run.joint_angles.shape[1],
-      run.input_tension.shape[1], protocol_case ? &time : nullptr);
+      run.input_tension.shape[1], plannable ? &time : nullptr, run.protocol_yaml);
   const Words words = WordsFor(run, facts);
   const std::vector<Instant> instants = ChooseInstants(time, facts, protocol_case, options);
 

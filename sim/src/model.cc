@@ -70,20 +70,9 @@ ArmModel::ArmModel(const ArmConfig& arm_config) : arm_(arm_config) {
     cables_.push_back(cable);
   }
 
-  joint_disk_radius_m_.assign(links_.size(), 0.0);
-  for (const DrivingCableModel& cable : cables_) {
-    int last_link = 0;
-    for (int s = 0; s <= cable.segment; ++s) last_link += arm.segments[s].links;
-    for (int j = 0; j < last_link; ++j)
-      joint_disk_radius_m_[j] = std::max(joint_disk_radius_m_[j], cable.radius_m);
-  }
-  for (std::size_t j = 0; j < links_.size(); ++j) {
-    // A joint no cable passes (a segment without cables is refused by
-    // CheckCableLayout) takes its own segment's hole circle.
-    if (joint_disk_radius_m_[j] == 0.0)
-      joint_disk_radius_m_[j] = arm.segments[links_[j].segment].hole_circle_radius_m;
-    joint_range_rad_.push_back(2.0 * std::atan(d / (2.0 * joint_disk_radius_m_[j])));
-  }
+  joint_disk_radius_m_ = JointDiskRadiiM(arm);
+  for (double radius : joint_disk_radius_m_)
+    joint_range_rad_.push_back(2.0 * std::atan(d / (2.0 * radius)));
 
   int offset = 0;
   for (const auto& cable : cables_) {
@@ -100,6 +89,24 @@ ArmModel::ArmModel(const ArmConfig& arm_config) : arm_(arm_config) {
   }
   num_coordinates_ = offset;
   sparse_layout_ = std::make_shared<const internal::SparseLayout>(*this);
+}
+
+std::vector<double> JointDiskRadiiM(const ArmConfig& arm) {
+  std::vector<double> radius;
+  for (const SegmentConfig& segment : arm.segments) radius.resize(radius.size() + segment.links);
+  for (const DrivingCableRoute& route : arm.driving.cables) {
+    int passes = 0;  // a cable passes joints 1 .. the last link of its segment
+    for (int s = 0; s < route.segment; ++s) passes += arm.segments[s].links;
+    const double r = arm.segments[route.segment - 1].hole_circle_radius_m;
+    for (int j = 0; j < passes; ++j) radius[j] = std::max(radius[j], r);
+  }
+  int j = 0;
+  for (const SegmentConfig& segment : arm.segments) {
+    for (int k = 0; k < segment.links; ++k, ++j) {
+      if (radius[j] == 0.0) radius[j] = segment.hole_circle_radius_m;
+    }
+  }
+  return radius;
 }
 
 Eigen::Vector3d ArmModel::p_parent_joint(int joint) const {

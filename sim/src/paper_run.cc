@@ -21,10 +21,18 @@ void ApplyPaperCase(int case_number, ArmParameters* parameters) {
 
 std::string DescribeRun(const PaperRun& run) {
   const bool paper_arm = IsPaperArm(run.config.arm);
+  std::string motion;
+  if (run.default_protocol) {
+    motion = "\n  protocol:                  " + DescribeProtocol(run.config.protocol);
+  } else if (run.protocol) {
+    motion = "\n  protocol:                  " + DescribeProtocolFile(*run.protocol);
+  } else {
+    motion =
+        "\n  inputs:                    recorded, " + run.inputs_source + ": " + run.inputs_note;
+  }
   return "run: " + DescribeCase(run.case_number, paper_arm) + " on " +
          (paper_arm ? "the paper's arm, " : "the arm of ") + run.config_path +
-         "\n  arm:                       " + DescribeArm(run.config.arm) +
-         "\n  protocol:                  " + DescribeProtocol(run.config.protocol) + "\n";
+         "\n  arm:                       " + DescribeArm(run.config.arm) + motion + "\n";
 }
 
 std::string BundledConfigPath(const std::string& name) {
@@ -45,6 +53,8 @@ std::string ConfigPathOrBundled(const std::string& path) {
   return path.empty() ? BundledConfigPath("paper.yaml") : path;
 }
 
+std::string BundledPaperProtocolPath() { return BundledConfigPath("protocols/paper.yaml"); }
+
 PaperRun PreparePaperRun(const PaperRunOptions& o) {
   const std::string path = ConfigPathOrBundled(o.config_path);
   std::string text = ReadTextFile(path);
@@ -57,35 +67,80 @@ PaperRun PreparePaperRun(const PaperRunOptions& o) {
     const auto [name, value] = ParseParameterAssignment(assignment, "--set");
     SetParameter(name, value, "--set", &config.parameters);
   }
+  if (!o.protocol_path.empty() && o.recorded_inputs) {
+    ThrowInputError("--protocol", "", "and --inputs exclude each other: give one");
+  }
+  const bool default_protocol = o.protocol_path.empty() && !o.recorded_inputs;
+  ProtocolOptions protocol_options;
   // Overrides are checked with the configuration's own rules, but the
   // message names the option they came from.
   if (!std::isnan(o.amplitude_deg)) {
-    config.protocol.amplitude_rad = o.amplitude_deg * M_PI / 180.0;
-    ValidateProtocol(config.protocol, "--amplitude");
+    if (o.recorded_inputs) {
+      ThrowInputError("--amplitude", "",
+                      "applies to a protocol; recorded inputs (--inputs) are used as recorded");
+    }
+    // The conversion the paper's runs have always used, kept to the bit.
+    const double amplitude_rad = o.amplitude_deg * M_PI / 180.0;
+    if (default_protocol) {
+      config.protocol.amplitude_rad = amplitude_rad;
+      ValidateProtocol(config.protocol, "--amplitude");
+    } else {
+      protocol_options.parameters["amplitude_deg"] = amplitude_rad;
+      protocol_options.parameters_source = "--amplitude";
+    }
   }
   if (!std::isnan(o.output_rate_hz)) {
     config.solver.output_rate_hz = o.output_rate_hz;
     ValidateSolver(config.solver, "--output-rate");
   }
-  const double duration = std::isnan(o.duration_s) ? config.protocol.duration_s() : o.duration_s;
+  ArmModel model(config.arm);
+  std::optional<Protocol> protocol;
+  std::string inputs_note;
+  std::optional<CableInputs> recorded;
+  if (o.recorded_inputs) {
+    recorded = MakeRecordedCableInputs(*o.recorded_inputs, model.num_cables(),
+                                       o.recorded_input_options, &inputs_note);
+  } else if (default_protocol) {
+    // The configuration's protocol section sets the paper protocol's
+    // parameters (SI values, as the configuration holds them).
+    protocol_options.parameters = PaperProtocolParameters(config.protocol);
+    protocol_options.parameters_source = path + ": protocol";
+    // The user wrote the amplitude, not the bundled file: a plan it makes
+    // impossible (past the joints' range) is blamed on where it came from.
+    try {
+      protocol = LoadProtocol(BundledPaperProtocolPath(), config.arm, protocol_options);
+    } catch (const InputError& e) {
+      ThrowInputError(
+          std::isnan(o.amplitude_deg) ? path + ": protocol.amplitude_deg" : "--amplitude", "",
+          e.what());
+    }
+  } else {
+    protocol = LoadProtocol(o.protocol_path, config.arm, protocol_options);
+  }
+  const double natural_duration = protocol ? protocol->duration_s() : recorded->end_time();
+  const double duration = std::isnan(o.duration_s) ? natural_duration : o.duration_s;
   if (!(duration > 0.0) || !std::isfinite(duration)) {
     ThrowInputError("--duration", "", "must be > 0 s");
   }
-  ArmModel model(config.arm);
-  const std::string motion_source =
-      std::isnan(o.amplitude_deg) ? path + ": protocol.amplitude_deg" : std::string("--amplitude");
-  CableInputs inputs = PlanCableInputs(model, PaperTrajectory(model, config.protocol), duration,
-                                       1e-3, motion_source);
+  CableInputs inputs =
+      protocol ? PlanProtocolInputs(model, *protocol, duration) : std::move(*recorded);
   SimulationOptions simulation;
   simulation.duration_s = duration;
   simulation.solver = config.solver;
-  return PaperRun{path,
-                  std::move(text),
-                  std::move(config),
-                  std::move(model),
-                  std::move(inputs),
-                  std::move(simulation),
-                  o.case_number};
+  PaperRun run{path,
+               std::move(text),
+               std::move(config),
+               std::move(model),
+               std::move(inputs),
+               std::move(simulation),
+               o.case_number};
+  run.protocol = std::move(protocol);
+  run.default_protocol = default_protocol;
+  if (o.recorded_inputs) {
+    run.inputs_source = o.recorded_inputs->source_name;
+    run.inputs_note = inputs_note;
+  }
+  return run;
 }
 
 }  // namespace ccsrm::sim

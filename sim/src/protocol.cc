@@ -10,6 +10,7 @@
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/gsl_errors.h"
+#include "protocol_internal.h"
 
 namespace ccsrm::sim {
 
@@ -162,6 +163,243 @@ CableInputs PlanCableInputs(const ArmModel& model, const JointTrajectory& trajec
     }
   }
   return CableInputs(std::move(time), std::move(change));
+}
+
+namespace internal {
+namespace {
+
+// d/dτ of QuinticBlend: 30τ²(1 − τ)² on [0, 1], 0 outside.
+double QuinticBlendRate(double tau) {
+  if (tau <= 0.0 || tau >= 1.0) return 0.0;
+  return 30.0 * tau * tau * (1.0 - tau) * (1.0 - tau);
+}
+
+// Phase φ [rad] and its rate [rad/s] of an oscillation at `t` [s] into it.
+void OscillationPhase(const ProtocolPiece& p, double t, double* phase, double* phase_rate) {
+  const double f0 = p.start_frequency_hz, f1 = p.end_frequency_hz, T = p.duration_s;
+  if (f0 == f1) {
+    *phase = 2.0 * M_PI * f0 * t;
+    *phase_rate = 2.0 * M_PI * f0;
+  } else if (p.exponential_sweep) {
+    // f(t) = f0 k^(t/T), k = f1/f0: φ = 2π f0 T (k^(t/T) − 1) / ln k.
+    const double log_k = std::log(f1 / f0);
+    const double growth = std::exp(log_k * t / T);
+    *phase = 2.0 * M_PI * f0 * T * (growth - 1.0) / log_k;
+    *phase_rate = 2.0 * M_PI * f0 * growth;
+  } else {
+    // f(t) = f0 + (f1 − f0) t / T.
+    *phase = 2.0 * M_PI * (f0 * t + 0.5 * (f1 - f0) * t * t / T);
+    *phase_rate = 2.0 * M_PI * (f0 + (f1 - f0) * t / T);
+  }
+}
+
+// The fade envelope w and its rate: quintic in over fade_s, out over the
+// last fade_s (their product, so that both ends are at rest however short).
+void Envelope(const ProtocolPiece& p, double t, double* w, double* w_rate) {
+  if (p.fade_s <= 0.0) {
+    *w = 1.0;
+    *w_rate = 0.0;
+    return;
+  }
+  const double in = t / p.fade_s, out = (p.duration_s - t) / p.fade_s;
+  const double w_in = QuinticBlend(in), w_out = QuinticBlend(out);
+  *w = w_in * w_out;
+  *w_rate = (QuinticBlendRate(in) * w_out - w_in * QuinticBlendRate(out)) / p.fade_s;
+}
+
+}  // namespace
+
+Eigen::Vector2d PlaneBendToCardan(double plane_rad, double bend_rad) {
+  const double s = std::sin(bend_rad);
+  return Eigen::Vector2d(std::atan2(-std::sin(plane_rad) * s, std::cos(bend_rad)),
+                         std::asin(std::clamp(std::cos(plane_rad) * s, -1.0, 1.0)));
+}
+
+JointAngles PieceAngles(const ProtocolPiece& p, double t) {
+  JointAngles a = p.start;
+  switch (p.kind) {
+    case ProtocolPiece::Kind::kHold:
+      break;
+    case ProtocolPiece::Kind::kMove: {
+      // Written as the paper's protocol computes it (A · q and A · (1 − q)),
+      // so that configs/protocols/paper.yaml plans the same inputs to the bit.
+      const double q = QuinticBlend(t / p.duration_s);
+      for (std::size_t j = 0; j < a.size(); ++j) {
+        for (int axis = 0; axis < 2; ++axis) {
+          a[j][axis] = p.start[j][axis] * (1.0 - q) + p.target[j][axis] * q;
+        }
+      }
+      break;
+    }
+    case ProtocolPiece::Kind::kOscillation: {
+      double phase, phase_rate, w, w_rate;
+      OscillationPhase(p, t, &phase, &phase_rate);
+      Envelope(p, t, &w, &w_rate);
+      const double factor = w * std::sin(phase);
+      for (std::size_t j = 0; j < a.size(); ++j) a[j] += p.amplitude[j] * factor;
+      break;
+    }
+  }
+  return a;
+}
+
+JointAngles PieceRates(const ProtocolPiece& p, double t) {
+  JointAngles rate(p.start.size(), Eigen::Vector2d::Zero());
+  switch (p.kind) {
+    case ProtocolPiece::Kind::kHold:
+      break;
+    case ProtocolPiece::Kind::kMove: {
+      const double q_rate = QuinticBlendRate(t / p.duration_s) / p.duration_s;
+      for (std::size_t j = 0; j < rate.size(); ++j) rate[j] = (p.target[j] - p.start[j]) * q_rate;
+      break;
+    }
+    case ProtocolPiece::Kind::kOscillation: {
+      double phase, phase_rate, w, w_rate;
+      OscillationPhase(p, t, &phase, &phase_rate);
+      Envelope(p, t, &w, &w_rate);
+      const double factor = w_rate * std::sin(phase) + w * phase_rate * std::cos(phase);
+      for (std::size_t j = 0; j < rate.size(); ++j) rate[j] = p.amplitude[j] * factor;
+      break;
+    }
+  }
+  return rate;
+}
+
+}  // namespace internal
+
+namespace {
+
+// The piece of `pieces` active at t and the time into it; nullptr after the
+// last one. Durations are subtracted one by one, as the paper's protocol
+// subtracts ramp_s and then hold_s.
+const ProtocolPiece* ActivePiece(const std::vector<ProtocolPiece>& pieces, double t,
+                                 double* local) {
+  *local = t;
+  for (const ProtocolPiece& p : pieces) {
+    if (*local < p.duration_s) return &p;
+    *local -= p.duration_s;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+double Protocol::duration_s() const {
+  double longest = 0.0;
+  for (const auto& pieces : segments) {
+    double total = 0.0;
+    for (const ProtocolPiece& p : pieces) total += p.duration_s;
+    longest = std::max(longest, total);
+  }
+  return longest;
+}
+
+JointAngles Protocol::PlannedAngles(double t) const {
+  JointAngles angles;
+  for (const auto& pieces : segments) {
+    double local = 0.0;
+    const ProtocolPiece* p = ActivePiece(pieces, t, &local);
+    const JointAngles a = p != nullptr
+                              ? internal::PieceAngles(*p, local)
+                              : internal::PieceAngles(pieces.back(), pieces.back().duration_s);
+    angles.insert(angles.end(), a.begin(), a.end());
+  }
+  return angles;
+}
+
+JointAngles Protocol::PlannedRates(double t) const {
+  JointAngles rates;
+  for (std::size_t s = 0; s < segments.size(); ++s) {
+    double local = 0.0;
+    const ProtocolPiece* p = ActivePiece(segments[s], t, &local);
+    const JointAngles r = p != nullptr ? internal::PieceRates(*p, local)
+                                       : JointAngles(segment_joints[s], Eigen::Vector2d::Zero());
+    rates.insert(rates.end(), r.begin(), r.end());
+  }
+  return rates;
+}
+
+JointTrajectory Protocol::Trajectory() const {
+  // A copy: the trajectory may outlive the protocol it came from.
+  return [protocol = *this](double t) { return protocol.PlannedAngles(t); };
+}
+
+CableInputs PlanProtocolInputs(const ArmModel& model, const Protocol& protocol, double duration_s,
+                               double sample_step_s) {
+  CableInputs inputs = PlanCableInputs(model, protocol.Trajectory(), duration_s, sample_step_s);
+  // Speeds and accelerations by central differences of the sampled lengths
+  // (second order; rounding adds ~1e-10 m/s² at 1 ms, far below any limit).
+  const Eigen::VectorXd& time = inputs.time();
+  const Eigen::MatrixXd& length = inputs.length_change();
+  for (Eigen::Index k = 1; k + 1 < time.size(); ++k) {
+    const double h_back = time[k] - time[k - 1], h_fore = time[k + 1] - time[k];
+    for (Eigen::Index c = 0; c < length.cols(); ++c) {
+      const double back = (length(k, c) - length(k - 1, c)) / h_back;
+      const double fore = (length(k + 1, c) - length(k, c)) / h_fore;
+      const double speed = 0.5 * (back + fore);
+      const double accel = 2.0 * (fore - back) / (h_back + h_fore);
+      const bool too_fast = std::abs(speed) > protocol.limits.cable_speed_mps;
+      const bool too_hard = std::abs(accel) > protocol.limits.cable_acceleration_mps2;
+      if (!too_fast && !too_hard) continue;
+      // Blame the piece of the cable's own segment active then.
+      const int segment = model.cables()[c].segment;
+      double local = 0.0;
+      const ProtocolPiece* p = ActivePiece(protocol.segments[segment], time[k], &local);
+      if (p == nullptr) p = &protocol.segments[segment].back();
+      char what[256];
+      if (too_fast) {
+        std::snprintf(what, sizeof(what),
+                      "cable %d would run at %.3g m/s at t = %.3f s, beyond "
+                      "limits.cable_speed_mps = %.3g",
+                      static_cast<int>(c) + 1, std::abs(speed), time[k],
+                      protocol.limits.cable_speed_mps);
+      } else {
+        std::snprintf(what, sizeof(what),
+                      "cable %d would accelerate at %.3g m/s² at t = %.3f s, beyond "
+                      "limits.cable_acceleration_mps2 = %.3g",
+                      static_cast<int>(c) + 1, std::abs(accel), time[k],
+                      protocol.limits.cable_acceleration_mps2);
+      }
+      ThrowInputError(protocol.source_name, p->source.Where(), what);
+    }
+  }
+  return inputs;
+}
+
+std::string DescribeProtocolFile(const Protocol& protocol) {
+  auto number = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.4g", v);
+    return std::string(text);
+  };
+  std::string text = "'" + (protocol.name.empty() ? std::string("unnamed") : protocol.name) +
+                     "' (" + protocol.source_name + "), " + number(protocol.duration_s()) + " s";
+  for (std::size_t s = 0; s < protocol.segments.size(); ++s) {
+    text += s == 0 ? ": " : "; ";
+    text += "segment " + std::to_string(s + 1);
+    std::string previous;
+    int count = 0;
+    auto flush = [&] {
+      if (count == 0) return;
+      text += " " + previous + (count > 1 ? " ×" + std::to_string(count) : "") + ",";
+    };
+    for (const ProtocolPiece& p : protocol.segments[s]) {
+      const std::string word = p.kind == ProtocolPiece::Kind::kHold         ? "hold"
+                               : p.kind == ProtocolPiece::Kind::kMove       ? "move"
+                               : p.start_frequency_hz == p.end_frequency_hz ? "sine"
+                                                                            : "chirp";
+      if (word == previous) {
+        ++count;
+        continue;
+      }
+      flush();
+      previous = word;
+      count = 1;
+    }
+    flush();
+    text.pop_back();  // the last ','
+  }
+  return text;
 }
 
 }  // namespace ccsrm::sim

@@ -299,15 +299,15 @@ const std::vector<BadInput>& Rows() {
        "simulate --config {d}/c.yaml --amplitude 100 --duration 0.1 --out {d}/run2.h5",
        {"--amplitude"}},
       // A plan past the joints' range, refused by the planner before it
-      // runs (docs/model-notes.md row 26): issue 32's -40 deg on the
+      // runs (docs/model-notes.md row 27): issue 32's -40 deg on the
       // three-segment arm (range 35.5 deg), 45 deg on the paper's (41.7).
       {"overrides",
        "simulate --config " + std::string(CCSRM_SOURCE_DIR) +
            "/configs/three-segment.yaml --case 1 --amplitude -40 --out {d}/run2.h5",
-       {"--amplitude", "joint 1 (segment 1)", "range of 35.5 deg"}},
+       {"--amplitude", "bends joint 1 to 40 deg", "past its 35.49 deg"}},
       {"overrides",
        "generate --config {d}/c.yaml --amplitude 45 --out {d}/exp2.h5",
-       {"--amplitude", "joint 1 (segment 1)", "range of 41.7 deg"}},
+       {"--amplitude", "bends joint 1 to 45 deg", "past its 41.71 deg"}},
       // HDF5 files: an experiment is checked against its own config_yaml at
       // every door (inspect, process, identify).
       {"hdf5",

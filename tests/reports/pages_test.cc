@@ -229,6 +229,27 @@ TEST(RunPage, CustomCaseOmitsThePlanAndSaysSo) {
   EXPECT_EQ(document.figures()[0]->figure.panels[0].series.size(), 6u);
 }
 
+TEST(RunPage, RecordedProtocolIsPlannedAgainWithItsErrorInBothAxes) {
+  // A run of any case that recorded its protocol (protocol_yaml, issue 25)
+  // is planned again from it: the plan is drawn and the error to it in θx
+  // and θy gets a figure each.
+  datasets::RunFile run = KnownRun("custom");
+  run.protocol_yaml =
+      ReadTextFile(std::string(CCSRM_SOURCE_DIR) + "/configs/protocols/two-axis.yaml");
+  ReportOptions options;
+  options.instants_s = {1.0};
+  const Document document = BuildRunDocument(run, "two-axis.h5", options);
+  const nlohmann::json json = ToJson(document);
+  EXPECT_TRUE(json["notices"].empty()) << json["notices"];
+  std::vector<std::string> names;
+  for (const FigureBlock* f : document.figures()) names.push_back(f->figure.name);
+  EXPECT_THAT(names, ::testing::IsSupersetOf({"plan_error_theta_x", "plan_error_theta_y"}));
+  // 12 joints and a plan row for each: the segments are planned apart.
+  EXPECT_EQ(json["tables"]["theta_x_at_instants"]["rows"].size(), 24u);
+  // The protocol in words, from the recorded file rather than the configuration.
+  EXPECT_THAT(json.dump(), HasSubstr("segment 1 move, hold, sine, hold, move, hold"));
+}
+
 TEST(RunPage, UnreadableConfigurationStillGivesAPage) {
   datasets::RunFile run = KnownRun("1");
   run.config_yaml = "arm: [not a configuration";

@@ -225,7 +225,7 @@ TEST(AleElement, StrainAccelerationBiasMatchesFiniteDifferences) {
 }
 
 TEST(AleElement, SlackElementCarriesNoTension) {
-  // A cable cannot push (docs/model-notes.md row 26): a compressed element
+  // A cable cannot push (docs/model-notes.md row 27): a compressed element
   // carries nothing, however fast it moves, and has no elastic mass.
   std::mt19937 rng(7);
   for (double h : {0.0, 0.01}) {

@@ -1,6 +1,6 @@
 // Where the arm leaves the paper's ground (issue 32): cables that would
 // push go slack instead and are reported, and joints are kept within the
-// range where their disks have not met (docs/model-notes.md row 26).
+// range where their disks have not met (docs/model-notes.md row 27).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -61,6 +61,8 @@ datasets::RunFile ToRunFile(const sim::ArmModel& model, const sim::SimulationRes
   const sim::SimulationSummary& s = result.summary;
   run.case_name = info.case_name;
   run.config_yaml = info.config_yaml;
+  run.protocol_yaml = info.protocol_yaml;
+  run.inputs_file = info.inputs_file;
   run.wall_time_s = s.wall_time_s;
   run.steps = s.steps;
   run.rejected_steps = s.rejected_steps;

@@ -101,7 +101,7 @@ AleElementTerms EvaluateAleElement(const AleElementParams& params, const Vector8
   // d/dt (r'.r'_dot) with q'' = 0: |r'_dot|^2 + r'.(-2 r'_dot Δs_dot / Δs).
   out.strain_accel_bias = k.r_s_dot.squaredNorm() - 2.0 * out.strain_rate * k.ds_dot * inv_ds;
 
-  // The unilateral law (docs/model-notes.md row 26): eq. 13's elastic term
+  // The unilateral law (docs/model-notes.md row 27): eq. 13's elastic term
   // k eps becomes phi(eps), zero when slack and joined to eps by a short
   // toe, and the Rayleigh and smoothing terms take the tangent stiffness
   // phi' in place of k (Rayleigh damping is proportional to it); a cable

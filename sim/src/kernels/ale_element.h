@@ -80,7 +80,7 @@ UnilateralStrain UnilateralElasticStrain(double strain, double toe_strain);
 // report the divergence.
 //
 // Notes:
-//  - A cable cannot push (docs/model-notes.md row 26). Eqs. 6 and 13 as
+//  - A cable cannot push (docs/model-notes.md row 27). Eqs. 6 and 13 as
 //    printed let the Rayleigh term beta eps_dot act on a slack element, which
 //    then pushes when compressed quickly. Here the elastic term k eps is
 //    phi(eps) (UnilateralElasticStrain), the Rayleigh and smoothing terms

@@ -43,6 +43,11 @@ struct ExperimentFile {
   ExperimentSource source = ExperimentSource::kRecorded;
   // The nominal YAML configuration of the arm.
   std::string config_yaml;
+  // Extension (optional attributes, written when not empty): the protocol
+  // the experiment followed (ccsrm-protocol/1), or the file of recorded
+  // inputs that drove a generated one.
+  std::string protocol_yaml;
+  std::string inputs_file;
 
   // --- Datasets --------------------------------------------------------------
   Array input_time;                       // /input/time, N, s: strictly increasing, finite, N >= 1.

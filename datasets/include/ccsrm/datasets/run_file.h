@@ -39,6 +39,11 @@ struct RunFile {
   std::string case_name = "custom";
   // The full YAML configuration the run used.
   std::string config_yaml;
+  // Extension (optional attributes, written when not empty): the protocol
+  // that drove the run (a ccsrm-protocol/1 document, its parameters at the
+  // values used), or the file of recorded inputs it was driven from.
+  std::string protocol_yaml;
+  std::string inputs_file;
   // ISO 8601 UTC time of writing; left empty, WriteRunFile stamps the
   // current time (the struct itself is not modified).
   std::string created;

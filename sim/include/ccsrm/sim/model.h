@@ -61,6 +61,12 @@ struct ConnectingPairModel {
   double wrap_angle_rad = 0.0;    // large S: Theta_lc
 };
 
+// The widest hole circle [m] through each joint of `arm` (index joint - 1):
+// that of the cables passing it (a joint no cable passes: its segment's).
+// Its disks are at least that wide, so the joint's range is at most
+// 2 atan(d / 2R) (ArmModel::joint_range_rad).
+std::vector<double> JointDiskRadiiM(const ArmConfig& arm);
+
 class ArmModel {
  public:
   // Builds the model. Throws InputError if the configuration is invalid.
@@ -87,7 +93,7 @@ class ArmModel {
   // (the disks are at least that wide, so the true range is no larger).
   // Beyond it a cable's path through the gap folds back; ccsrm has no
   // contact between disks, so a plan beyond it is refused and a run that
-  // reaches it stops (docs/model-notes.md row 26).
+  // reaches it stops (docs/model-notes.md row 27).
   double joint_range_rad(int joint) const { return joint_range_rad_[joint - 1]; }
   // The hole circle radius R [m] that sets joint i's range.
   double joint_disk_radius_m(int joint) const { return joint_disk_radius_m_[joint - 1]; }

@@ -5,6 +5,7 @@
 // call shared by `ccsrm simulate`, `generate`, `bench`, identification and
 // the tests.
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/parameters.h"
 #include "ccsrm/sim/protocol.h"
+#include "ccsrm/sim/recorded_inputs.h"
 #include "ccsrm/sim/simulator.h"
 
 namespace ccsrm::sim {
@@ -24,14 +26,32 @@ void ApplyPaperCase(int case_number, ArmParameters* parameters);
 
 // What a paper run is made of. The fields stand for the command-line
 // options of the same names, and errors name those options.
+//
+// The motion: without protocol_path and recorded_inputs, the bundled
+// configs/protocols/paper.yaml with its parameters (amplitude_deg, ramp_s,
+// hold_s, return_s, rest_s) set from the configuration's `protocol:`
+// section, and amplitude_deg from --amplitude when given: the paper's
+// protocol as before, to the bit. With protocol_path, that file as written
+// (the configuration's `protocol:` section plays no part), --amplitude
+// setting its amplitude_deg parameter (refused when it has none). With
+// recorded_inputs, those lengths (--amplitude is refused).
 struct PaperRunOptions {
   // --config; empty: the bundled configs/paper.yaml (BundledConfigPath),
   // found wherever the program runs from.
   std::string config_path;
   int case_number = 0;          // --case; 0: friction as configured
-  double amplitude_deg = NAN;   // --amplitude; NaN: protocol.amplitude_deg
+  double amplitude_deg = NAN;   // --amplitude; NaN: the protocol's own (see above)
   double output_rate_hz = NAN;  // --output-rate; NaN: solver.output_rate_hz
-  double duration_s = NAN;      // --duration; NaN: the whole protocol
+  // --duration; NaN: the whole protocol, or up to the last recorded sample.
+  // Beyond the protocol's end the arm holds its last planned state (the
+  // last recorded lengths).
+  double duration_s = NAN;
+  // --protocol: a ccsrm-protocol/1 file; empty: see above.
+  std::string protocol_path;
+  // --inputs, read by the command (sim_io::ReadRecordedInputs), and how its
+  // samples are checked and resampled. Exclusive with protocol_path.
+  std::optional<RecordedInputs> recorded_inputs;
+  RecordedInputOptions recorded_input_options;
   // Named parameters (SPEC 6), applied after the case: a YAML file
   // (--params), then name=value assignments (--set).
   std::string params_path;
@@ -46,6 +66,13 @@ struct PaperRun {
   CableInputs inputs;
   SimulationOptions simulation;  // duration and solver settings of the run
   int case_number = 0;           // 0: custom
+  // The protocol followed, and its file (the bundled paper.yaml by
+  // default); absent with recorded inputs.
+  std::optional<Protocol> protocol;
+  bool default_protocol = false;  // the configuration's paper protocol
+  // Recorded inputs: their file and how the samples were used; else empty.
+  std::string inputs_source;
+  std::string inputs_note;
 };
 
 // Reads the configuration and builds the run. Throws InputError for a bad
@@ -54,7 +81,8 @@ PaperRun PreparePaperRun(const PaperRunOptions& options);
 
 // The run in words for any arm, the lines a command prints above the
 // simulation's summary: the case and the file (the paper's case only on the
-// paper's arm, sim/describe.h), the arm as configured and the protocol.
+// paper's arm, sim/describe.h), the arm as configured and the protocol (or
+// the recorded inputs) followed.
 std::string DescribeRun(const PaperRun& run);
 
 // The path of the configuration `name` ("paper.yaml") that ships with ccsrm:
@@ -67,5 +95,8 @@ std::string BundledConfigPath(const std::string& name);
 
 // `path`, or when it is empty the bundled configs/paper.yaml.
 std::string ConfigPathOrBundled(const std::string& path);
+
+// The bundled configs/protocols/paper.yaml (BundledConfigPath).
+std::string BundledPaperProtocolPath();
 
 }  // namespace ccsrm::sim

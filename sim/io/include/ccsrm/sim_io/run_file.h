@@ -14,6 +14,8 @@ namespace ccsrm::sim_io {
 struct RunFileInfo {
   std::string case_name = "custom";  // "1".."4" or "custom"
   std::string config_yaml;           // the full configuration used (sim::ToYaml)
+  std::string protocol_yaml;         // the protocol followed (sim::Protocol::ToYaml), or empty
+  std::string inputs_file;           // the recorded inputs followed, or empty
 };
 
 // Every frame of `result.trajectory` and its solver statistics and status.
