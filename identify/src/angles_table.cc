@@ -3,8 +3,13 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <set>
 #include <sstream>
+
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/datasets/run_file.h"
+#include "ccsrm/sim_io/run_file.h"
 
 namespace ccsrm::identify::internal {
 
@@ -58,6 +63,45 @@ std::vector<std::string> OutputStems(const std::vector<std::string>& names) {
     stems.push_back(unique);
   }
   return stems;
+}
+
+void WriteRecordingOutputs(const Experiment& x, const std::string& name,
+                           const sim::SimulationResult& run, const sim::ArmParameters& parameters,
+                           const Eigen::MatrixXd& simulated_rad, const std::string& kind,
+                           const std::string& stem, const std::string& run_suffix,
+                           const std::string& tmp_dir, const std::string& directory,
+                           nlohmann::json* entry, std::vector<std::string>* written) {
+  namespace fs = std::filesystem;
+  constexpr double kDeg = 180.0 / M_PI;
+  const fs::path tmp(tmp_dir);
+  (*entry)["run_file"] = stem + run_suffix;
+  (*entry)["angles_file"] = stem + ".angles.csv";
+  if (run.trajectory.size() > 0) {
+    sim::Config config = x.config;
+    config.parameters = parameters;
+    sim_io::RunFileInfo info;
+    info.config_yaml = sim::ToYaml(config);
+    const datasets::RunFile file = sim_io::ToRunFile(*x.model, run, info);
+    datasets::WriteRunFile((tmp / (stem + run_suffix)).string(), file);
+    written->push_back((fs::path(directory) / (stem + run_suffix)).string());
+  } else {
+    (*entry)["run_file"] = nullptr;
+  }
+  const auto measured = [&x](Eigen::Index f, Eigen::Index c) {
+    return x.measured_rad(f, c) * kDeg;
+  };
+  const auto simulated = [&simulated_rad](Eigen::Index f, Eigen::Index c) {
+    return simulated_rad.rows() > f ? simulated_rad(f, c) * kDeg : NAN;
+  };
+  const std::string csv = AnglesCsvText(
+      name + ": measured and " + kind + " joint angles [deg] at the measured frames; residual = " +
+          kind + " - measured; empty where not measured",
+      x.frame_time_s, x.joints,
+      {{"measured", measured}, {kind, simulated}, {"residual", [&](Eigen::Index f, Eigen::Index c) {
+                                                     return simulated(f, c) - measured(f, c);
+                                                   }}});
+  WriteTextFileAtomically((tmp / (stem + ".angles.csv")).string(), csv);
+  written->push_back((fs::path(directory) / (stem + ".angles.csv")).string());
 }
 
 }  // namespace ccsrm::identify::internal

@@ -7,8 +7,13 @@
 // empty cell where there is no value.
 #include <Eigen/Core>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
+
+#include "ccsrm/identify/experiment.h"
+#include "ccsrm/sim/parameters.h"
+#include "ccsrm/sim/simulator.h"
 
 namespace ccsrm::identify::internal {
 
@@ -26,5 +31,19 @@ std::string AnglesCsvText(const std::string& comment, const std::vector<double>&
 // letters, digits, '-', '_' and '.' kept, anything else '_'; an empty name
 // is "experiment"; a repeated one gets "_2", "_3", ...
 std::vector<std::string> OutputStems(const std::vector<std::string>& names);
+
+// The files a command writes for one recording it simulated (a fit's, a
+// prediction's): <stem><run_suffix>, the run with `parameters` on the
+// recording's configuration, left out when the run has no frame; and
+// <stem>.angles.csv, the measured angles, `simulated_rad` under `kind`
+// ("fitted", "predicted") and their residual. Both go into `tmp_dir`; their
+// names into (*entry)["run_file"] (null without a run) and
+// ["angles_file"], their final paths (in `directory`) onto *written.
+void WriteRecordingOutputs(const Experiment& x, const std::string& name,
+                           const sim::SimulationResult& run, const sim::ArmParameters& parameters,
+                           const Eigen::MatrixXd& simulated_rad, const std::string& kind,
+                           const std::string& stem, const std::string& run_suffix,
+                           const std::string& tmp_dir, const std::string& directory,
+                           nlohmann::json* entry, std::vector<std::string>* written);
 
 }  // namespace ccsrm::identify::internal

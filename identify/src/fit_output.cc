@@ -15,8 +15,6 @@
 namespace ccsrm::identify {
 namespace {
 
-constexpr double kDeg = 180.0 / M_PI;
-
 std::string Format(const char* format, double value) {
   if (!std::isfinite(value)) return "-";
   char text[64];
@@ -249,35 +247,9 @@ std::vector<std::string> WriteFitDirectory(const IdentificationSummary& summary,
   nlohmann::json json = ToJson(summary);
   for (std::size_t e = 0; e < experiments.size(); ++e) {
     const ExperimentFit& fit = summary.experiments[e];
-    const Experiment& x = experiments[e];
-    json["experiments"][e]["run_file"] = stems[e] + ".fit.h5";
-    json["experiments"][e]["angles_file"] = stems[e] + ".angles.csv";
-    if (fit.run.trajectory.size() > 0) {
-      sim::Config config = x.config;
-      config.parameters = fit.parameters;
-      datasets::RunFile run = sim_io::ToRunFile(*x.model, fit.run, {"custom", sim::ToYaml(config)});
-      datasets::WriteRunFile((tmp / (stems[e] + ".fit.h5")).string(), run);
-      written.push_back((fs::path(directory) / (stems[e] + ".fit.h5")).string());
-    } else {
-      json["experiments"][e]["run_file"] = nullptr;
-    }
-    const auto measured = [&x](Eigen::Index f, Eigen::Index c) {
-      return x.measured_rad(f, c) * kDeg;
-    };
-    const auto fitted = [&fit](Eigen::Index f, Eigen::Index c) {
-      return fit.simulated_rad.rows() > f ? fit.simulated_rad(f, c) * kDeg : NAN;
-    };
-    const std::string csv = internal::AnglesCsvText(
-        fit.name +
-            ": measured and fitted joint angles [deg] at the measured frames; residual = fitted - "
-            "measured; empty where not measured",
-        x.frame_time_s, x.joints,
-        {{"measured", measured},
-         {"fitted", fitted},
-         {"residual",
-          [&](Eigen::Index f, Eigen::Index c) { return fitted(f, c) - measured(f, c); }}});
-    WriteTextFileAtomically((tmp / (stems[e] + ".angles.csv")).string(), csv);
-    written.push_back((fs::path(directory) / (stems[e] + ".angles.csv")).string());
+    internal::WriteRecordingOutputs(experiments[e], fit.name, fit.run, fit.parameters,
+                                    fit.simulated_rad, "fitted", stems[e], ".fit.h5",
+                                    out.temp_path(), directory, &json["experiments"][e], &written);
   }
   WriteTextFileAtomically((tmp / "fit.json").string(), json.dump(2) + "\n");
   written.insert(written.begin(), (fs::path(directory) / "fit.json").string());

@@ -14,8 +14,6 @@
 namespace ccsrm::identify {
 namespace {
 
-constexpr double kDeg = 180.0 / M_PI;
-
 std::string Format(const char* format, double value) {
   if (!std::isfinite(value)) return "-";
   char text[64];
@@ -204,36 +202,9 @@ std::vector<std::string> WritePredictionDirectory(const PredictionSummary& summa
   nlohmann::json json = ToJson(summary);
   for (std::size_t e = 0; e < recordings.size(); ++e) {
     const RecordingPrediction& r = summary.recordings[e];
-    const Experiment& x = recordings[e];
-    json["recordings"][e]["run_file"] = stems[e] + ".pred.h5";
-    json["recordings"][e]["angles_file"] = stems[e] + ".angles.csv";
-    if (r.run.trajectory.size() > 0) {
-      sim::Config config = x.config;
-      config.parameters = r.parameters;
-      const datasets::RunFile run =
-          sim_io::ToRunFile(*x.model, r.run, {"custom", sim::ToYaml(config)});
-      datasets::WriteRunFile((tmp / (stems[e] + ".pred.h5")).string(), run);
-      written.push_back((fs::path(directory) / (stems[e] + ".pred.h5")).string());
-    } else {
-      json["recordings"][e]["run_file"] = nullptr;
-    }
-    const auto measured = [&x](Eigen::Index f, Eigen::Index c) {
-      return x.measured_rad(f, c) * kDeg;
-    };
-    const auto predicted = [&r](Eigen::Index f, Eigen::Index c) {
-      return r.predicted_rad.rows() > f ? r.predicted_rad(f, c) * kDeg : NAN;
-    };
-    const std::string csv = internal::AnglesCsvText(
-        r.name +
-            ": measured and predicted joint angles [deg] at the measured frames; residual = "
-            "predicted - measured; empty where not measured",
-        x.frame_time_s, x.joints,
-        {{"measured", measured},
-         {"predicted", predicted},
-         {"residual",
-          [&](Eigen::Index f, Eigen::Index c) { return predicted(f, c) - measured(f, c); }}});
-    WriteTextFileAtomically((tmp / (stems[e] + ".angles.csv")).string(), csv);
-    written.push_back((fs::path(directory) / (stems[e] + ".angles.csv")).string());
+    internal::WriteRecordingOutputs(recordings[e], r.name, r.run, r.parameters, r.predicted_rad,
+                                    "predicted", stems[e], ".pred.h5", out.temp_path(), directory,
+                                    &json["recordings"][e], &written);
   }
   WriteTextFileAtomically((tmp / "pred.json").string(), json.dump(2) + "\n");
   written.insert(written.begin(), (fs::path(directory) / "pred.json").string());
