@@ -125,9 +125,9 @@ AleElementTerms EvaluateAleElement(const AleElementParams& params, const Vector8
   // the smoothing's added mass (eq. 20, a part of the averaged stress that
   // only resists strain acceleration) stays, so that the inertia the
   // integrator sees does not jump when it starts or stops.
-  out.pushing = out.taut && (tension < 0.0 || explicit_stress < 0.0);
+  out.pushing = out.taut && explicit_stress < 0.0;
   out.strain_energy_density = u.energy;
-  out.tension = out.taut && !out.pushing ? tension : 0.0;
+  out.tension = out.taut ? std::max(0.0, tension) : 0.0;
   if (!out.taut) {
     out.smoothed_damping_s = 0.0;
     out.smoothed_inertia_s2 = 0.0;

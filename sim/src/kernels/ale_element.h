@@ -57,7 +57,7 @@ struct AleElementTerms {
   double smoothed_damping_s = 0.0;
   double smoothed_inertia_s2 = 0.0;
   bool taut = false;     // k of eq. 6: eps > 0
-  bool pushing = false;  // stretched, but eq. 13 or 20 would push: no force
+  bool pushing = false;  // stretched, but eq. 20's explicit stress would push: held at 0
 };
 
 // The elastic term of eq. 13 made unilateral: phi(eps) = 0 when slack
@@ -84,10 +84,10 @@ UnilateralStrain UnilateralElasticStrain(double strain, double toe_strain);
 //    printed let the Rayleigh term beta eps_dot act on a slack element, which
 //    then pushes when compressed quickly. Here the elastic term k eps is
 //    phi(eps) (UnilateralElasticStrain), the Rayleigh and smoothing terms
-//    take its slope phi' for k, and an element whose tension (eq. 13) or
-//    smoothed stress (eq. 20, without its q'' part) would be negative carries
-//    no force and no elastic mass. Beyond the toe: eqs. 13 and 20 as
-//    printed, bit for bit.
+//    take its slope phi' for k. A stretched element whose smoothed stress
+//    (eq. 20, without its q'' part) would be negative has it held at 0 and
+//    keeps only the smoothing's added mass; `tension` (eq. 13) is never
+//    below 0. Beyond the toe: eqs. 13 and 20 as printed, bit for bit.
 //  - eq. 20 of the paper prints eps_dot_q^T in front of Q'_e; substituting
 //    eq. 18 into eq. 17 gives eps_q^T, which is what is used here.
 AleElementTerms EvaluateAleElement(const AleElementParams& params, const Vector8d& q,
