@@ -71,8 +71,7 @@ ArmModel::ArmModel(const ArmConfig& arm_config) : arm_(arm_config) {
   }
 
   joint_disk_radius_m_ = JointDiskRadiiM(arm);
-  for (double radius : joint_disk_radius_m_)
-    joint_range_rad_.push_back(2.0 * std::atan(d / (2.0 * radius)));
+  joint_range_rad_ = JointRangesRad(arm);
 
   int offset = 0;
   for (const auto& cable : cables_) {
@@ -107,6 +106,13 @@ std::vector<double> JointDiskRadiiM(const ArmConfig& arm) {
     }
   }
   return radius;
+}
+
+std::vector<double> JointRangesRad(const ArmConfig& arm) {
+  std::vector<double> range;
+  for (double radius : JointDiskRadiiM(arm))
+    range.push_back(2.0 * std::atan(arm.joint_disk_gap_m / (2.0 * radius)));
+  return range;
 }
 
 Eigen::Vector3d ArmModel::p_parent_joint(int joint) const {

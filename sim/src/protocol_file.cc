@@ -337,15 +337,6 @@ class ProtocolReader {
   mutable std::set<std::string> used_;
 };
 
-// Largest bend [rad] of each joint of `arm` (1-based index - 1): where its
-// disks meet (ArmModel::joint_range_rad, docs/model-notes.md row 27).
-std::vector<double> JointBendLimits(const ArmConfig& arm) {
-  std::vector<double> limits;
-  for (double radius : JointDiskRadiiM(arm))
-    limits.push_back(2.0 * std::atan(arm.joint_disk_gap_m / (2.0 * radius)));
-  return limits;
-}
-
 std::string Degrees(double rad) {
   char text[32];
   std::snprintf(text, sizeof(text), "%.4g", rad / kDegToRad);
@@ -513,7 +504,7 @@ Protocol ParseProtocol(const std::string& yaml_text, const std::string& source_n
                  std::to_string(num_segments) + " (give every segment, or 'all')");
     }
   }
-  const std::vector<double> bend_limits = JointBendLimits(arm);
+  const std::vector<double> bend_limits = JointRangesRad(arm);
   int first_joint = 1;
   for (int s = 0; s < num_segments; ++s) {
     const int joints = arm.segments[s].links;

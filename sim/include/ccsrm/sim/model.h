@@ -67,6 +67,10 @@ struct ConnectingPairModel {
 // 2 atan(d / 2R) (ArmModel::joint_range_rad).
 std::vector<double> JointDiskRadiiM(const ArmConfig& arm);
 
+// The range [rad] of each joint of `arm` (index joint - 1): 2 atan(d / 2R)
+// with R from JointDiskRadiiM (ArmModel::joint_range_rad).
+std::vector<double> JointRangesRad(const ArmConfig& arm);
+
 class ArmModel {
  public:
   // Builds the model. Throws InputError if the configuration is invalid.
