@@ -122,8 +122,8 @@ PaperRun PreparePaperRun(const PaperRunOptions& o) {
   if (!(duration > 0.0) || !std::isfinite(duration)) {
     ThrowInputError("--duration", "", "must be > 0 s");
   }
-  CableInputs inputs =
-      protocol ? PlanProtocolInputs(model, *protocol, duration) : std::move(*recorded);
+  CableInputs inputs = protocol ? PlanProtocolInputs(model, *protocol, config.parameters, duration)
+                                : std::move(*recorded);
   SimulationOptions simulation;
   simulation.duration_s = duration;
   simulation.solver = config.solver;
@@ -133,9 +133,11 @@ PaperRun PreparePaperRun(const PaperRunOptions& o) {
                std::move(model),
                std::move(inputs),
                std::move(simulation),
-               o.case_number};
-  run.protocol = std::move(protocol);
-  run.default_protocol = default_protocol;
+               o.case_number,
+               std::move(protocol),
+               default_protocol,
+               /*inputs_source=*/"",
+               /*inputs_note=*/""};
   if (o.recorded_inputs) {
     run.inputs_source = o.recorded_inputs->source_name;
     run.inputs_note = inputs_note;

@@ -138,10 +138,76 @@ void CheckPlannedJointRange(const ArmModel& model, const Eigen::VectorXd& time,
                       " mm the hole circle); ccsrm has no contact between disks");
 }
 
+// Stretch [m] each cable needs beyond its kinematic length for the
+// frictionless arm to rest at `angles` (InputPlanning::kStaticEquilibrium):
+// ΔT·L/EA, with ΔT the least-squares change of the tensions from T_d0 that
+// balances the cables' moments Σ_c T_c ∂L_c/∂Θ on every segment's bending
+// Θ = (θx, θy) of all its joints together. Throws InputError when a cable
+// would need a tension below zero.
+Eigen::VectorXd StaticEquilibriumStretch(const ArmModel& model, const JointAngles& angles,
+                                         double time_s, const InputPlanning& planning,
+                                         const std::string& source) {
+  const int cables = model.num_cables();
+  const int segments = static_cast<int>(model.arm().segments.size());
+  // ∂L_c/∂Θ by central differences. The moments cancel to first order
+  // (Σ_c ∂L_c/∂Θ is second order in the bend), so rounding in the path
+  // lengths (~1e-15 m) is amplified into the tensions: a 1e-3 rad step keeps
+  // it to ~1e-12 of them, where 1e-6 rad left noise of ~1e-11 m in the
+  // planned lengths, 1e-5 m/s² in their splines' second derivative. The
+  // step's truncation, ~δ²/6 = 2e-7 of the moment arms, is smooth in the
+  // plan.
+  constexpr double kStep = 1e-3;
+  Eigen::MatrixXd moment_arm(cables, 2 * segments);
+  int first_joint = 0;
+  for (int s = 0; s < segments; ++s) {
+    const int joints = model.arm().segments[s].links;
+    for (int axis = 0; axis < 2; ++axis) {
+      JointAngles plus = angles, minus = angles;
+      for (int j = first_joint; j < first_joint + joints; ++j) {
+        plus[j][axis] += kStep;
+        minus[j][axis] -= kStep;
+      }
+      const std::vector<LinkPose> poses_plus = ForwardKinematics(model, plus);
+      const std::vector<LinkPose> poses_minus = ForwardKinematics(model, minus);
+      for (int c = 0; c < cables; ++c) {
+        moment_arm(c, 2 * s + axis) =
+            (CablePathLength(model, c, poses_plus) - CablePathLength(model, c, poses_minus)) /
+            (2.0 * kStep);
+      }
+    }
+    first_joint += joints;
+  }
+  // Balance: moment_armᵀ (T_d0 + ΔT) = 0, ΔT of least norm. Straight, the
+  // moment arms of a segment's cables cancel and ΔT = 0.
+  const Eigen::VectorXd unbalanced =
+      planning.pretension_n * moment_arm.transpose() * Eigen::VectorXd::Ones(cables);
+  const Eigen::VectorXd tension_change =
+      -moment_arm.transpose().completeOrthogonalDecomposition().solve(unbalanced);
+  const std::vector<LinkPose> poses = ForwardKinematics(model, angles);
+  const DrivingCableConfig& driving = model.arm().driving;
+  const double axial_stiffness_n = driving.youngs_modulus_pa * driving.cross_section_m2;
+  Eigen::VectorXd stretch(cables);
+  for (int c = 0; c < cables; ++c) {
+    const double tension = planning.pretension_n + tension_change[c];
+    if (!(tension > 0.0)) {
+      ThrowInputError(source, "",
+                      "planning: static_equilibrium needs cable " + std::to_string(c + 1) +
+                          " to push (" + Format("%.3g", tension) +
+                          " N) to hold the plan at t = " + Format("%.3f", time_s) +
+                          " s: raise the pre-tension T_d0 or plan a smaller bend");
+    }
+    // Uniform tension along the frictionless cable: its whole free length
+    // (input point to anchor) stretches.
+    stretch[c] = tension_change[c] * CablePathLength(model, c, poses) / axial_stiffness_n;
+  }
+  return stretch;
+}
+
 }  // namespace
 
 CableInputs PlanCableInputs(const ArmModel& model, const JointTrajectory& trajectory,
-                            double duration_s, double sample_step_s, const std::string& source) {
+                            double duration_s, double sample_step_s, const std::string& source,
+                            const InputPlanning& planning) {
   CCSRM_CHECK(duration_s > 0.0 && sample_step_s > 0.0);
   const int samples = static_cast<int>(std::ceil(duration_s / sample_step_s - 1e-9)) + 1;
   Eigen::VectorXd time(samples);
@@ -160,6 +226,10 @@ CableInputs PlanCableInputs(const ArmModel& model, const JointTrajectory& trajec
     const std::vector<LinkPose> poses = ForwardKinematics(model, plan[k]);
     for (int c = 0; c < model.num_cables(); ++c) {
       change(k, c) = rest_length[c] - CablePathLength(model, c, poses);
+    }
+    if (planning.method == InputPlanning::Method::kStaticEquilibrium) {
+      change.row(k) +=
+          StaticEquilibriumStretch(model, plan[k], time[k], planning, source).transpose();
     }
   }
   return CableInputs(std::move(time), std::move(change));
@@ -324,9 +394,14 @@ JointTrajectory Protocol::Trajectory() const {
   return [protocol = *this](double t) { return protocol.PlannedAngles(t); };
 }
 
-CableInputs PlanProtocolInputs(const ArmModel& model, const Protocol& protocol, double duration_s,
+CableInputs PlanProtocolInputs(const ArmModel& model, const Protocol& protocol,
+                               const ArmParameters& parameters, double duration_s,
                                double sample_step_s) {
-  CableInputs inputs = PlanCableInputs(model, protocol.Trajectory(), duration_s, sample_step_s);
+  InputPlanning planning;
+  planning.method = protocol.planning;
+  planning.pretension_n = parameters.T_d0;
+  CableInputs inputs = PlanCableInputs(model, protocol.Trajectory(), duration_s, sample_step_s,
+                                       protocol.source_name, planning);
   // Speeds and accelerations by central differences of the sampled lengths
   // (second order; rounding adds ~1e-10 m/s² at 1 ms, far below any limit).
   const Eigen::VectorXd& time = inputs.time();

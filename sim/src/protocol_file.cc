@@ -419,7 +419,8 @@ Protocol ParseProtocol(const std::string& yaml_text, const std::string& source_n
   const YAML::Node root = ParseYamlDocument(yaml_text, source_name);
   ProtocolReader r(source_name, options);
   if (!root.IsMap()) r.Fail(root, "", "expected a mapping with schema, segments, ...");
-  r.OnlyKeys(root, "", {"schema", "name", "description", "limits", "parameters", "segments"});
+  r.OnlyKeys(root, "",
+             {"schema", "name", "description", "planning", "limits", "parameters", "segments"});
   const YAML::Node schema = root["schema"];
   if (!schema.IsDefined()) r.Fail(root, "", "missing key 'schema' (ccsrm-protocol/1)");
   if (!schema.IsScalar() || schema.Scalar() != kProtocolSchema) {
@@ -440,6 +441,17 @@ Protocol ParseProtocol(const std::string& yaml_text, const std::string& source_n
     (std::string(field) == "name" ? protocol.name : protocol.description) = node.Scalar();
   }
   r.ReadParameters(root["parameters"]);
+  if (const YAML::Node planning = root["planning"]; planning.IsDefined()) {
+    if (planning.IsScalar() && planning.Scalar() == "kinematic") {
+      protocol.planning = InputPlanning::Method::kKinematic;
+    } else if (planning.IsScalar() && planning.Scalar() == "static_equilibrium") {
+      protocol.planning = InputPlanning::Method::kStaticEquilibrium;
+    } else {
+      r.Fail(planning, "planning",
+             "expected kinematic or static_equilibrium, found '" +
+                 (planning.IsScalar() ? planning.Scalar() : std::string("a collection")) + "'");
+    }
+  }
   const YAML::Node limits = root["limits"];
   if (limits.IsDefined()) {
     r.OnlyKeys(limits, "limits", {"cable_speed_mps", "cable_acceleration_mps2", "joint_bend_deg"});

@@ -75,7 +75,8 @@ inline RoundTripTrial MakeRoundTripTrial(int case_number, const ProtocolConfig& 
   recording.nominal_config_yaml = sim::ToYaml(nominal);
   recording.recording.seed = seed;
   VirtualExperiment generated = MakeVirtualExperiment(
-      sim_io::ToRunFile(model, simulated, {std::to_string(case_number), sim::ToYaml(truth)}),
+      sim_io::ToRunFile(model, simulated,
+                        {std::to_string(case_number), sim::ToYaml(truth), "", ""}),
       DefaultMarkerLayout(model), recording);
   trial.truth = std::move(generated.truth);
   trial.experiment = std::move(generated.experiment);

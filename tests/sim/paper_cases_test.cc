@@ -120,7 +120,7 @@ const CaseRun& RunCase(int case_number, double amplitude_deg) {
   from_config.parameters = PaperProtocolParameters(p);
   const Protocol protocol = LoadProtocol(kPaperProtocol, config.arm, from_config);
   const JointTrajectory plan = protocol.Trajectory();
-  const CableInputs inputs = PlanProtocolInputs(model, protocol, p.duration_s());
+  const CableInputs inputs = PlanProtocolInputs(model, protocol, config.parameters, p.duration_s());
   SimulationOptions options;
   options.duration_s = p.duration_s();
   options.solver = config.solver;

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/sim/config.h"
@@ -81,7 +82,7 @@ TEST(PaperProtocolFile, PlansTheSameAnglesAndInputsAsThePaperTrajectoryToTheBit)
           ASSERT_EQ(a[j].y(), b[j].y()) << "t = " << t << ", joint " << j + 1;
         }
       }
-      ExpectSameInputs(PlanProtocolInputs(model, file, p.duration_s()),
+      ExpectSameInputs(PlanProtocolInputs(model, file, config.parameters, p.duration_s()),
                        PlanCableInputs(model, paper, p.duration_s()));
     }
   }
@@ -136,6 +137,62 @@ TEST(TwoAxisProtocol, BendsSegmentOneInThetaYAndSegmentTwoInThetaXThenSwingsSegm
   EXPECT_GT(swing, 0.95 * kDeg);
   EXPECT_LE(swing, 1.0 * kDeg + 1e-12);
   EXPECT_NEAR(p.PlannedAngles(p.duration_s() + 1.0)[0].y(), 0.0, 1e-15);
+}
+
+TEST(StaticEquilibriumPlanning, PullsTheStretchWhoseTensionsBalanceEveryBentSegment) {
+  const Config config = LoadConfig(kPaperConfig);
+  const ArmModel model(config.arm);
+  const Protocol kinematic = LoadProtocol(kConfigs + "/protocols/two-axis.yaml", config.arm);
+  ASSERT_EQ(kinematic.planning, InputPlanning::Method::kStaticEquilibrium);  // as the file asks
+  InputPlanning balanced;
+  balanced.method = InputPlanning::Method::kStaticEquilibrium;
+  balanced.pretension_n = 100.0;
+  const CableInputs plain = PlanCableInputs(model, kinematic.Trajectory(), 16.0, 1e-3);
+  const CableInputs planned =
+      PlanCableInputs(model, kinematic.Trajectory(), 16.0, 1e-3, "two-axis", balanced);
+  // Straight (t = 0), equal tensions balance: nothing to add but the
+  // rounding of moments that cancel (~1e-15 m).
+  for (int c = 0; c < model.num_cables(); ++c) {
+    EXPECT_NEAR(planned.length_change()(0, c), plain.length_change()(0, c), 1e-13);
+  }
+  // Bent (t = 15 s: segment 1 at θy = 8°, segment 2 at θx = −6°): the
+  // tensions the extra pull implies, T_d0 + EA·Δu/L, have no moment on
+  // either segment's bending, where T_d0 alone has one. Moment arms here by
+  // a step (1e-5 rad) other than the planner's.
+  const JointAngles bent = kinematic.PlannedAngles(15.0);
+  const std::vector<LinkPose> poses = ForwardKinematics(model, bent);
+  const double ea = config.arm.driving.youngs_modulus_pa * config.arm.driving.cross_section_m2;
+  const int k = 15000;
+  ASSERT_EQ(planned.time()[k], 15.0);
+  int bent_axes = 0;  // those on which T_d0 alone has a moment
+  for (int segment = 0; segment < 2; ++segment) {
+    for (int axis = 0; axis < 2; ++axis) {
+      JointAngles plus = bent, minus = bent;
+      for (int j = 6 * segment; j < 6 * segment + 6; ++j) {
+        plus[j][axis] += 1e-5;
+        minus[j][axis] -= 1e-5;
+      }
+      double moment = 0.0, unbalanced = 0.0;
+      for (int c = 0; c < model.num_cables(); ++c) {
+        const double arm = (CablePathLength(model, c, ForwardKinematics(model, plus)) -
+                            CablePathLength(model, c, ForwardKinematics(model, minus))) /
+                           2e-5;
+        const double extra = planned.length_change()(k, c) - plain.length_change()(k, c);
+        const double tension = 100.0 + ea * extra / CablePathLength(model, c, poses);
+        moment += tension * arm;
+        unbalanced += 100.0 * arm;
+      }
+      // Straight the pre-tension's moment is 0; bent 8° or 6° it is first
+      // order in the bend. The balance leaves the two steps' truncation,
+      // ~1e-6 of it.
+      if (std::abs(unbalanced) > 1e-3) {
+        ++bent_axes;
+        EXPECT_LT(std::abs(moment), 1e-5 * std::abs(unbalanced))
+            << "segment " << segment + 1 << " axis " << axis;
+      }
+    }
+  }
+  EXPECT_EQ(bent_axes, 2);  // segment 1 in θy, segment 2 in θx
 }
 
 TEST(ProtocolPieces, RatesAreTheDerivativesOfTheAngles) {
@@ -208,7 +265,7 @@ TEST(ProtocolChecks, RefuseACableFasterThanTheLimitNamingThePiece) {
       "    - step: {to: {theta_x_deg: 10}, rise_s: 0.5, duration_s: 1}\n",
       "p.yaml", config.arm);
   try {
-    PlanProtocolInputs(model, p, p.duration_s());
+    PlanProtocolInputs(model, p, config.parameters, p.duration_s());
     FAIL() << "a 0.11 m/s cable passed";
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr("p.yaml: line 4, key 'segments.all[0].step'"));

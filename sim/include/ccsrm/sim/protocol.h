@@ -56,15 +56,43 @@ class CableInputs {
   std::unique_ptr<Splines> splines_;
 };
 
-// Plans the inputs for a joint trajectory by pure kinematics: samples the
-// trajectory every `sample_step_s` over [0, duration_s] and records
-// L(0) − L(t) for every cable. Throws InputError, labelled `source` (the
-// option or file the motion came from), when a planned joint tilts beyond
-// its range (ArmModel::joint_range_rad): past it the paths through the gap
-// fold and the plan means nothing.
+// How planned joint angles become input lengths (docs/protocols.md,
+// "Planning").
+struct InputPlanning {
+  enum class Method {
+    // SPEC 3, the paper's: the change of each cable's geometric path length,
+    // L(0) − L(t). Every cable keeps its pre-tension, which does not hold a
+    // bent arm in place: the frictionless arm bends past the plan by a
+    // fraction that grows with T_d0 / EA (0.15° at −6° on segment 2 of the
+    // paper's arm).
+    kKinematic,
+    // The kinematic lengths plus each cable's stretch under the tensions
+    // that hold the frictionless arm at the planned state: the smallest
+    // change ΔT from T_d0 (least squares) that balances the cables' moments
+    // on every segment's bending (all its joints together), pulled in as
+    // ΔT·L/EA. Assumes what the frictionless arm does when it follows a plan
+    // slowly: constant curvature per segment, uniform tension along each
+    // cable.
+    kStaticEquilibrium,
+  };
+  Method method = Method::kKinematic;
+  // The driving cables' pre-tension T_d0 [N] (the run's ArmParameters::T_d0);
+  // kStaticEquilibrium only.
+  double pretension_n = 0.0;
+};
+
+// Plans the inputs for a joint trajectory: samples the trajectory every
+// `sample_step_s` over [0, duration_s] and records each cable's pulled-in
+// length by `planning` (by default pure kinematics, L(0) − L(t)). Throws
+// InputError, labelled `source` (the option or file the motion came from),
+// when a planned joint tilts beyond its range (ArmModel::joint_range_rad):
+// past it the paths through the gap fold and the plan means nothing; and,
+// planning for static equilibrium, when a cable would have to push to hold
+// a planned state.
 CableInputs PlanCableInputs(const ArmModel& model, const JointTrajectory& trajectory,
                             double duration_s, double sample_step_s = 1e-3,
-                            const std::string& source = "planned motion");
+                            const std::string& source = "planned motion",
+                            const InputPlanning& planning = {});
 
 // ---------------------------------------------------------------------------
 // Protocol files (ccsrm-protocol/1, docs/protocols.md): per segment a
@@ -134,6 +162,8 @@ struct Protocol {
   // The parameters' values as used (SI: rad, s or Hz), by name.
   std::map<std::string, double> parameters;
   ProtocolLimits limits;
+  // The file's `planning:` (kinematic unless it says static_equilibrium).
+  InputPlanning::Method planning = InputPlanning::Method::kKinematic;
   std::vector<std::vector<ProtocolPiece>> segments;  // [segment][piece]
   std::vector<int> segment_joints;                   // joints of each segment
 
@@ -169,11 +199,13 @@ Protocol LoadProtocol(const std::string& path, const ArmConfig& arm,
 // return_s, rest_s, in SI).
 std::map<std::string, double> PaperProtocolParameters(const ProtocolConfig& protocol);
 
-// The protocol's inputs over [0, duration_s] (PlanCableInputs), checked
-// against limits.cable_speed_mps and cable_acceleration_mps2 (central
-// differences of the sampled lengths). Throws InputError naming the piece
-// active where a limit is exceeded, the cable, the time and the limit.
-CableInputs PlanProtocolInputs(const ArmModel& model, const Protocol& protocol, double duration_s,
+// The protocol's inputs over [0, duration_s] (PlanCableInputs, by the
+// protocol's planning, for an arm with `parameters`), checked against
+// limits.cable_speed_mps and cable_acceleration_mps2 (central differences
+// of the sampled lengths). Throws InputError naming the piece active where
+// a limit is exceeded, the cable, the time and the limit.
+CableInputs PlanProtocolInputs(const ArmModel& model, const Protocol& protocol,
+                               const ArmParameters& parameters, double duration_s,
                                double sample_step_s = 1e-3);
 
 // "'two-axis' (file.yaml), 12 s: segment 1 move, hold, sine; segment 2 ...".
