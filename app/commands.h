@@ -18,4 +18,5 @@ void AddDerivativesCommand(CLI::App& root);
 void AddIdentifyCommand(CLI::App& root);
 void AddLoopCommand(CLI::App& root);
 void AddPredictCommand(CLI::App& root);
+void AddDesignCommand(CLI::App& root);
 }  // namespace ccsrm::app

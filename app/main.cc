@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
   ccsrm::app::AddIdentifyCommand(root);
   ccsrm::app::AddLoopCommand(root);
   ccsrm::app::AddPredictCommand(root);
+  ccsrm::app::AddDesignCommand(root);
   try {
     root.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -96,6 +96,12 @@ OutputKind PredictionFolderOutput() {
           }};
 }
 
+OutputKind DesignFolderOutput() {
+  return {"ccsrm design folder (design.json, ccsrm-design/1)", true, [](const std::string& p) {
+            return FolderJsonHasSchema(p, "design.json", "ccsrm-design/1");
+          }};
+}
+
 OutputKind RenderFolderOutput() {
   return {"ccsrm camera render folder (cameras.yaml, ccsrm-cameras/1)", true,
           [](const std::string& p) {

@@ -21,6 +21,7 @@ OutputKind DerivativesJsonOutput();   // derivatives --json
 OutputKind FitFolderOutput();         // identify: fit.json, schema ccsrm-fit/1
 OutputKind LoopFolderOutput();        // loop: loop.json, schema ccsrm-loop/1
 OutputKind PredictionFolderOutput();  // predict: pred.json, schema ccsrm-prediction/1
+OutputKind DesignFolderOutput();      // design: design.json, schema ccsrm-design/1
 // cameras render: cameras.yaml (ccsrm-cameras/1) with its videos.
 OutputKind RenderFolderOutput();
 // cameras render-board: the checkerboard images (PNG files only).

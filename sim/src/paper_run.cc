@@ -72,6 +72,14 @@ PaperRun PreparePaperRun(const PaperRunOptions& o) {
   }
   const bool default_protocol = o.protocol_path.empty() && !o.recorded_inputs;
   ProtocolOptions protocol_options;
+  if (!o.protocol_parameters.empty()) {
+    if (o.protocol_path.empty()) {
+      ThrowInputError(o.protocol_parameters_source, "",
+                      "protocol parameters apply to a protocol file only");
+    }
+    protocol_options.parameters = o.protocol_parameters;
+    protocol_options.parameters_source = o.protocol_parameters_source;
+  }
   // Overrides are checked with the configuration's own rules, but the
   // message names the option they came from.
   if (!std::isnan(o.amplitude_deg)) {

@@ -140,6 +140,9 @@ class BadInputTable : public ::testing::Test {
           EditedThreeSegment("hole_angle_deg: 280.0", "hole_angle_deg: 100.0"));
     fs::create_directory(d / "confdir");
     Write(d / "p.yaml", "mu: 0.2\n");
+    Write(d / "proto.yaml",
+          "schema: ccsrm-protocol/1\nparameters: {amplitude_deg: 2}\nsegments:\n  all:\n"
+          "    - move: {to: {theta_x_deg: amplitude_deg}, duration_s: 1}\n");
     Write(d / "pbounds.yaml", "mu: {value: 0.5, free: true, bounds: [0.1, 0.3]}\n");
     Write(d / "prange.yaml", "mu: {value: 5, free: true}\n");
     Write(d / "pdup.yaml", "mu: 0.2\nmu_s: 0.3\nmu: 0.25\n");
@@ -308,6 +311,22 @@ const std::vector<BadInput>& Rows() {
       {"overrides",
        "generate --config {d}/c.yaml --amplitude 45 --out {d}/exp2.h5",
        {"--amplitude", "bends joint 1 to 45 deg", "past its 41.71 deg"}},
+      // Experiment design (issue 26): its plans and priors, before any run.
+      {"overrides",
+       "design --free mu,,T_p --plans {d}/proto.yaml --out {d}/design",
+       {"--free", "empty name"}},
+      {"overrides",
+       "design --free mu --plans {d}/proto.yaml@amplitude --out {d}/design",
+       {"--plans", "expected name=value after '@'"}},
+      {"overrides",
+       "design --free mu --plans {d}/proto.yaml@speed_deg=3 --out {d}/design",
+       {"--plans", "speed_deg"}},
+      {"overrides",
+       "design --case 1 --free mu --plans {d}/proto.yaml --out {d}/design",
+       {"--free", "mu", "its prior value is 0"}},
+      {"overrides",
+       "design --free mu --plans {d}/proto.yaml --noise-from {d}/p.yaml --out {d}/design",
+       {"{d}/p.yaml", "not JSON"}},
       // HDF5 files: an experiment is checked against its own config_yaml at
       // every door (inspect, process, identify).
       {"hdf5",

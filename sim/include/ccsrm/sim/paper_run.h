@@ -5,6 +5,7 @@
 // call shared by `ccsrm simulate`, `generate`, `bench`, identification and
 // the tests.
 #include <cmath>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,6 +49,11 @@ struct PaperRunOptions {
   double duration_s = NAN;
   // --protocol: a ccsrm-protocol/1 file; empty: see above.
   std::string protocol_path;
+  // Values of the protocol file's `parameters:` (SI: rad for a name ending
+  // in _deg), as ProtocolOptions::parameters; a name the file does not
+  // declare is refused, blamed on protocol_parameters_source.
+  std::map<std::string, double> protocol_parameters;
+  std::string protocol_parameters_source = "--protocol";
   // --inputs, read by the command (sim_io::ReadRecordedInputs), and how its
   // samples are checked and resampled. Exclusive with protocol_path.
   std::optional<RecordedInputs> recorded_inputs;

@@ -1,0 +1,245 @@
+// ccsrm design --free mu,mu_s,mu_c,T_p --plans PLAN [PLAN ...] [--config arm.yaml] [--case N]
+//              [--params prior.yaml] [--set name=value ...] [--noise-deg D]
+//              [--effective-fraction F] [--frame-rate HZ] [--threads N] --out design/
+//
+// A PLAN is one or more protocol files joined by '+', each optionally with
+// parameter values after '@': "paper.yaml@amplitude_deg=6+paper.yaml@amplitude_deg=-5".
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/common/error.h"
+#include "ccsrm/common/number_text.h"
+#include "ccsrm/identify/design.h"
+#include "ccsrm/sim/paper_run.h"
+#include "commands.h"
+#include "fit_inputs.h"
+#include "option_checks.h"
+#include "output_kinds.h"
+
+namespace ccsrm::app {
+namespace {
+
+struct DesignArgs {
+  std::string config;
+  int case_number = 0;
+  std::string params;
+  std::vector<std::string> set;
+  std::string free;
+  std::vector<std::string> plans;
+  double noise_deg = identify::DesignOptions().noise_deg;
+  double effective_fraction = identify::DesignOptions().effective_sample_fraction;
+  double frame_rate_hz = identify::DesignOptions().frame_rate_hz;
+  int threads = identify::DesignOptions().threads;
+  std::string noise_from;
+  std::string out;
+  bool quiet = false;
+};
+
+std::vector<std::string> Split(const std::string& text, char separator) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t end = text.find(separator, start);
+    parts.push_back(text.substr(start, end == std::string::npos ? std::string::npos : end - start));
+    if (end == std::string::npos) return parts;
+    start = end + 1;
+  }
+}
+
+// One experiment of a plan: "file.yaml" or "file.yaml@name=value,name=value".
+identify::PlannedExperiment PlanExperiment(const std::string& spec, const DesignArgs& a) {
+  const std::string where = "--plans '" + spec + "'";
+  const std::size_t at = spec.find('@');
+  sim::PaperRunOptions run;
+  run.config_path = a.config;
+  run.case_number = a.case_number;
+  run.params_path = a.params;
+  run.sets = a.set;
+  run.protocol_path = spec.substr(0, at);
+  run.protocol_parameters_source = where;
+  if (run.protocol_path.empty()) ThrowInputError(where, "", "names no protocol file");
+  if (at != std::string::npos) {
+    for (const std::string& assignment : Split(spec.substr(at + 1), ',')) {
+      const std::size_t eq = assignment.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        ThrowInputError(where, "", "expected name=value after '@', found '" + assignment + "'");
+      }
+      const std::string name = assignment.substr(0, eq);
+      double value = 0.0;
+      const std::string problem = ParseNumberText(assignment.substr(eq + 1), &value);
+      if (!problem.empty()) ThrowInputError(where, name, problem);
+      // Protocol parameters are given in the file's units (deg for _deg).
+      const bool degrees = name.size() > 4 && name.compare(name.size() - 4, 4, "_deg") == 0;
+      run.protocol_parameters[name] = degrees ? value * M_PI / 180.0 : value;
+    }
+  }
+  sim::PaperRun prepared = sim::PreparePaperRun(run);
+  identify::PlannedExperiment e;
+  e.name = spec;
+  e.duration_s = prepared.simulation.duration_s;
+  e.config = prepared.config;
+  e.model = std::make_shared<const sim::ArmModel>(std::move(prepared.model));
+  e.inputs = std::make_shared<const sim::CableInputs>(std::move(prepared.inputs));
+  return e;
+}
+
+// The noise of recordings like those an earlier fit saw (its fit.json):
+// the RMS of its experiments' per-joint noise times the root of its
+// residual variance (what the residuals were, against that noise), and its
+// effective samples per residual.
+void NoiseFromFit(const std::string& path, identify::DesignOptions* options) {
+  nlohmann::json fit;
+  try {
+    fit = nlohmann::json::parse(ReadTextFile(path));
+  } catch (const nlohmann::json::exception& e) {
+    ThrowInputError(path, "", std::string("not JSON: ") + e.what());
+  }
+  if (!fit.is_object() || fit.value("schema", "") != "ccsrm-fit/1") {
+    ThrowInputError(path, "schema", "expected a fit.json of ccsrm identify (ccsrm-fit/1)");
+  }
+  const auto number = [&](const char* key) {
+    if (!fit.contains(key) || !fit[key].is_number() || !std::isfinite(fit[key].get<double>())) {
+      ThrowInputError(path, key, "missing or not a finite number");
+    }
+    return fit[key].get<double>();
+  };
+  const double residuals = number("residuals"), effective = number("effective_samples");
+  const double variance = number("residual_variance");
+  if (!(residuals > 0.0) || !(effective > 0.0) || effective > residuals || !(variance > 0.0)) {
+    ThrowInputError(path, "effective_samples",
+                    "needs 0 < effective_samples <= residuals and residual_variance > 0");
+  }
+  double sum = 0.0;
+  int count = 0;
+  if (fit.contains("experiments") && fit["experiments"].is_array()) {
+    for (const nlohmann::json& e : fit["experiments"]) {
+      if (!e.contains("noise_deg") || !e["noise_deg"].is_array()) continue;
+      for (const nlohmann::json& v : e["noise_deg"]) {
+        if (v.is_number() && v.get<double>() > 0.0) {
+          sum += v.get<double>() * v.get<double>();
+          ++count;
+        }
+      }
+    }
+  }
+  if (count == 0) ThrowInputError(path, "experiments[].noise_deg", "no noise recorded");
+  options->noise_deg = std::sqrt(sum / count * variance);
+  options->effective_sample_fraction = effective / residuals;
+}
+
+int RunDesign(const DesignArgs& a) {
+  identify::DesignOptions options;
+  options.free_parameters = Split(a.free, ',');
+  for (const std::string& name : options.free_parameters) {
+    if (name.empty()) ThrowInputError("--free", "", "has an empty name: give mu,mu_s,...");
+  }
+  options.noise_deg = a.noise_deg;
+  options.effective_sample_fraction = a.effective_fraction;
+  options.frame_rate_hz = a.frame_rate_hz;
+  options.threads = a.threads;
+  if (!a.noise_from.empty()) NoiseFromFit(a.noise_from, &options);
+  std::string error;
+  if (!options.IsValid(&error)) ThrowInputError("--free", "", error);
+  std::vector<std::string> inputs = {a.config, a.params, a.noise_from};
+  std::vector<identify::DesignCandidate> candidates;
+  for (const std::string& plan : a.plans) {
+    identify::DesignCandidate candidate;
+    candidate.name = plan;
+    for (const std::string& spec : Split(plan, '+')) {
+      candidate.experiments.push_back(PlanExperiment(spec, a));
+      inputs.push_back(spec.substr(0, spec.find('@')));
+    }
+    candidates.push_back(std::move(candidate));
+  }
+  CheckOut(a.out, DesignFolderOutput(), inputs);
+  std::printf("design: %zu plan%s, free %s, on %d thread%s\n", candidates.size(),
+              candidates.size() == 1 ? "" : "s", a.free.c_str(), options.threads,
+              options.threads == 1 ? "" : "s");
+  std::fflush(stdout);
+  if (!a.quiet) options.on_run = RunProgress();
+  const identify::DesignSummary summary = identify::EvaluateDesigns(candidates, options);
+  std::printf("%s", summary.FullReport().c_str());
+  AtomicOutputDirectory out(a.out);
+  WriteTextFileAtomically((std::filesystem::path(out.temp_path()) / "design.json").string(),
+                          identify::ToJson(summary).dump(2) + "\n");
+  out.Commit();
+  std::printf("  output: %s/design.json\n", a.out.c_str());
+  for (const identify::CandidateInformation& c : summary.candidates) {
+    if (!c.completed) {
+      std::fprintf(stderr, "ccsrm: plan '%s' was not evaluated: %s (outputs written)\n",
+                   c.name.c_str(), c.message.c_str());
+      return 3;
+    }
+  }
+  return 0;
+}
+
+// Options valid but for the field checked (DesignOptions needs a free
+// parameter to be valid at all).
+identify::DesignOptions Checkable() {
+  identify::DesignOptions options;
+  options.free_parameters = {"mu"};
+  return options;
+}
+
+}  // namespace
+
+void AddDesignCommand(CLI::App& root) {
+  CLI::App* cmd = root.add_subcommand(
+      "design",
+      "Rank plans of motions by the standard errors a fit of their recordings would give: the "
+      "Fisher information of the identification's residuals at the prior values, summed over "
+      "each plan's experiments (writes design.json; exit 3 if a plan could not be evaluated)");
+  auto a = std::make_shared<DesignArgs>();
+  cmd->add_option("--free", a->free, "Parameters a fit would free, comma-separated")->required();
+  cmd->add_option("--plans", a->plans,
+                  "Candidate plans, one or more: protocol files joined by '+' (one experiment "
+                  "each), each with optional parameter values after '@' "
+                  "(paper.yaml@amplitude_deg=6+paper.yaml@amplitude_deg=-5)")
+      ->required()
+      ->expected(1, -1);
+  cmd->add_option("--config", a->config,
+                  "Arm configuration (YAML); default: the bundled paper.yaml");
+  cmd->add_option("--case", a->case_number,
+                  "Paper case whose friction the prior takes: 1 no friction, 2 all friction, "
+                  "3 driving cables only, 4 connecting cables only")
+      ->check(CLI::Range(1, 4));
+  cmd->add_option("--params", a->params, "YAML file of prior values (name: value)");
+  cmd->add_option("--set", a->set, "Prior value, name=value (repeatable, after --params)");
+  CLI::Option* noise_option =
+      cmd->add_option("--noise-deg", a->noise_deg,
+                      "Standard deviation of every measured joint angle [deg]")
+          ->capture_default_str()
+          ->check(Above(0.0, "deg"));
+  CLI::Option* fraction_option =
+      cmd->add_option("--effective-fraction", a->effective_fraction,
+                      "N_eff / N of the recordings' residuals (a fit.json's effective_samples / "
+                      "residuals; 1: white noise)")
+          ->capture_default_str()
+          ->check(CLI::Range(1e-6, 1.0));
+  cmd->add_option("--noise-from", a->noise_from,
+                  "A fit.json of recordings like those planned: their noise (times the root of "
+                  "the fit's residual variance) and N_eff / N, instead of --noise-deg and "
+                  "--effective-fraction")
+      ->excludes(noise_option)
+      ->excludes(fraction_option);
+  cmd->add_option("--frame-rate", a->frame_rate_hz, "Mocap frames per second [Hz]")
+      ->capture_default_str()
+      ->check(Above(0.0, "Hz"));
+  cmd->add_option("--threads", a->threads, "Simulations at a time (default: every core)")
+      ->check(ValidIn(&identify::DesignOptions::threads, Checkable()));
+  cmd->add_option("--out", a->out, "Output folder")->required();
+  cmd->add_flag("--quiet", a->quiet, "No progress lines");
+  cmd->callback([a] {
+    const int code = RunDesign(*a);
+    if (code != 0) throw CLI::RuntimeError(code);
+  });
+}
+
+}  // namespace ccsrm::app

@@ -1,0 +1,133 @@
+#pragma once
+// Experiment design (issue 26): how well a plan of motions would pin the
+// free parameters down, before anything is recorded.
+//
+// A plan is one or more planned experiments (a motion driving the arm,
+// recorded at the mocap rate). Its information about the free parameters is
+// the Fisher information JᵀΣ⁻¹J of the identification's own residuals: J is
+// the Jacobian of the simulated joint angles at the plan's frames with
+// respect to the free parameters at their prior values (the
+// identification's central finite differences, ccsrm::identify::Identify),
+// Σ the measurement noise (white, noise_deg on every angle, the effective
+// samples N_eff/N applied as the identification applies them), summed over
+// the plan's experiments. Its inverse is the covariance a fit of such
+// recordings would report to first order.
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ccsrm/identify/sensitivity.h"
+#include "ccsrm/identify/simulation_backend.h"
+#include "ccsrm/sim/config.h"
+#include "ccsrm/sim/model.h"
+#include "ccsrm/sim/protocol.h"
+
+namespace ccsrm::identify {
+
+// One experiment of a plan: a motion and the arm it drives.
+struct PlannedExperiment {
+  std::string name;  // e.g. "paper.yaml (amplitude_deg = 6)"
+  // The arm's configuration, its parameters at the prior values (those of
+  // the free parameters are where the information is evaluated).
+  sim::Config config;
+  std::shared_ptr<const sim::ArmModel> model;
+  std::shared_ptr<const sim::CableInputs> inputs;
+  double duration_s = 0.0;  // recorded from 0 to this time [s]
+};
+
+// A candidate plan: experiments recorded and fitted together.
+struct DesignCandidate {
+  std::string name;
+  std::vector<PlannedExperiment> experiments;
+};
+
+struct DesignOptions {
+  // The parameters a fit would free, by name (sim::Parameters()). Required.
+  std::vector<std::string> free_parameters;
+  // Standard deviation of every measured joint angle [deg]. Default: the
+  // 0.03 deg floor of 0.2 mm marker noise, which identification also uses
+  // when a recording says nothing better.
+  double noise_deg = kMocapNoiseFloorDeg;
+  // N_eff / N of the recordings' residuals: below 1 when the noise of
+  // successive frames is correlated (a low-pass, drifting markers), which
+  // identification measures and corrects for; a fit.json of a lab's own
+  // recordings gives it as effective_samples / residuals. Default 1: white
+  // noise.
+  double effective_sample_fraction = 1.0;
+  // Mocap frames per second: the samples a fit compares. Default 100.
+  double frame_rate_hz = 100.0;
+  // The identification's relative finite-difference step. Default 1e-2.
+  double relative_step = 1e-2;
+  int threads = DefaultThreads();
+  // Another backend for the simulations (null: threads on this machine).
+  std::shared_ptr<SimulationBackend> backend;
+  // Called after every simulation; may be empty.
+  RunFinishedCallback on_run;
+
+  // False with the reason naming the field: no free parameter, an unknown or
+  // repeated name, noise_deg or frame_rate_hz not positive,
+  // effective_sample_fraction outside (0, 1], relative_step outside (0, 0.1],
+  // threads < 1.
+  bool IsValid(std::string* error) const;
+};
+
+// What a candidate plan would tell about the free parameters.
+struct CandidateInformation {
+  std::string name;
+  std::vector<std::string> experiments;
+  double duration_s = 0.0;              // total recording time [s]
+  std::size_t samples = 0;              // measured angles compared (N)
+  bool completed = false;               // every run completed
+  std::string message;                  // why not
+  std::vector<std::string> parameters;  // the free parameters, in the options' order
+  std::vector<double> prior;            // their values
+  // Predicted standard error of each, in its units, and relative to its
+  // prior value; inf along a direction the plan does not inform at all.
+  std::vector<double> std_error;
+  std::vector<double> relative_std_error;
+  // The largest relative standard error, and whose (the default criterion).
+  double worst_relative_std_error = 0.0;
+  std::string worst_parameter;
+  // Over the relative covariance C (parameters relative to their priors):
+  // D-criterion det(C)^(1/p) (the geometric mean of its eigenvalues: the
+  // volume of the confidence ellipsoid) and A-criterion trace(C)/p (the mean
+  // variance), both as a standard error: their square roots.
+  double d_criterion = 0.0;
+  double a_criterion = 0.0;
+  // The worst-determined direction: C's largest eigenvalue (its square root,
+  // a relative standard error) and eigenvector, largest component first.
+  double worst_direction_relative_std_error = 0.0;
+  std::vector<std::pair<std::string, double>> worst_direction;
+  // Fisher information in relative units (C = its inverse), p × p.
+  Eigen::MatrixXd fisher_relative;
+  std::int64_t simulations = 0;
+};
+
+struct DesignSummary {
+  std::vector<CandidateInformation> candidates;  // in the order given
+  std::vector<std::size_t> ranking;  // candidate indices, smallest worst relative error first
+  DesignOptions options;
+  int threads = 0;
+  std::int64_t simulations = 0;
+  double wall_time_s = 0.0;
+
+  // The table: a row per candidate in rank order, a column per parameter.
+  std::string FullReport() const;
+};
+
+// Evaluates every candidate at the prior. Throws InputError for invalid
+// options, a free parameter whose prior value is 0 (its relative error has
+// no meaning: give a prior), or a candidate without experiments. A run
+// that diverges is reported in the candidate (completed = false), not
+// thrown.
+DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
+                              const DesignOptions& options);
+
+// design.json (schema ccsrm-design/1): every number of the summary.
+nlohmann::json ToJson(const DesignSummary& summary);
+
+}  // namespace ccsrm::identify
