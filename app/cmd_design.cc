@@ -37,6 +37,8 @@ struct DesignArgs {
   double frame_rate_hz = identify::DesignOptions().frame_rate_hz;
   int threads = identify::DesignOptions().threads;
   std::string noise_from;
+  bool propose = false;
+  identify::ProposalSpace space;
   std::string out;
   bool quiet = false;
 };
@@ -146,6 +148,11 @@ int RunDesign(const DesignArgs& a) {
   if (!a.noise_from.empty()) NoiseFromFit(a.noise_from, &options);
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError("--free", "", error);
+  std::string space_error;
+  if (a.propose && !a.space.IsValid(&space_error)) ThrowInputError("--propose", "", space_error);
+  if (!a.propose && a.plans.empty()) {
+    ThrowInputError("--plans", "", "give the plans to compare, or --propose (or both)");
+  }
   std::vector<std::string> inputs = {a.config, a.params, a.noise_from};
   std::vector<identify::DesignCandidate> candidates;
   for (const std::string& plan : a.plans) {
@@ -163,13 +170,41 @@ int RunDesign(const DesignArgs& a) {
               options.threads == 1 ? "" : "s");
   std::fflush(stdout);
   if (!a.quiet) options.on_run = RunProgress();
-  const identify::DesignSummary summary = identify::EvaluateDesigns(candidates, options);
+  std::vector<std::string> skipped;
+  identify::DesignSummary summary;
+  if (a.propose) {
+    // The prior: the arm with the case, --params and --set, as a plan's.
+    sim::PaperRunOptions prior;
+    prior.config_path = a.config;
+    prior.case_number = a.case_number;
+    prior.params_path = a.params;
+    prior.sets = a.set;
+    summary = identify::ProposeDesign(sim::PreparePaperRun(prior).config, a.space, candidates,
+                                      options, &skipped);
+  } else {
+    summary = identify::EvaluateDesigns(candidates, options);
+  }
   std::printf("%s", summary.FullReport().c_str());
+  for (const std::string& why : skipped) std::printf("  left out: %s\n", why.c_str());
   AtomicOutputDirectory out(a.out);
-  WriteTextFileAtomically((std::filesystem::path(out.temp_path()) / "design.json").string(),
-                          identify::ToJson(summary).dump(2) + "\n");
+  const std::filesystem::path tmp(out.temp_path());
+  WriteTextFileAtomically((tmp / "design.json").string(), identify::ToJson(summary).dump(2) + "\n");
+  // The best proposed motion, ready for the lab and for `ccsrm generate`.
+  const identify::CandidateInformation* best = nullptr;
+  for (const std::size_t k : summary.ranking) {
+    const identify::CandidateInformation& c = summary.candidates[k];
+    if (c.completed && !c.protocol_yaml.empty()) {
+      best = &c;
+      break;
+    }
+  }
+  if (best != nullptr)
+    WriteTextFileAtomically((tmp / "proposed.yaml").string(), best->protocol_yaml);
   out.Commit();
   std::printf("  output: %s/design.json\n", a.out.c_str());
+  if (best != nullptr) {
+    std::printf("  proposed: %s/proposed.yaml (%s)\n", a.out.c_str(), best->name.c_str());
+  }
   for (const identify::CandidateInformation& c : summary.candidates) {
     if (!c.completed) {
       std::fprintf(stderr, "ccsrm: plan '%s' was not evaluated: %s (outputs written)\n",
@@ -202,8 +237,20 @@ void AddDesignCommand(CLI::App& root) {
                   "Candidate plans, one or more: protocol files joined by '+' (one experiment "
                   "each), each with optional parameter values after '@' "
                   "(paper.yaml@amplitude_deg=6+paper.yaml@amplitude_deg=-5)")
-      ->required()
       ->expected(1, -1);
+  cmd->add_flag("--propose", a->propose,
+                "Also search reversal motions (every segment between +A and -A, --amplitudes x "
+                "--move-times, segments together and opposed) filling --budget-s, and write the "
+                "best as proposed.yaml");
+  cmd->add_option("--budget-s", a->space.budget_s, "Recording time of a proposed plan [s]")
+      ->capture_default_str()
+      ->check(Above(0.0, "s"));
+  cmd->add_option("--amplitudes", a->space.amplitudes_deg, "Amplitudes A the proposal tries [deg]")
+      ->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--move-times", a->space.move_times_s, "Times of one move the proposal tries [s]")
+      ->delimiter(',')
+      ->capture_default_str();
   cmd->add_option("--config", a->config,
                   "Arm configuration (YAML); default: the bundled paper.yaml");
   cmd->add_option("--case", a->case_number,

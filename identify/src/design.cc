@@ -92,6 +92,7 @@ DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
     }
     CandidateInformation info;
     info.name = candidate.name;
+    info.protocol_yaml = candidate.protocol_yaml;
     info.parameters = options.free_parameters;
     std::vector<Experiment> experiments;
     for (const PlannedExperiment& planned : candidate.experiments) {
@@ -222,6 +223,98 @@ DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
   return summary;
 }
 
+bool ProposalSpace::IsValid(std::string* error) const {
+  const auto fail = [error](const std::string& why) {
+    if (error != nullptr) *error = why;
+    return false;
+  };
+  if (amplitudes_deg.empty()) return fail("amplitudes_deg: none given");
+  if (move_times_s.empty()) return fail("move_times_s: none given");
+  for (const double a : amplitudes_deg) {
+    if (!(a > 0.0) || !std::isfinite(a)) return fail("amplitudes_deg: each must be > 0");
+  }
+  for (const double m : move_times_s) {
+    if (!(m > 0.0) || !std::isfinite(m)) return fail("move_times_s: each must be > 0");
+  }
+  if (!(hold_s >= 0.0) || !std::isfinite(hold_s)) return fail("hold_s must be >= 0");
+  const double shortest = *std::min_element(move_times_s.begin(), move_times_s.end());
+  if (!(budget_s >= 2.0 * (shortest + hold_s)) || !std::isfinite(budget_s)) {
+    return fail("budget_s must hold at least two moves and holds (" +
+                Format("%.3g", 2.0 * (shortest + hold_s)) + " s)");
+  }
+  return true;
+}
+
+std::string ReversalProtocolYaml(double amplitude_deg, double move_s, bool opposed,
+                                 const ProposalSpace& space, int segments, std::string* name) {
+  const int moves = static_cast<int>(std::floor(space.budget_s / (move_s + space.hold_s) + 1e-9));
+  *name = "reversals A=" + Format("%g", amplitude_deg) + " move=" + Format("%g", move_s) +
+          (opposed ? " opposed" : "");
+  std::string text = "schema: ccsrm-protocol/1\nname: " + *name +
+                     "\ndescription: every segment swings between +" + Format("%g", amplitude_deg) +
+                     " and -" + Format("%g", amplitude_deg) + " deg in theta_x, " +
+                     std::to_string(moves) + " moves of " + Format("%g", move_s) + " s" +
+                     (opposed ? ", neighbouring segments in opposite directions" : "") +
+                     " (ccsrm design)\nsegments:\n";
+  for (int s = 0; s < (opposed ? segments : 1); ++s) {
+    text += opposed ? "  " + std::to_string(s + 1) + ":\n" : std::string("  all:\n");
+    const double sign = (opposed && s % 2 == 1) ? -1.0 : 1.0;
+    for (int k = 0; k < moves; ++k) {
+      // +A, −A, +A, ... and the last move back to straight.
+      const double target = k + 1 == moves ? 0.0 : sign * (k % 2 == 0 ? 1.0 : -1.0) * amplitude_deg;
+      text += "    - move: {to: {theta_x_deg: " + Format("%.17g", target + 0.0) +
+              "}, duration_s: " + Format("%.17g", move_s) + "}\n";
+      text += "    - hold: {duration_s: " + Format("%.17g", space.hold_s) + "}\n";
+    }
+  }
+  return text;
+}
+
+PlannedExperiment PlanExperiment(const sim::Config& prior, const sim::Protocol& protocol,
+                                 const std::string& name) {
+  PlannedExperiment e;
+  e.name = name;
+  e.config = prior;
+  auto model = std::make_shared<sim::ArmModel>(prior.arm);
+  e.duration_s = protocol.duration_s();
+  e.inputs = std::make_shared<const sim::CableInputs>(
+      sim::PlanProtocolInputs(*model, protocol, prior.parameters, e.duration_s));
+  e.model = std::move(model);
+  return e;
+}
+
+DesignSummary ProposeDesign(const sim::Config& prior, const ProposalSpace& space,
+                            const std::vector<DesignCandidate>& given, const DesignOptions& options,
+                            std::vector<std::string>* skipped) {
+  std::string error;
+  if (!space.IsValid(&error)) ThrowInputError("design proposal space", "", error);
+  std::vector<DesignCandidate> candidates = given;
+  const int segments = static_cast<int>(prior.arm.segments.size());
+  for (const bool opposed : {false, true}) {
+    if (opposed && (!space.opposed_segments || segments < 2)) continue;
+    for (const double amplitude : space.amplitudes_deg) {
+      for (const double move_s : space.move_times_s) {
+        if (space.budget_s < 2.0 * (move_s + space.hold_s)) continue;
+        std::string name;
+        const std::string text =
+            ReversalProtocolYaml(amplitude, move_s, opposed, space, segments, &name);
+        try {
+          const sim::Protocol protocol = sim::ParseProtocol(text, name, prior.arm);
+          DesignCandidate candidate;
+          candidate.name = name;
+          candidate.protocol_yaml = text;
+          candidate.experiments.push_back(PlanExperiment(prior, protocol, name));
+          candidates.push_back(std::move(candidate));
+        } catch (const InputError& e) {
+          // Past the joints' range or the cable limits: not a motion to run.
+          if (skipped != nullptr) skipped->push_back(e.what());
+        }
+      }
+    }
+  }
+  return EvaluateDesigns(candidates, options);
+}
+
 std::string DesignSummary::FullReport() const {
   std::string out;
   out += "design: " + std::to_string(candidates.size()) + " candidate plan" +
@@ -295,6 +388,7 @@ nlohmann::json ToJson(const DesignSummary& s) {
     }
     candidates.push_back(
         {{"name", c.name},
+         {"protocol_yaml", c.protocol_yaml},
          {"experiments", c.experiments},
          {"duration_s", c.duration_s},
          {"samples", c.samples},

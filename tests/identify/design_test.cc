@@ -101,6 +101,35 @@ TEST(Design, InformationAddsOverAPlansExperiments) {
   EXPECT_NEAR(quiet.candidates[0].std_error[1], 0.5 * once.std_error[1], 1e-9 * once.std_error[1]);
 }
 
+TEST(Design, ProposesMotionsWithinTheJointsRangeAndWritesWhatItEvaluated) {
+  const sim::Config prior = Nominal();
+  ProposalSpace space;
+  space.amplitudes_deg = {4.0, 45.0};  // 45° is past the paper arm's 41.7° range
+  space.move_times_s = {1.0};
+  space.hold_s = 0.5;
+  space.budget_s = 3.0;  // two moves: out to A, back to straight
+  std::vector<std::string> skipped;
+  const DesignSummary design = ProposeDesign(prior, space, {}, Options(), &skipped);
+  // Together and opposed at 4°; both at 45° refused by the protocol checks.
+  ASSERT_EQ(design.candidates.size(), 2u);
+  ASSERT_EQ(skipped.size(), 2u);
+  EXPECT_THAT(skipped[0], ::testing::HasSubstr("past its 41.71 deg"));
+  for (const CandidateInformation& c : design.candidates) {
+    ASSERT_TRUE(c.completed) << c.message;
+    EXPECT_DOUBLE_EQ(c.duration_s, 3.0);
+    // The text written out (proposed.yaml) is the motion evaluated: its
+    // inputs again, to the bit.
+    const sim::Protocol again = sim::ParseProtocol(c.protocol_yaml, "proposed.yaml", prior.arm);
+    const sim::ArmModel model(prior.arm);
+    const sim::CableInputs planned =
+        sim::PlanProtocolInputs(model, again, prior.parameters, again.duration_s());
+    const PlannedExperiment evaluated = PlanExperiment(prior, again, c.name);
+    EXPECT_EQ(planned.length_change(), evaluated.inputs->length_change()) << c.name;
+    EXPECT_THAT(c.protocol_yaml, ::testing::HasSubstr("theta_x_deg: 4}"));
+  }
+  EXPECT_THAT(design.candidates[1].name, ::testing::HasSubstr("opposed"));
+}
+
 TEST(Design, RefusesAPriorOfZeroAndAPlanWithoutExperiments) {
   const sim::ArmParameters truth = Truth();
   const Experiment recording = MakeExperiment(Record(truth, 0.03, 1), "seed1.h5", {});

@@ -43,6 +43,8 @@ struct PlannedExperiment {
 struct DesignCandidate {
   std::string name;
   std::vector<PlannedExperiment> experiments;
+  // The protocol text of a proposed plan (ProposeDesign), to write out.
+  std::string protocol_yaml;
 };
 
 struct DesignOptions {
@@ -78,6 +80,7 @@ struct DesignOptions {
 // What a candidate plan would tell about the free parameters.
 struct CandidateInformation {
   std::string name;
+  std::string protocol_yaml;  // a proposed plan's protocol; empty for a given one
   std::vector<std::string> experiments;
   double duration_s = 0.0;              // total recording time [s]
   std::size_t samples = 0;              // measured angles compared (N)
@@ -119,6 +122,36 @@ struct DesignSummary {
   std::string FullReport() const;
 };
 
+// The motions ProposeDesign searches: every segment swings between +A and
+// −A in θx along quintic moves of move_s, holding hold_s after each, as
+// many moves as fill budget_s, the last back to straight. Reversals make
+// the cables slide both ways through their holes and stop between, where
+// the static and kinetic friction and the pre-tension show.
+struct ProposalSpace {
+  std::vector<double> amplitudes_deg = {5.0, 10.0, 20.0};  // A
+  std::vector<double> move_times_s = {2.0, 4.0, 8.0};      // move_s
+  // Also try the segments swinging in opposite directions (segment 2 at −A
+  // while segment 1 is at +A, ...).
+  bool opposed_segments = true;
+  double hold_s = 1.0;
+  double budget_s = 24.0;  // the recording's length [s]
+
+  // False with the reason naming the field: an empty list, a value not
+  // positive, budget_s shorter than two moves and holds.
+  bool IsValid(std::string* error) const;
+};
+
+// The protocol (ccsrm-protocol/1 text) of one point of the space on an arm
+// of `segments` segments; its name says the point ("reversals A=10 move=4
+// opposed").
+std::string ReversalProtocolYaml(double amplitude_deg, double move_s, bool opposed,
+                                 const ProposalSpace& space, int segments, std::string* name);
+
+// One experiment of `protocol` on the arm of `prior` (its parameters the
+// prior), recorded over the protocol's duration.
+PlannedExperiment PlanExperiment(const sim::Config& prior, const sim::Protocol& protocol,
+                                 const std::string& name);
+
 // Evaluates every candidate at the prior. Throws InputError for invalid
 // options, a free parameter whose prior value is 0 (its relative error has
 // no meaning: give a prior), or a candidate without experiments. A run
@@ -126,6 +159,14 @@ struct DesignSummary {
 // thrown.
 DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
                               const DesignOptions& options);
+
+// Evaluates every point of `space` as a plan of one experiment on the arm of
+// `prior`, after `given` (plans to compare with). A point whose protocol the
+// checks refuse (a bend past the joints' range, a cable faster than the
+// protocol limits) is left out and listed in *skipped with the reason.
+DesignSummary ProposeDesign(const sim::Config& prior, const ProposalSpace& space,
+                            const std::vector<DesignCandidate>& given, const DesignOptions& options,
+                            std::vector<std::string>* skipped);
 
 // design.json (schema ccsrm-design/1): every number of the summary.
 nlohmann::json ToJson(const DesignSummary& summary);
