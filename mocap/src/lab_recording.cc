@@ -92,6 +92,9 @@ std::string AssembledRecording::Report() const {
   if (clock.drift_sigma > 0.0)
     out += ", drift ± " + Format("%.3g", clock.drift_sigma * 1e6) + " ppm";
   out += "\n  " + clock.note + "\n";
+  if (!kinematic_check.empty()) {
+    out += std::string(misaligned ? "warning: " : "  ") + kinematic_check + "\n";
+  }
   const datasets::ExperimentFile& e = processed.experiment;
   out += "inputs: " + std::to_string(e.input_length_change.shape[1]) + " cable(s) resampled onto " +
          std::to_string(e.input_time.size()) + " mocap frames (linear interpolation)\n";
@@ -193,6 +196,31 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
     }
   }
 
+  if (request.sync != ClockSync::kEstimate && experiment.measured_joint_angles) {
+    // The joint angles as a second witness: where they put the log, at the
+    // middle of the recording, against the alignment used.
+    const double t_mid = 0.5 * (mocap_time.front() + mocap_time.back());
+    const double frame_s = (mocap_time.back() - mocap_time.front()) /
+                           static_cast<double>(std::max<std::size_t>(1, mocap_time.size() - 1));
+    try {
+      const ClockFit kinematic = AlignByKinematics(
+          model, mocap_time, experiment.measured_joint_angles->values, log.time_s,
+          log.length_change_m, request.estimate, request.markers + " + " + request.actuators);
+      const double difference = kinematic.LogTime(t_mid) - out.clock.LogTime(t_mid);
+      const double sigma = std::hypot(kinematic.offset_sigma_s, out.clock.offset_sigma_s);
+      const double limit = std::max(4.0 * sigma, 2.0 * frame_s);
+      out.misaligned = std::abs(difference) > limit;
+      out.kinematic_check =
+          "kinematic check: the joint angles put the log " + Format("%+.1f", difference * 1e3) +
+          " ms from this alignment (± " + Format("%.2g", sigma * 1e3) + " ms)" +
+          (out.misaligned ? ", more than the " + Format("%.3g", limit * 1e3) +
+                                " ms a correct alignment allows: check the trigger or the offset"
+                          : ": consistent");
+    } catch (const InputError& e) {
+      out.kinematic_check = std::string("kinematic check not possible: ") + e.what();
+    }
+  }
+
   const Eigen::MatrixXd lengths = ResampleOntoMocapTimes(out.clock, mocap_time, log.time_s,
                                                          log.length_change_m, request.actuators);
   experiment.input_time = experiment.mocap_time;
@@ -215,7 +243,7 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
   alignment.offset_uncertainty_s = out.clock.offset_sigma_s;
   alignment.drift_ppm = out.clock.drift * 1e6;
   alignment.drift_uncertainty_ppm = out.clock.drift_sigma * 1e6;
-  alignment.note = out.clock.note;
+  alignment.note = out.clock.note + (out.kinematic_check.empty() ? "" : "; " + out.kinematic_check);
   experiment.clock_alignment = alignment;
   datasets::ValidateExperimentFile(experiment, request.markers);
   return out;

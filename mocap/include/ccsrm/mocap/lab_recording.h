@@ -53,6 +53,12 @@ struct AssembledRecording {
   ProcessedRecording processed;
   ClockFit clock;
   std::string log_summary;  // one line: what the log held
+  // For a trigger or a given offset: the kinematic estimate as a check (one
+  // line), and whether it disagrees with the alignment used by more than
+  // 4 standard deviations and two mocap frames (a wrong offset, a pulse
+  // paired with the wrong tick). Empty / false for --sync estimate.
+  std::string kinematic_check;
+  bool misaligned = false;
   // Lines saying what was done (alignment, resampling), for the command.
   std::string Report() const;
 };
