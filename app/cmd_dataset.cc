@@ -142,6 +142,9 @@ void AddDatasetCommands(CLI::App& root) {
   assemble->add_option("--trigger-polarity", a->trigger_polarity, "rising or falling edges")
       ->default_val("rising")
       ->check(CLI::IsMember({"rising", "falling"}));
+  assemble->add_flag("--estimate-drift", r.estimate.estimate_drift,
+                     "With --sync estimate: also estimate the clocks' rate difference (for long "
+                     "recordings; default: drift 0)");
   assemble->add_option("--name", r.name, "Experiment name (default: the marker file's stem)");
   assemble->add_option("--out", a->out, "Output experiment (.h5)")->required();
   assemble->add_flag("--quiet", a->quiet, "One summary line instead of the quality tables");

@@ -207,17 +207,19 @@ ClockFit AlignByTrigger(const std::vector<double>& mocap_edges_s,
 namespace {
 
 // Per-cable affine misfit of the kinematic lengths `q` (frames × cables)
-// against the log at offset `offset_s` (drift 0): the sum over cables of the
-// residual sum of squares of q_k ≈ a_k + b_k · l_k.
+// against the log at t_log = offset_s + (1 + drift) t: the sum over cables
+// of the residual sum of squares of q_k ≈ a_k + b_k · l_k.
 double Misfit(const Eigen::MatrixXd& q, const std::vector<double>& t_mocap, double offset_s,
-              const Eigen::VectorXd& log_time, const Eigen::MatrixXd& log_length) {
+              const Eigen::VectorXd& log_time, const Eigen::MatrixXd& log_length,
+              double drift = 0.0) {
   const Eigen::Index frames = q.rows();
   double total = 0.0;
   for (Eigen::Index c = 0; c < q.cols(); ++c) {
     Eigen::Index hint = 0;
     double sl = 0, sq = 0, sll = 0, slq = 0, sqq = 0;
     for (Eigen::Index f = 0; f < frames; ++f) {
-      const double l = Interpolate(log_time, log_length, c, offset_s + t_mocap[f], &hint);
+      const double l =
+          Interpolate(log_time, log_length, c, offset_s + (1.0 + drift) * t_mocap[f], &hint);
       const double y = q(f, c);
       sl += l;
       sq += y;
@@ -339,9 +341,62 @@ ClockFit AlignByKinematics(const sim::ArmModel& model, const std::vector<double>
   out.offset_s = offset;
   // Gauss-Newton: misfit ≈ misfit_min + ½ H δ², var(δ) = variance / (½ H).
   out.offset_sigma_s = curvature > 0.0 ? std::sqrt(2.0 * variance / curvature) : step;
-  out.note = std::to_string(frames) + " frames, " + std::to_string(cables) +
-             " cables; kinematic path change vs log, residual RMS " +
-             Format("%.3g", std::sqrt(variance) * 1e3) + " mm; drift not estimated";
+  const std::string head = std::to_string(frames) + " frames, " + std::to_string(cables) +
+                           " cables; kinematic path change vs log, residual RMS " +
+                           Format("%.3g", std::sqrt(variance) * 1e3) + " mm";
+  out.note = head + "; drift not estimated";
+  if (!options.estimate_drift) return out;
+
+  // Drift: profile the misfit over a grid of drifts, each at its best log
+  // time at the recording's middle (where offset and drift are least
+  // correlated), found by a parabola through three points half a frame apart
+  // around the drift-free one.
+  const double t_mid = 0.5 * (times.front() + times.back());
+  const double mid0 = offset + t_mid;  // log time at t_mid without drift
+  const double h = 0.5 * frame_step;
+  struct Profile {
+    double misfit = 0.0;
+    double mid = 0.0;
+    double curvature = 0.0;  // d²misfit/dmid²
+  };
+  auto profile = [&](double drift) {
+    auto at = [&](double mid) {
+      return Misfit(q, times, mid - (1.0 + drift) * t_mid, log_time_s, log_length_change_m, drift);
+    };
+    const double a = at(mid0 - h), b = at(mid0), c = at(mid0 + h);
+    Profile p;
+    p.curvature = (a - 2.0 * b + c) / (h * h);
+    p.mid = mid0;
+    if (p.curvature > 0.0) p.mid += std::clamp(0.5 * h * (a - c) / (a - 2.0 * b + c), -h, h);
+    p.misfit = at(p.mid);
+    return p;
+  };
+  const int half = static_cast<int>(std::ceil(options.max_drift / options.drift_step));
+  std::vector<Profile> profiles;
+  for (int k = -half; k <= half; ++k) profiles.push_back(profile(k * options.drift_step));
+  std::size_t k_best = 0;
+  for (std::size_t k = 1; k < profiles.size(); ++k) {
+    if (profiles[k].misfit < profiles[k_best].misfit) k_best = k;
+  }
+  double drift = (static_cast<int>(k_best) - half) * options.drift_step;
+  double drift_curvature = 0.0;
+  if (k_best > 0 && k_best + 1 < profiles.size()) {
+    const double a = profiles[k_best - 1].misfit, b = profiles[k_best].misfit,
+                 c = profiles[k_best + 1].misfit;
+    drift_curvature = (a - 2.0 * b + c) / (options.drift_step * options.drift_step);
+    if (drift_curvature > 0.0) drift += 0.5 * options.drift_step * (a - c) / (a - 2.0 * b + c);
+  }
+  const Profile at_best = profile(drift);
+  out.drift = drift;
+  out.offset_s = at_best.mid - (1.0 + drift) * t_mid;
+  // The profile's curvature gives the drift's marginal variance; the offset
+  // at t = 0 carries the drift's uncertainty over t_mid.
+  out.drift_sigma =
+      drift_curvature > 0.0 ? std::sqrt(2.0 * variance / drift_curvature) : options.drift_step;
+  const double mid_sigma =
+      at_best.curvature > 0.0 ? std::sqrt(2.0 * variance / at_best.curvature) : h;
+  out.offset_sigma_s = std::hypot(mid_sigma, t_mid * out.drift_sigma);
+  out.note = head + "; drift profiled over ±" + Format("%.4g", options.max_drift * 1e6) + " ppm";
   return out;
 }
 

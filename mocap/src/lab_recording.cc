@@ -78,8 +78,11 @@ bool LabRecordingRequest::IsValid(std::string* error) const {
   }
   if (!(trigger.max_drift > 0.0)) return fail("trigger: max_drift must be > 0");
   if (!(estimate.grid_step_s >= 0.0) || !(estimate.ambiguity_separation_s >= 0.0) ||
-      !(estimate.ambiguity_chi2 > 0.0)) {
-    return fail("estimate: grid step and separation must be >= 0, chi2 > 0");
+      !(estimate.ambiguity_chi2 > 0.0) || !(estimate.max_drift > 0.0) ||
+      !(estimate.drift_step > 0.0) || !(estimate.max_drift / estimate.drift_step <= 1e4)) {
+    return fail(
+        "estimate: grid step and separation must be >= 0, chi2, max drift and drift step > 0, "
+        "at most 1e4 drift steps each way");
   }
   return processing.IsValid(error);
 }

@@ -140,15 +140,27 @@ struct KinematicRecording {
   Eigen::MatrixXd log_length;
 };
 
-KinematicRecording MakeRecording(const sim::ArmModel& model, double offset, bool periodic) {
+enum class Motion { kRamps, kPeriodic, kTwoSines };
+
+KinematicRecording MakeRecording(const sim::ArmModel& model, double offset, Motion motion,
+                                 double duration_s = 4.0, double drift = 0.0) {
   const int joints = model.num_joints();
   auto theta_at = [&](double t) {
     sim::JointAngles theta(joints);
     for (int j = 0; j < joints; ++j) {
-      const double x = periodic
-                           ? 0.02 * std::sin(2.0 * M_PI * t)
-                           : 0.03 * sim::QuinticBlend(std::clamp(t / 1.5, 0.0, 1.0)) -
-                                 0.02 * sim::QuinticBlend(std::clamp((t - 2.2) / 1.0, 0.0, 1.0));
+      double x = 0.0;
+      switch (motion) {
+        case Motion::kPeriodic:
+          x = 0.02 * std::sin(2.0 * M_PI * t);
+          break;
+        case Motion::kRamps:
+          x = 0.03 * sim::QuinticBlend(std::clamp(t / 1.5, 0.0, 1.0)) -
+              0.02 * sim::QuinticBlend(std::clamp((t - 2.2) / 1.0, 0.0, 1.0));
+          break;
+        case Motion::kTwoSines:  // incommensurate: never repeats
+          x = 0.03 * std::sin(0.7 * t) + 0.02 * std::sin(1.9 * t + 1.0);
+          break;
+      }
       theta[j] = Eigen::Vector2d(x, 0.5 * x);
     }
     return theta;
@@ -160,7 +172,8 @@ KinematicRecording MakeRecording(const sim::ArmModel& model, double offset, bool
   // 0.01°, a link pose from markers 0.1 mm apart over 0.5 m).
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0.0, 2e-4);
-  for (int f = 0; f < 400; ++f) {  // 4 s at 100 Hz
+  const int frames = static_cast<int>(std::lround(duration_s * 100.0));
+  for (int f = 0; f < frames; ++f) {  // at 100 Hz
     const double t = f * 0.01;
     r.mocap_time.push_back(t);
     for (const Eigen::Vector2d& a : theta_at(t)) {
@@ -168,16 +181,16 @@ KinematicRecording MakeRecording(const sim::ArmModel& model, double offset, bool
       r.angles.push_back(a.y() + noise(rng));
     }
   }
-  // 8 s at 500 Hz, from 2 s before the mocap's start (log clock): the
-  // periodic motion has equally good offsets one period either side.
-  const int samples = 4000;
+  // At 500 Hz from 2 s before the mocap's start (log clock) to 2 s after its
+  // end: the periodic motion has equally good offsets one period either side.
+  const int samples = static_cast<int>(std::lround((duration_s + 4.0) / 0.002));
   r.log_time.resize(samples);
   r.log_length.resize(samples, model.num_cables());
   for (int i = 0; i < samples; ++i) {
     const double t_log = offset - 2.0 + i * 0.002;
     r.log_time[i] = t_log;
     const std::vector<sim::LinkPose> poses =
-        sim::ForwardKinematics(model, theta_at(t_log - offset));
+        sim::ForwardKinematics(model, theta_at((t_log - offset) / (1.0 + drift)));
     for (int c = 0; c < model.num_cables(); ++c) {
       // Stretch (×1.02) and a zero of the log's own: the affine fit absorbs both.
       r.log_length(i, c) = 1.02 * (sim::CablePathLength(model, c, straight) -
@@ -192,7 +205,7 @@ TEST(AlignByKinematics, RecoversTheOffsetWithinOneFrame) {
   const sim::ArmModel model(
       sim::LoadConfig(std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml").arm);
   const double offset = 1.37;
-  const KinematicRecording r = MakeRecording(model, offset, false);
+  const KinematicRecording r = MakeRecording(model, offset, Motion::kRamps);
   const ClockFit fit =
       AlignByKinematics(model, r.mocap_time, r.angles, r.log_time, r.log_length, {}, "test");
   // The issue asks for one mocap frame (10 ms); the reported uncertainty
@@ -208,11 +221,34 @@ TEST(AlignByKinematics, RecoversTheOffsetWithinOneFrame) {
 TEST(AlignByKinematics, PeriodicMotionIsAmbiguous) {
   const sim::ArmModel model(
       sim::LoadConfig(std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml").arm);
-  const KinematicRecording r = MakeRecording(model, 1.37, true);
+  const KinematicRecording r = MakeRecording(model, 1.37, Motion::kPeriodic);
   const std::string error = InputErrorOf([&] {
     AlignByKinematics(model, r.mocap_time, r.angles, r.log_time, r.log_length, {}, "rec.c3d");
   });
   EXPECT_NE(error.find("ambiguous alignment"), std::string::npos) << error;
+}
+
+// A long recording (60 s) on a clock 300 ppm fast: 18 ms of drift over the
+// recording, which the drift-free estimate would smear; with estimate_drift
+// both come back.
+TEST(AlignByKinematics, EstimatesTheDriftOfALongRecording) {
+  const sim::ArmModel model(
+      sim::LoadConfig(std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml").arm);
+  const double offset = 0.81, drift = 300e-6;
+  const KinematicRecording r = MakeRecording(model, offset, Motion::kTwoSines, 60.0, drift);
+  KinematicAlignmentOptions options;
+  options.estimate_drift = true;
+  const ClockFit fit =
+      AlignByKinematics(model, r.mocap_time, r.angles, r.log_time, r.log_length, options, "test");
+  std::printf("kinematic offset %.6f s ± %.3g ms, drift %.1f ± %.2g ppm (true %.2f s, %.0f ppm)\n",
+              fit.offset_s, fit.offset_sigma_s * 1e3, fit.drift * 1e6, fit.drift_sigma * 1e6,
+              offset, drift * 1e6);
+  // One frame (10 ms) for the offset, as the issue asks; the drift to the
+  // 20 ppm the issue asks of the trigger; and both within 4 reported σ.
+  EXPECT_NEAR(fit.offset_s, offset, 0.01);
+  EXPECT_NEAR(fit.drift, drift, 20e-6);
+  EXPECT_NEAR(fit.offset_s, offset, 4.0 * fit.offset_sigma_s);
+  EXPECT_NEAR(fit.drift, drift, 4.0 * fit.drift_sigma);
 }
 
 TEST(ResampleOntoMocapTimes, RefusesALogThatDoesNotCoverTheRecording) {

@@ -91,9 +91,16 @@ struct KinematicAlignmentOptions {
   // ambiguous.
   double ambiguity_separation_s = 0.05;
   double ambiguity_chi2 = 9.0;
+  // Also estimate the drift (worth it for long recordings: 100 ppm over
+  // 100 s is 10 ms, a frame), over ±max_drift on a grid of drift_step,
+  // refined between grid points. Off: drift 0.
+  bool estimate_drift = false;
+  double max_drift = 1e-3;   // crystal clocks are within ±100 ppm; room for cheap ones
+  double drift_step = 1e-5;  // 10 ppm
 };
 
-// Finds the offset (drift 0) at which the logged length changes best
+// Finds the offset (and, with options.estimate_drift, the drift; else drift
+// 0) at which the logged length changes best
 // explain the cable path lengths of the measured joint angles: for every
 // frame with all angles finite, q_k = L_k(0) − L_k(θ(t)) by kinematics
 // (what a quasi-static arm pulls in), compared per cable through an affine
