@@ -98,6 +98,7 @@ struct LabFiles {
   fs::path dir;
   ccsrm::datasets::ExperimentFile original;
   std::string c3d, log, map;
+  std::string config;  // the experiment's own nominal configuration, as the lab's arm.yaml
 };
 
 // Made once (the suite is one process): generate, then record "in the lab".
@@ -113,6 +114,11 @@ const LabFiles& Lab() {
     EXPECT_EQ(o.status, 0) << o.err;
     f.original = ccsrm::datasets::ReadExperimentFile(exp);
     const ccsrm::datasets::ExperimentFile& e = f.original;
+    // The arm's configuration as the generated experiment states it (case
+    // 1's parameters), so that the assembled experiment is the original's
+    // twin for identify.
+    f.config = (f.dir / "arm.yaml").string();
+    std::ofstream(f.config) << e.config_yaml;
 
     // The C3D file: the markers, and the trigger at 20 analog samples per
     // frame (2 kHz at 100 Hz).
@@ -194,7 +200,7 @@ const LabFiles& Lab() {
 
 std::string Assemble(const std::string& sync, const std::string& out) {
   return "dataset assemble --markers " + Lab().c3d + " --actuators " + Lab().log +
-         " --actuator-map " + Lab().map + " --config " + Paper() + " --sync " + sync +
+         " --actuator-map " + Lab().map + " --config " + Lab().config + " --sync " + sync +
          " --trigger-channel trigger --quiet --out " + out;
 }
 
@@ -214,6 +220,13 @@ double LargestInputError(const ccsrm::datasets::ExperimentFile& assembled) {
     }
   }
   return largest;
+}
+
+// Equal, NaN equal to NaN.
+bool SameValues(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](double x, double y) {
+           return x == y || (std::isnan(x) && std::isnan(y));
+         });
 }
 
 TEST(DatasetAssemble, TriggerRecoversTheOffsetAndTheDrift) {
@@ -241,6 +254,18 @@ TEST(DatasetAssemble, TriggerRecoversTheOffsetAndTheDrift) {
   EXPECT_LT(LargestInputError(a), 1e-5);
   std::printf("largest input error %.3g µm\n", LargestInputError(a) * 1e6);
   EXPECT_EQ(a.input_time.values, a.mocap_time.values);
+  // The arm is the original's, and the markers went through the mocap
+  // pipeline exactly as `ccsrm mocap process` takes them.
+  EXPECT_EQ(a.config_yaml, Lab().original.config_yaml);
+  const std::string processed = (Lab().dir / "processed.h5").string();
+  const Outcome p = RunCcsrm("mocap process --quiet --in " + Lab().c3d + " --config " +
+                             Lab().config + " --out " + processed);
+  ASSERT_EQ(p.status, 0) << p.err;
+  const ccsrm::datasets::ExperimentFile m = ccsrm::datasets::ReadExperimentFile(processed);
+  ASSERT_TRUE(m.measured_joint_angles && a.measured_joint_angles);
+  EXPECT_EQ(a.mocap_time.values, m.mocap_time.values);
+  EXPECT_TRUE(SameValues(a.mocap_markers.values, m.mocap_markers.values));
+  EXPECT_TRUE(SameValues(a.measured_joint_angles->values, m.measured_joint_angles->values));
 }
 
 TEST(DatasetAssemble, EstimateRecoversTheOffsetWithinOneFrame) {
