@@ -387,6 +387,11 @@ void ReadAnalogLayout(const ParameterSection& params, const ByteReader& in, Layo
                   ": expected a whole number of analog samples per frame (1 to 65535)");
     }
     samples = static_cast<std::uint64_t>(whole);
+    if (header_samples > 0 && header_samples != samples) {
+      warnings->push_back("header word 10 gives " + std::to_string(header_samples) +
+                          " analog samples per frame, ANALOG:RATE / POINT:RATE " +
+                          std::to_string(samples) + "; used the parameters");
+    }
   } else if (header_samples > 0) {
     samples = header_samples;
   } else {

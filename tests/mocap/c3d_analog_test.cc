@@ -337,6 +337,24 @@ TEST(C3dAnalog, UnsignedFormatReadsTheWordsAsUnsigned) {
       << error;
 }
 
+// The header's analog counts (words 3 and 10) disagreeing with ANALOG:USED
+// and ANALOG:RATE: the parameters set the layout, with a warning each, and
+// the values are those of the unpatched file.
+TEST(C3dAnalog, HeaderCountsThatDisagreeWithTheParametersWarn) {
+  CCSRM_SHARED_FILE_OR_SKIP(path, "data/mocap/c3d/pc_int.c3d");
+  std::vector<std::uint8_t> bytes = ReadBytes(path);
+  const C3dRecording original = ReadC3dRecordingFromMemory(bytes, "pc_int.c3d");
+  bytes[4] = 60;  // header word 3: 60 analog values per frame (16 × 4 = 64)
+  bytes[18] = 5;  // header word 10: 5 samples per frame (ANALOG:RATE 200 / 50 = 4)
+  const C3dRecording patched = ReadC3dRecordingFromMemory(bytes, "pc_int.c3d");
+  EXPECT_TRUE(Contains(patched.markers.warnings,
+                       "header word 3 gives 60 analog values per frame, the parameters 64"));
+  EXPECT_TRUE(Contains(patched.markers.warnings,
+                       "header word 10 gives 5 analog samples per frame, ANALOG:RATE / "
+                       "POINT:RATE 4; used the parameters"));
+  EXPECT_EQ(patched.analog.values, original.analog.values);
+}
+
 // The field quirk: POINT:DATA_START = 0 with a valid header word 9 opens
 // with a warning (as established readers do); with both 0, refused.
 TEST(C3dAnalog, DataStartZeroFallsBackToTheHeaderWord) {
