@@ -55,6 +55,22 @@ std::size_t TriggerChannel(const C3dAnalog& analog, const std::string& wanted,
                   "several analog channels (" + labels + "): name the trigger's");
 }
 
+// One time stamp's jitter [s]: the robust scatter (1.4826 × the median
+// absolute deviation) of the log's steps about their median, over √2.
+double StampJitter(const Eigen::VectorXd& time_s) {
+  const Eigen::Index n = time_s.size();
+  if (n < 3) return 0.0;
+  std::vector<double> steps(static_cast<std::size_t>(n - 1));
+  for (Eigen::Index i = 1; i < n; ++i) steps[i - 1] = time_s[i] - time_s[i - 1];
+  auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  const double middle = median(steps);
+  for (double& s : steps) s = std::abs(s - middle);
+  return 1.4826 * median(steps) / std::sqrt(2.0);
+}
+
 }  // namespace
 
 bool LabRecordingRequest::IsValid(std::string* error) const {
@@ -180,8 +196,12 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
         options.mocap_edge_sigma_s = 1.0 / (analog.rate_hz * std::sqrt(12.0));
       }
       // The log's edges are its ticks (the controller raised its output
-      // then): their error is the stamps' jitter, which the residuals of
-      // the pairing show (AlignByTrigger takes the larger of the two).
+      // then): their error is the stamps' jitter, measured on the log
+      // itself from the scatter of its steps (a step is the difference of
+      // two stamps: √2 × one stamp's jitter).
+      if (options.log_edge_sigma_s <= 0.0) {
+        options.log_edge_sigma_s = StampJitter(log.time_s);
+      }
       out.clock = AlignByTrigger(mocap_edges, log_edges, options,
                                  request.markers + " + " + request.actuators);
       out.clock.note = "channel '" + analog.labels[channel] + "': " + out.clock.note;

@@ -38,7 +38,9 @@ struct LabRecordingRequest {
   // way between its extremes; rising edges; interpolated crossings).
   std::string trigger_channel;
   EdgeOptions mocap_edges;
-  TriggerAlignmentOptions trigger;  // edge timings are filled from the sample rates
+  // Edge timings left at 0 are filled in: the C3D channel's from its rate
+  // (one sample / √12), the log's from the jitter of its stamps.
+  TriggerAlignmentOptions trigger;
   KinematicAlignmentOptions estimate;
 
   ProcessingOptions processing;
