@@ -93,8 +93,8 @@ std::vector<double> FindEdges(const Eigen::VectorXd& time_s, const Eigen::Vector
     if (!(hi > lo)) return {};  // a flat signal has no edge
     threshold = 0.5 * (lo + hi);
   }
-  // The signal as "past the threshold" (true after a rising edge, or before
-  // a falling one, i.e. on the edge's far side).
+  // True on the far side of an edge of the chosen polarity: at or above the
+  // level for rising edges, at or below it for falling ones.
   auto past = [&](double v) { return options.rising ? v >= threshold : v <= threshold; };
   std::vector<double> edges;
   bool armed = false;  // has been on the near side long enough

@@ -142,6 +142,11 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
   // The markers, read once (with the analog channels of a C3D file).
   C3dRecording recording = ReadMarkerFileWithAnalog(request.markers);
   const C3dAnalog analog = std::move(recording.analog);
+  // The trigger's channel is found before the (slower) processing.
+  const std::size_t trigger_channel =
+      request.sync == ClockSync::kTrigger
+          ? TriggerChannel(analog, request.trigger_channel, request.markers)
+          : 0;
   RecordingRequest pipeline;
   pipeline.reconstruct = [table = std::move(recording.markers)](const MarkerLayout&,
                                                                 const sim::ArmModel*) {
@@ -174,7 +179,7 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
       out.clock.note = "given (--sync offset=S)";
       break;
     case ClockSync::kTrigger: {
-      const std::size_t channel = TriggerChannel(analog, request.trigger_channel, request.markers);
+      const std::size_t channel = trigger_channel;
       Eigen::VectorXd t(static_cast<Eigen::Index>(analog.sample_count));
       Eigen::VectorXd v(static_cast<Eigen::Index>(analog.sample_count));
       for (std::size_t s = 0; s < analog.sample_count; ++s) {
