@@ -241,9 +241,11 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
       out.kinematic_check =
           "kinematic check: the joint angles put the log " + Format("%+.1f", difference * 1e3) +
           " ms from this alignment (± " + Format("%.2g", sigma * 1e3) + " ms)" +
-          (out.misaligned ? ", more than the " + Format("%.3g", limit * 1e3) +
-                                " ms a correct alignment allows: check the trigger or the offset"
-                          : ": consistent");
+          (out.misaligned
+               ? ", more than the " + Format("%.3g", limit * 1e3) +
+                     " ms a quasi-static arm allows: check the trigger or the offset (or the "
+                     "arm lags its inputs: friction, elasticity)"
+               : ": consistent");
     } catch (const InputError& e) {
       out.kinematic_check = std::string("kinematic check not possible: ") + e.what();
     }

@@ -58,7 +58,10 @@ struct AssembledRecording {
   // For a trigger or a given offset: the kinematic estimate as a check (one
   // line), and whether it disagrees with the alignment used by more than
   // 4 standard deviations and two mocap frames (a wrong offset, a pulse
-  // paired with the wrong tick). Empty / false for --sync estimate.
+  // paired with the wrong tick). Empty / false for --sync estimate. The
+  // estimate assumes a quasi-static arm: an arm that lags its inputs
+  // (friction: about 50 ms on the generated case-2 arm) shows as a
+  // disagreement too, so this is a warning, not a refusal.
   std::string kinematic_check;
   bool misaligned = false;
   // Lines saying what was done (alignment, resampling), for the command.
