@@ -86,6 +86,9 @@ bool LabRecordingRequest::IsValid(std::string* error) const {
   if (!std::isfinite(clock_drift_ppm) || std::abs(clock_drift_ppm) >= 1e5) {
     return fail("--clock-drift-ppm: expected a finite rate difference below 1e5 ppm");
   }
+  if (clock_drift_ppm != 0.0 && sync != ClockSync::kOffset) {
+    return fail("--clock-drift-ppm: only with --sync offset=S (the other methods find it)");
+  }
   if (!(mocap_edges.min_separation_s >= 0.0)) {
     return fail("trigger: min_separation_s must be >= 0");
   }

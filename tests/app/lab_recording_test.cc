@@ -344,6 +344,7 @@ TEST(DatasetAssemble, BadInputsAreOneLineAndWriteNothing) {
       {"--sync sometimes", "--sync: expected trigger, estimate or offset=S"},
       {"--sync offset=abc", "--sync: offset 'abc'"},
       {"--trigger-channel force", "--trigger-channel: no analog channel 'force'"},
+      {"--sync estimate --clock-drift-ppm 80", "--clock-drift-ppm: only with --sync offset=S"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.args);
