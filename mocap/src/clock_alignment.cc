@@ -289,14 +289,25 @@ ClockFit AlignByKinematics(const sim::ArmModel& model, const std::vector<double>
                     "the measured motion changes no cable path by more than 0.1 mm: nothing to "
                     "align the clocks on (give --sync offset=S or a trigger)");
   }
-  // Offsets that keep every frame inside the log.
-  const double lo = log_time_s[0] - times.front();
-  const double hi = log_time_s[log_time_s.size() - 1] - times.back();
+  // Offsets that keep every frame inside the log, then inside the window
+  // asked for.
+  double lo = log_time_s[0] - times.front();
+  double hi = log_time_s[log_time_s.size() - 1] - times.back();
   if (!(hi >= lo)) {
     ThrowInputError(source, "actuator log",
                     "covers " + Format("%.6g", log_time_s[log_time_s.size() - 1] - log_time_s[0]) +
                         " s, shorter than the mocap recording (" +
                         Format("%.6g", times.back() - times.front()) + " s)");
+  }
+  if (std::isfinite(options.search_center_s) && std::isfinite(options.search_half_width_s)) {
+    lo = std::max(lo, options.search_center_s - options.search_half_width_s);
+    hi = std::min(hi, options.search_center_s + options.search_half_width_s);
+    if (!(hi >= lo)) {
+      ThrowInputError(source, "actuator log",
+                      "no offset within " + Format("%.6g", options.search_half_width_s) + " s of " +
+                          Format("%.6g", options.search_center_s) +
+                          " s keeps the recording inside the log");
+    }
   }
   const double frame_step = (times.back() - times.front()) / static_cast<double>(frames - 1);
   const double step = options.grid_step_s > 0.0 ? options.grid_step_s : frame_step;

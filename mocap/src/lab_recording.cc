@@ -233,10 +233,16 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
     const double t_mid = 0.5 * (mocap_time.front() + mocap_time.back());
     const double frame_s = (mocap_time.back() - mocap_time.front()) /
                            static_cast<double>(std::max<std::size_t>(1, mocap_time.size() - 1));
+    // Within 1 s of the alignment used (ten times the largest lag seen on
+    // the generated arms): the check costs a fraction of a full search.
+    KinematicAlignmentOptions window = request.estimate;
+    window.estimate_drift = false;
+    window.search_center_s = out.clock.LogTime(t_mid) - t_mid;
+    window.search_half_width_s = 1.0;
     try {
       const ClockFit kinematic = AlignByKinematics(
           model, mocap_time, experiment.measured_joint_angles->values, log.time_s,
-          log.length_change_m, request.estimate, request.markers + " + " + request.actuators);
+          log.length_change_m, window, request.markers + " + " + request.actuators);
       const double difference = kinematic.LogTime(t_mid) - out.clock.LogTime(t_mid);
       const double sigma = std::hypot(kinematic.offset_sigma_s, out.clock.offset_sigma_s);
       const double limit = std::max(4.0 * sigma, 2.0 * frame_s);

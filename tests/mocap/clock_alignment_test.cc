@@ -218,6 +218,26 @@ TEST(AlignByKinematics, RecoversTheOffsetWithinOneFrame) {
   EXPECT_EQ(fit.method, "estimate");
 }
 
+TEST(AlignByKinematics, ASearchWindowFindsTheSameOffset) {
+  const sim::ArmModel model(
+      sim::LoadConfig(std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml").arm);
+  const KinematicRecording r = MakeRecording(model, 1.37, Motion::kRamps);
+  const ClockFit whole =
+      AlignByKinematics(model, r.mocap_time, r.angles, r.log_time, r.log_length, {}, "test");
+  KinematicAlignmentOptions window;
+  window.search_center_s = 1.2;
+  window.search_half_width_s = 0.5;
+  const ClockFit windowed =
+      AlignByKinematics(model, r.mocap_time, r.angles, r.log_time, r.log_length, window, "test");
+  // The same grid points around the minimum: the same parabola, to rounding.
+  EXPECT_NEAR(windowed.offset_s, whole.offset_s, 1e-3 * whole.offset_sigma_s + 1e-9);
+  window.search_center_s = 10.0;
+  const std::string error = InputErrorOf([&] {
+    AlignByKinematics(model, r.mocap_time, r.angles, r.log_time, r.log_length, window, "rec");
+  });
+  EXPECT_NE(error.find("no offset within 0.5 s of 10 s"), std::string::npos) << error;
+}
+
 TEST(AlignByKinematics, PeriodicMotionIsAmbiguous) {
   const sim::ArmModel model(
       sim::LoadConfig(std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml").arm);

@@ -85,6 +85,11 @@ struct KinematicAlignmentOptions {
   // inside the log, on a grid of `grid_step_s` (0: one mocap frame), then
   // refined between grid points.
   double grid_step_s = 0.0;
+  // Search only offsets within search_half_width_s of search_center_s
+  // (NaN, the default: every offset the log allows). A check of a known
+  // alignment needs a window, not a log's whole length.
+  double search_center_s = std::numeric_limits<double>::quiet_NaN();
+  double search_half_width_s = std::numeric_limits<double>::quiet_NaN();
   // Two minima of the misfit further apart than `ambiguity_separation_s`
   // whose misfits differ by less than `ambiguity_chi2` (in units of the
   // residual variance, 9 = three standard deviations) make the alignment
