@@ -1,14 +1,78 @@
 // ccsrm dataset inspect FILE [--json]
+// ccsrm dataset assemble --markers rec.c3d --actuators log.csv --actuator-map map.yaml
+//   --config arm.yaml [--rigid-bodies rb.yaml] [--static-trial FILE]
+//   [--sync trigger|estimate|offset=S] --out exp.h5
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
 #include <variant>
 
+#include "ccsrm/common/error.h"
+#include "ccsrm/common/number_text.h"
+#include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/datasets/inspect.h"
+#include "ccsrm/mocap/lab_recording.h"
 #include "ccsrm/sim_io/experiment_check.h"
 #include "commands.h"
+#include "output_kinds.h"
 
 namespace ccsrm::app {
+namespace {
+
+struct AssembleArgs {
+  mocap::LabRecordingRequest request;
+  std::string sync = "trigger";
+  std::string trigger_polarity = "rising";
+  double trigger_threshold = std::nan("");
+  std::string out;
+  bool quiet = false;
+};
+
+// --sync trigger | estimate | offset=S (S in seconds, the log's time at
+// mocap time 0).
+void ParseSync(const std::string& sync, mocap::LabRecordingRequest* request) {
+  if (sync == "trigger") {
+    request->sync = mocap::ClockSync::kTrigger;
+  } else if (sync == "estimate") {
+    request->sync = mocap::ClockSync::kEstimate;
+  } else if (sync.rfind("offset=", 0) == 0) {
+    request->sync = mocap::ClockSync::kOffset;
+    const std::string problem = ParseNumberText(sync.substr(7), &request->clock_offset_s);
+    if (!problem.empty()) {
+      ThrowInputError("dataset assemble", "--sync", "offset '" + sync.substr(7) + "' " + problem);
+    }
+  } else {
+    ThrowInputError("dataset assemble", "--sync",
+                    "expected trigger, estimate or offset=S, found '" + sync + "'");
+  }
+}
+
+// Parse -> mocap::AssembleLabRecording -> check, write, print.
+void RunAssemble(AssembleArgs a) {
+  mocap::LabRecordingRequest& request = a.request;
+  ParseSync(a.sync, &request);
+  request.mocap_edges.threshold = a.trigger_threshold;
+  request.mocap_edges.rising = a.trigger_polarity == "rising";
+  CheckOut(a.out, ExperimentFileOutput(),
+           {request.markers, request.actuators, request.actuator_map, request.config,
+            request.rigid_bodies, request.static_trial});
+  const mocap::AssembledRecording assembled = mocap::AssembleLabRecording(request);
+  const datasets::ExperimentFile& experiment = assembled.processed.experiment;
+  sim_io::CheckExperimentAgainstConfig(experiment, request.markers);
+  datasets::WriteExperimentFile(a.out, experiment);
+  std::printf("%s", assembled.Report().c_str());
+  const mocap::ProcessingResult& result = assembled.processed.result;
+  if (a.quiet) {
+    std::printf("%s\n", result.summary.BriefReport().c_str());
+  } else {
+    std::printf("%s", result.summary.FullReport().c_str());
+  }
+  std::printf("  output: %s (%zu frames, %zu cables, source recorded)\n", a.out.c_str(),
+              experiment.mocap_time.size(), experiment.input_length_change.shape[1]);
+}
+
+}  // namespace
 
 void AddDatasetCommands(CLI::App& root) {
   CLI::App* dataset =
@@ -39,6 +103,52 @@ void AddDatasetCommands(CLI::App& root) {
       std::printf("%s", datasets::ToText(summary).c_str());
     }
   });
+
+  CLI::App* assemble = dataset->add_subcommand(
+      "assemble",
+      "Make a ccsrm-dataset/1 experiment from a lab's recording: a marker file, the actuators' "
+      "log (CSV/TSV, mapped by a ccsrm-actuators/1 YAML) and the arm's configuration; the log "
+      "is aligned to the mocap clock (trigger pulse, estimate, or a given offset) and resampled "
+      "onto the mocap frames");
+  auto a = std::make_shared<AssembleArgs>();
+  mocap::LabRecordingRequest& r = a->request;
+  assemble->add_option("--markers", r.markers, "Marker file (C3D for --sync trigger)")->required();
+  assemble->add_option("--actuators", r.actuators, "Actuator log (CSV or TSV)")->required();
+  assemble
+      ->add_option("--actuator-map", r.actuator_map,
+                   "The log's columns (ccsrm-actuators/1 YAML, datasets/README.md)")
+      ->required();
+  assemble->add_option("--config", r.config, "Arm configuration (YAML)")->required();
+  assemble->add_option("--rigid-bodies", r.rigid_bodies,
+                       "Rigid bodies (ccsrm-rigid-bodies/1); default: the config's layout");
+  assemble->add_option("--static-trial", r.static_trial,
+                       "Marker file of a static trial with the arm straight");
+  assemble
+      ->add_option("--sync", a->sync,
+                   "How the clocks are aligned: trigger (a C3D analog pulse against the log's "
+                   "trigger column), estimate (from the joint angles through the kinematics) "
+                   "or offset=S (the log's time at mocap time 0, s)")
+      ->default_val("trigger");
+  assemble
+      ->add_option("--clock-drift-ppm", r.clock_drift_ppm,
+                   "With --sync offset=S: how much faster the log's clock runs [ppm]")
+      ->default_val(0.0);
+  assemble->add_option("--trigger-channel", r.trigger_channel,
+                       "C3D analog channel of the trigger pulse (default: the only channel, "
+                       "or the one named trigger or sync)");
+  assemble->add_option("--trigger-threshold", a->trigger_threshold,
+                       "Level of the pulse's edges in the channel's units (default: half way "
+                       "between its extremes)");
+  assemble->add_option("--trigger-polarity", a->trigger_polarity, "rising or falling edges")
+      ->default_val("rising")
+      ->check(CLI::IsMember({"rising", "falling"}));
+  assemble->add_flag("--estimate-drift", r.estimate.estimate_drift,
+                     "With --sync estimate: also estimate the clocks' rate difference (for long "
+                     "recordings; default: drift 0)");
+  assemble->add_option("--name", r.name, "Experiment name (default: the marker file's stem)");
+  assemble->add_option("--out", a->out, "Output experiment (.h5)")->required();
+  assemble->add_flag("--quiet", a->quiet, "One summary line instead of the quality tables");
+  assemble->callback([a] { RunAssemble(*a); });
 }
 
 }  // namespace ccsrm::app

@@ -139,10 +139,15 @@ void RunExport(const ExportArgs& a) {
   options.units = a.units;
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError("mocap export", "--units", error);
-  const mocap::MarkerTable table = mocap::ReadMarkerFile(a.in);
-  mocap::WriteC3d(a.out, table, options);
-  std::printf("%s: %zu frames, %zu markers at %g Hz (C3D, Intel, float storage, %s)\n",
-              a.out.c_str(), table.frames(), table.markers(), table.rate_hz, options.units.c_str());
+  // A C3D input keeps its analog channels (scaled values, SCALE 1).
+  const mocap::C3dRecording recording = mocap::ReadMarkerFileWithAnalog(a.in);
+  const mocap::MarkerTable& table = recording.markers;
+  mocap::WriteC3d(a.out, recording, options);
+  std::printf(
+      "%s: %zu frames, %zu markers at %g Hz, %zu analog channel(s) (C3D, Intel, float "
+      "storage, %s)\n",
+      a.out.c_str(), table.frames(), table.markers(), table.rate_hz, recording.analog.channels(),
+      options.units.c_str());
 }
 
 }  // namespace
@@ -164,11 +169,14 @@ void AddMocapCommands(CLI::App& root) {
   inspect->add_option("FILE", inspect_args->path, "Marker file")->required();
   inspect->add_flag("--json", inspect_args->json, "Print one JSON object instead of text");
   inspect->callback([inspect_args] {
-    const mocap::MarkerTable table = mocap::ReadMarkerFile(inspect_args->path);
+    const mocap::C3dRecording recording = mocap::ReadMarkerFileWithAnalog(inspect_args->path);
     if (inspect_args->json) {
-      std::printf("%s\n", mocap::InspectJson(table).dump(2).c_str());
+      nlohmann::json j = mocap::InspectJson(recording.markers);
+      if (recording.analog.channels() > 0) j["analog"] = mocap::InspectAnalogJson(recording.analog);
+      std::printf("%s\n", j.dump(2).c_str());
     } else {
-      std::printf("%s", mocap::InspectText(table).c_str());
+      std::printf("%s%s", mocap::InspectText(recording.markers).c_str(),
+                  mocap::InspectAnalogText(recording.analog).c_str());
     }
   });
 

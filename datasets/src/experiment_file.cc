@@ -1,6 +1,7 @@
 #include "ccsrm/datasets/experiment_file.h"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <string>
 #include <utility>
@@ -144,6 +145,26 @@ void ValidateExperimentFile(const ExperimentFile& experiment, const std::string&
                         std::to_string(experiment.marker_names.size()));
   }
   internal::ExpectUniqueNames(file, "/mocap/marker_names", experiment.marker_names);
+  if (const auto& a = experiment.clock_alignment) {
+    if (a->method != "trigger" && a->method != "estimate" && a->method != "offset") {
+      ThrowInputError(file, "clock_alignment",
+                      "expected trigger, estimate or offset, found '" + a->method + "'");
+    }
+    const std::pair<const char*, double> numbers[] = {
+        {"clock_offset_s", a->offset_s},
+        {"clock_offset_uncertainty_s", a->offset_uncertainty_s},
+        {"clock_drift_ppm", a->drift_ppm},
+        {"clock_drift_uncertainty_ppm", a->drift_uncertainty_ppm}};
+    for (const auto& [name, value] : numbers) {
+      const bool is_uncertainty = std::string(name).find("uncertainty") != std::string::npos;
+      if (!std::isfinite(value) || (is_uncertainty && value < 0.0)) {
+        ThrowInputError(file, name,
+                        std::string(is_uncertainty ? "expected a finite value >= 0"
+                                                   : "expected a finite value") +
+                            ", found " + std::to_string(value));
+      }
+    }
+  }
   ValidateRigidBodies(experiment, file);
   ValidateQuality(experiment, file);
 
@@ -201,6 +222,15 @@ void WriteExperimentFile(const std::string& path, const ExperimentFile& experime
       writer.WriteStringAttribute("protocol_yaml", experiment.protocol_yaml);
     if (!experiment.inputs_file.empty())
       writer.WriteStringAttribute("inputs_file", experiment.inputs_file);
+    if (const auto& a = experiment.clock_alignment) {
+      writer.WriteStringAttribute("clock_alignment", a->method);
+      writer.WriteStringAttribute("actuator_log", a->actuator_log);
+      writer.WriteDoubleAttribute("clock_offset_s", a->offset_s);
+      writer.WriteDoubleAttribute("clock_offset_uncertainty_s", a->offset_uncertainty_s);
+      writer.WriteDoubleAttribute("clock_drift_ppm", a->drift_ppm);
+      writer.WriteDoubleAttribute("clock_drift_uncertainty_ppm", a->drift_uncertainty_ppm);
+      writer.WriteStringAttribute("clock_alignment_note", a->note);
+    }
     // Created explicitly so that a file without rigid bodies still has it.
     writer.CreateGroup(kRigidBodies);
     VisitArrays(experiment, [&](const std::string& dataset, const char* units, const Array& array) {
@@ -236,6 +266,17 @@ ExperimentFile ReadExperimentFile(const std::string& path) {
     experiment.protocol_yaml = reader.ReadStringAttribute("protocol_yaml");
   if (reader.HasRootAttribute("inputs_file"))
     experiment.inputs_file = reader.ReadStringAttribute("inputs_file");
+  if (reader.HasRootAttribute("clock_alignment")) {
+    ClockAlignment a;
+    a.method = reader.ReadStringAttribute("clock_alignment");
+    a.actuator_log = reader.ReadStringAttribute("actuator_log");
+    a.offset_s = reader.ReadDoubleAttribute("clock_offset_s");
+    a.offset_uncertainty_s = reader.ReadDoubleAttribute("clock_offset_uncertainty_s");
+    a.drift_ppm = reader.ReadDoubleAttribute("clock_drift_ppm");
+    a.drift_uncertainty_ppm = reader.ReadDoubleAttribute("clock_drift_uncertainty_ppm");
+    a.note = reader.ReadStringAttribute("clock_alignment_note");
+    experiment.clock_alignment = a;
+  }
 
   // Skeleton first (rigid bodies, optional members), then every array.
   for (const std::string& name : reader.ListGroup(kRigidBodies)) {

@@ -86,6 +86,14 @@ void SummariseExperiment(const ExperimentFile& experiment, FileSummary* summary)
       {"description", experiment.description}, {"source", ExperimentSourceName(experiment.source)},
       {"created", experiment.created},         {"config_yaml", LineCount(experiment.config_yaml)},
   };
+  if (const auto& a = experiment.clock_alignment) {
+    char text[160];
+    std::snprintf(text, sizeof(text), "%s: offset %.6f ± %.6f s, drift %.2f ± %.2f ppm",
+                  a->method.c_str(), a->offset_s, a->offset_uncertainty_s, a->drift_ppm,
+                  a->drift_uncertainty_ppm);
+    summary->attributes.emplace_back("clock_alignment", text);
+    summary->attributes.emplace_back("actuator_log", a->actuator_log);
+  }
   summary->counts = {
       {"input_samples", experiment.input_time.size()},
       {"mocap_frames", experiment.mocap_time.size()},

@@ -1,7 +1,8 @@
-// libFuzzer target: arbitrary bytes through the C3D reader. The only allowed
-// outcomes are a table or an InputError; a crash, a sanitizer report or any
-// other exception is a bug. A table that was read must also survive the
-// inspect summary and a write/read round trip without error.
+// libFuzzer target: arbitrary bytes through the C3D reader (points and
+// analog channels). The only allowed outcomes are a recording or an
+// InputError; a crash, a sanitizer report or any other exception is a bug. A
+// recording that was read must also survive the inspect summaries and a
+// write/read round trip without error.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -13,22 +14,25 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace ccsrm::mocap;
   const std::vector<std::uint8_t> bytes(data, data + size);
-  MarkerTable table;
+  C3dRecording recording;
   try {
-    table = ReadC3dFromMemory(bytes, "fuzz.c3d");
+    recording = ReadC3dRecordingFromMemory(bytes, "fuzz.c3d");
   } catch (const ccsrm::InputError&) {
     return 0;
   }
+  const MarkerTable& table = recording.markers;
   InspectJson(table).dump();
   InspectText(table);
+  InspectAnalogJson(recording.analog).dump();
+  InspectAnalogText(recording.analog);
   if (table.frames() * table.markers() > 1000000) return 0;  // keep runs fast
   std::vector<std::uint8_t> rewritten;
   try {
-    rewritten = EncodeC3d(table);
+    rewritten = EncodeC3d(recording);
   } catch (const ccsrm::InputError&) {
-    return 0;  // a table the writer refuses (e.g. a rate no float can hold)
+    return 0;  // a recording the writer refuses (e.g. a rate no float can hold)
   }
   // Must not throw: an InputError escaping here aborts the fuzzer.
-  ReadC3dFromMemory(rewritten, "fuzz-rewritten.c3d");
+  ReadC3dRecordingFromMemory(rewritten, "fuzz-rewritten.c3d");
   return 0;
 }

@@ -17,7 +17,8 @@
 //       (column-major, first dimension fastest), description.
 //   data section (block POINT:DATA_START): per frame, per point x, y, z and a
 //     residual word (int16, or float when POINT:SCALE < 0), then the analog
-//     samples of that frame (same storage).
+//     samples of that frame (same storage), sample by sample, each sample
+//     holding every channel (ANALOG:USED values).
 //
 // Every read is checked against the end of the buffer (and, for parameters,
 // against the data start) before it happens. Counts the file can get wrong
@@ -114,6 +115,9 @@ class ByteReader {
   // Unchecked variants for the data section, whose extent is checked once.
   std::int16_t RawI16(std::uint64_t offset) const {
     return internal::DecodeI16(&bytes_[offset], processor_);
+  }
+  std::uint16_t RawU16(std::uint64_t offset) const {
+    return internal::DecodeU16(&bytes_[offset], processor_);
   }
   float RawF32(std::uint64_t offset) const {
     return internal::DecodeF32(&bytes_[offset], processor_);
@@ -315,10 +319,13 @@ std::optional<double> MetresPerUnit(const std::string& u) {
 // What the data section holds and how to decode it.
 struct Layout {
   std::uint64_t points = 0;
-  bool float_storage = false;                 // POINT:SCALE < 0
-  double scale = 0.0;                         // |POINT:SCALE| in file units
-  double rate_hz = 0.0;                       // POINT:RATE
-  std::uint64_t data_offset = 0;              // byte where frame 0 starts
+  bool float_storage = false;         // POINT:SCALE < 0
+  double scale = 0.0;                 // |POINT:SCALE| in file units
+  double rate_hz = 0.0;               // POINT:RATE
+  std::uint64_t data_offset = 0;      // byte where frame 0 starts
+  std::uint64_t analog_channels = 0;  // ANALOG:USED
+  std::uint64_t analog_samples_per_frame = 0;
+  double analog_rate_hz = 0.0;
   std::uint64_t analog_values_per_frame = 0;  // channels × samples per frame
   std::uint64_t frame_bytes = 0;              // points and analog values of one frame
   std::uint64_t frames = 0;
@@ -352,7 +359,8 @@ std::uint64_t CountParameter(const ParameterSection& params, const ByteReader& i
   return static_cast<std::uint64_t>(params.Number(p, 0, true));
 }
 
-// Stage 3: analog values interleaved after the points of each frame (skipped).
+// Stage 3: the shape of the analog values interleaved after the points of
+// each frame.
 void ReadAnalogLayout(const ParameterSection& params, const ByteReader& in, Layout* layout,
                       std::vector<std::string>* warnings) {
   const std::uint16_t header_values_per_frame = in.U16(4, "header word 3 (analog values)");
@@ -379,12 +387,20 @@ void ReadAnalogLayout(const ParameterSection& params, const ByteReader& in, Layo
                   ": expected a whole number of analog samples per frame (1 to 65535)");
     }
     samples = static_cast<std::uint64_t>(whole);
+    if (header_samples > 0 && header_samples != samples) {
+      warnings->push_back("header word 10 gives " + std::to_string(header_samples) +
+                          " analog samples per frame, ANALOG:RATE / POINT:RATE " +
+                          std::to_string(samples) + "; used the parameters");
+    }
   } else if (header_samples > 0) {
     samples = header_samples;
   } else {
     in.Fail(18, "expected ANALOG:RATE or header word 10 (analog samples per frame) for " +
                     std::to_string(channels) + " analog channel(s)");
   }
+  layout->analog_channels = channels;
+  layout->analog_samples_per_frame = samples;
+  layout->analog_rate_hz = layout->rate_hz * static_cast<double>(samples);
   layout->analog_values_per_frame = channels * samples;
   if (header_values_per_frame != layout->analog_values_per_frame) {
     warnings->push_back("header word 3 gives " + std::to_string(header_values_per_frame) +
@@ -666,7 +682,17 @@ Layout ReadPointLayout(const ParameterSection& params, const ByteReader& in,
   if (const Parameter* p = params.Find("POINT", "DATA_START")) {
     data_block = CountParameter(params, in, *p);
     data_start_at = p->record_offset;
-    if (data_block != header_data_block) {
+    const bool header_usable =
+        header_data_block >= 2 && (header_data_block - 1) * kC3dBlockSize <= in.size();
+    if (data_block < 2 && header_usable) {
+      // A field quirk: POINT:DATA_START left at 0 while the header's word is
+      // right. Established readers (ezc3d, btk) take the header's word.
+      warnings->push_back("POINT:DATA_START is " + std::to_string(data_block) +
+                          ", not a block number; used header word 9 (block " +
+                          std::to_string(header_data_block) + ")");
+      data_block = header_data_block;
+      data_start_at = 16;
+    } else if (data_block != header_data_block) {
       warnings->push_back("header word 9 gives the data start as block " +
                           std::to_string(header_data_block) + ", POINT:DATA_START as block " +
                           std::to_string(data_block) + "; used POINT:DATA_START");
@@ -760,12 +786,149 @@ void DecodePoints(const ByteReader& in, const Layout& layout, MarkerTable* table
   }
 }
 
-}  // namespace
+// Up to `count` strings of a character parameter and its continuations
+// (NAME, NAME2, NAME3, ... as for POINT:LABELS); fewer when the file holds
+// fewer.
+std::vector<std::string> ChainedStrings(const ParameterSection& params, const std::string& group,
+                                        const std::string& name, std::uint64_t count) {
+  std::vector<std::string> out;
+  for (int k = 1; out.size() < count; ++k) {
+    const Parameter* p = params.Find(group, k == 1 ? name : name + std::to_string(k));
+    if (p == nullptr || p->type != -1) break;
+    for (std::string& s : params.Strings(*p)) out.push_back(internal::AsUtf8(std::move(s)));
+  }
+  if (out.size() > count) out.resize(count);
+  return out;
+}
 
-MarkerTable ReadC3dFromMemory(const std::vector<std::uint8_t>& bytes,
-                              const std::string& name_for_errors) {
+// One value per channel of a numeric ANALOG parameter: `fallback` for every
+// channel (with a warning) when it is missing; an error when it holds fewer
+// values than there are channels, since the channels it misses cannot be
+// scaled.
+std::vector<double> PerChannel(const ParameterSection& params, const ByteReader& in,
+                               const std::string& name, std::uint64_t channels, double fallback,
+                               bool unsigned_int, std::vector<std::string>* warnings) {
+  const Parameter* p = params.Find("ANALOG", name);
+  if (p == nullptr) {
+    warnings->push_back("ANALOG:" + name + " is missing; took " + std::to_string(fallback) +
+                        " for every channel");
+    return std::vector<double>(channels, fallback);
+  }
+  if (p->count < channels) {
+    in.Fail(p->record_offset, "ANALOG:" + name + ": expected " + std::to_string(channels) +
+                                  " values (ANALOG:USED), found " + std::to_string(p->count));
+  }
+  std::vector<double> out(channels);
+  for (std::uint64_t c = 0; c < channels; ++c) {
+    out[c] = params.Number(*p, c, unsigned_int && p->type == 2);
+    if (!std::isfinite(out[c])) {
+      in.Fail(p->record_offset, "ANALOG:" + name +
+                                    ": expected finite values, found one at channel " +
+                                    std::to_string(c + 1));
+    }
+  }
+  return out;
+}
+
+// Stage 6: the analog channels: names, units, scaling, and the values of
+// every frame. The caller has checked that the frames lie in the file.
+void DecodeAnalog(const ParameterSection& params, const ByteReader& in, const Layout& layout,
+                  C3dAnalog* analog, std::vector<std::string>* warnings) {
+  const std::uint64_t channels = layout.analog_channels;
+  analog->samples_per_frame = layout.analog_samples_per_frame;
+  analog->rate_hz = layout.analog_rate_hz;
+  analog->sample_count = channels == 0 ? 0 : layout.frames * layout.analog_samples_per_frame;
+  if (channels == 0) return;
+
+  analog->labels = ChainedStrings(params, "ANALOG", "LABELS", channels);
+  std::size_t unnamed = 0;
+  analog->labels.resize(channels);
+  for (std::size_t c = 0; c < channels; ++c) {
+    if (analog->labels[c].empty()) {
+      analog->labels[c] = "analog_" + std::to_string(c + 1);
+      ++unnamed;
+    }
+  }
+  if (unnamed > 0) {
+    warnings->push_back(std::to_string(unnamed) +
+                        " analog channel(s) without a label in ANALOG:LABELS were named "
+                        "analog_<n>");
+  }
+  analog->units = ChainedStrings(params, "ANALOG", "UNITS", channels);
+  analog->units.resize(channels);
+
+  // ANALOG:FORMAT says whether 16-bit samples are signed (the default) or
+  // unsigned (some older A/D boards, with OFFSET near 2^(BITS-1)).
+  if (const Parameter* p = params.Find("ANALOG", "FORMAT")) {
+    const std::vector<std::string> format = params.Strings(*p);
+    const std::string f = format.empty() ? std::string() : Upper(format[0]);
+    if (f == "UNSIGNED") {
+      analog->unsigned_integers = true;
+    } else if (f != "SIGNED" && !f.empty()) {
+      in.Fail(p->record_offset,
+              "ANALOG:FORMAT: expected \"SIGNED\" or \"UNSIGNED\", found \"" + f + "\"");
+    }
+  }
+  if (analog->unsigned_integers && layout.float_storage) {
+    warnings->push_back("ANALOG:FORMAT is UNSIGNED in a float file; ignored (floats carry a sign)");
+    analog->unsigned_integers = false;
+  }
+  analog->scale = PerChannel(params, in, "SCALE", channels, 1.0, false, warnings);
+  // OFFSET is an int16 parameter; with unsigned samples its words are
+  // unsigned too (an offset of 32768 for a 16-bit unsigned board).
+  analog->offset =
+      PerChannel(params, in, "OFFSET", channels, 0.0, analog->unsigned_integers, warnings);
+  if (const Parameter* p = params.Find("ANALOG", "GEN_SCALE")) {
+    analog->gen_scale = params.Number(*p, 0, false);
+    if (!std::isfinite(analog->gen_scale)) {
+      in.Fail(p->record_offset, "ANALOG:GEN_SCALE: expected a finite scale, found " +
+                                    std::to_string(analog->gen_scale));
+    }
+  } else {
+    warnings->push_back("ANALOG:GEN_SCALE is missing; took 1");
+    analog->gen_scale = 1.0;
+  }
+
+  const std::uint64_t value_bytes = layout.float_storage ? 4 : 2;
+  const std::uint64_t points_bytes = layout.points * 4 * value_bytes;
+  std::vector<double> factor(channels);
+  for (std::uint64_t c = 0; c < channels; ++c) factor[c] = analog->scale[c] * analog->gen_scale;
+  analog->values.resize(analog->sample_count * channels);
+  std::size_t non_finite = 0;
+  std::size_t i = 0;
+  for (std::uint64_t f = 0; f < layout.frames; ++f) {
+    std::uint64_t at = layout.data_offset + f * layout.frame_bytes + points_bytes;
+    for (std::uint64_t s = 0; s < layout.analog_samples_per_frame; ++s) {
+      for (std::uint64_t c = 0; c < channels; ++c, ++i, at += value_bytes) {
+        double raw = 0.0;
+        if (layout.float_storage) {
+          raw = in.RawF32(at);
+        } else if (analog->unsigned_integers) {
+          raw = in.RawU16(at);
+        } else {
+          raw = in.RawI16(at);
+        }
+        const double v = (raw - analog->offset[c]) * factor[c];
+        if (!std::isfinite(v)) {
+          ++non_finite;
+          analog->values[i] = std::numeric_limits<double>::quiet_NaN();
+        } else {
+          analog->values[i] = v;
+        }
+      }
+    }
+  }
+  if (non_finite > 0) {
+    warnings->push_back(std::to_string(non_finite) +
+                        " analog sample(s) are not finite numbers; kept as NaN");
+  }
+}
+
+C3dRecording Read(const std::vector<std::uint8_t>& bytes, const std::string& name_for_errors,
+                  bool with_analog) {
   ByteReader in(bytes, name_for_errors);
-  MarkerTable table;
+  C3dRecording recording;
+  MarkerTable& table = recording.markers;
   table.format = "c3d";
   const ParameterSection params = ReadParameterSection(bytes, &in, &table);
   Layout layout = ReadPointLayout(params, in, &table.warnings);
@@ -783,16 +946,67 @@ MarkerTable ReadC3dFromMemory(const std::vector<std::uint8_t>& bytes,
   table.Reset(layout.frames, ReadLabels(params, layout.points, &table.warnings),
               /*with_residual=*/true);
   DecodePoints(in, layout, &table);
-  return table;
+  if (with_analog) DecodeAnalog(params, in, layout, &recording.analog, &table.warnings);
+  return recording;
 }
 
-MarkerTable ReadC3d(const std::string& path) {
+std::vector<std::uint8_t> ReadBytes(const std::string& path) {
   std::ifstream stream(path, std::ios::binary);
   if (!stream) ThrowInputError(path, "", "cannot open for reading");
   std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(stream)),
                                   std::istreambuf_iterator<char>());
   if (stream.bad()) ThrowInputError(path, "", "read failed");
-  return ReadC3dFromMemory(bytes, path);
+  return bytes;
 }
+
+}  // namespace
+
+double C3dAnalog::value(std::size_t sample, std::size_t channel) const {
+  CCSRM_CHECK(sample < sample_count && channel < channels());
+  return values[sample * channels() + channel];
+}
+
+std::optional<std::size_t> C3dAnalog::index_of(const std::string& label) const {
+  for (std::size_t c = 0; c < labels.size(); ++c) {
+    if (labels[c] == label) return c;
+  }
+  return std::nullopt;
+}
+
+bool C3dAnalog::IsConsistent(std::string* error) const {
+  auto fail = [&](const std::string& why) {
+    if (error != nullptr) *error = why;
+    return false;
+  };
+  const std::size_t n = channels();
+  if (units.size() != n || scale.size() != n || offset.size() != n) {
+    return fail("analog: units, scale and offset need one entry per label (" + std::to_string(n) +
+                ")");
+  }
+  if (values.size() != sample_count * n) {
+    return fail("analog: expected " + std::to_string(sample_count * n) + " values, found " +
+                std::to_string(values.size()));
+  }
+  if (n > 0 && (samples_per_frame == 0 || !std::isfinite(rate_hz) || !(rate_hz > 0.0))) {
+    return fail("analog: channels need samples_per_frame >= 1 and a positive rate");
+  }
+  return true;
+}
+
+C3dRecording ReadC3dRecordingFromMemory(const std::vector<std::uint8_t>& bytes,
+                                        const std::string& name_for_errors) {
+  return Read(bytes, name_for_errors, /*with_analog=*/true);
+}
+
+C3dRecording ReadC3dRecording(const std::string& path) {
+  return ReadC3dRecordingFromMemory(ReadBytes(path), path);
+}
+
+MarkerTable ReadC3dFromMemory(const std::vector<std::uint8_t>& bytes,
+                              const std::string& name_for_errors) {
+  return Read(bytes, name_for_errors, /*with_analog=*/false).markers;
+}
+
+MarkerTable ReadC3d(const std::string& path) { return ReadC3dFromMemory(ReadBytes(path), path); }
 
 }  // namespace ccsrm::mocap

@@ -1,4 +1,4 @@
-// C3D writer: Intel processor, float storage, points only (no analog data).
+// C3D writer: Intel processor, float storage, points and analog channels.
 // The layout is described at the top of c3d_reader.cc.
 #include <algorithm>
 #include <cmath>
@@ -64,6 +64,13 @@ class ParameterWriter {
     Parameter(group_id, name, 4, {}, data);
   }
 
+  // At most 255 values (one uint8 dimension).
+  void FloatArray(int group_id, const std::string& name, const std::vector<float>& v) {
+    std::vector<std::uint8_t> data(4 * v.size());
+    for (std::size_t i = 0; i < v.size(); ++i) EncodeIntelF32(v[i], &data[4 * i]);
+    Parameter(group_id, name, 4, {v.size()}, data);
+  }
+
   void String(int group_id, const std::string& name, const std::string& value) {
     Parameter(group_id, name, -1, {value.size()},
               std::vector<std::uint8_t>(value.begin(), value.end()));
@@ -120,11 +127,48 @@ std::vector<std::uint16_t> TwoWords(std::uint64_t value) {
   return {static_cast<std::uint16_t>(value & 0xFFFF), static_cast<std::uint16_t>(value >> 16)};
 }
 
-std::vector<std::uint8_t> Encode(const MarkerTable& table, const C3dWriteOptions& options,
-                                 const std::string& name) {
+std::vector<std::uint8_t> Encode(const MarkerTable& table, const C3dAnalog& analog,
+                                 const C3dWriteOptions& options, const std::string& name) {
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError(name, "C3D write options", error);
   if (!table.IsConsistent(&error)) ThrowInputError(name, "marker table", error);
+  if (!analog.IsConsistent(&error)) ThrowInputError(name, "analog channels", error);
+  const std::size_t channels = analog.channels();
+  const std::size_t samples_per_frame = channels == 0 ? 0 : analog.samples_per_frame;
+  if (channels > 0) {
+    if (analog.sample_count != table.frames() * samples_per_frame) {
+      ThrowInputError(name, "analog channels",
+                      std::to_string(analog.sample_count) + " samples for " +
+                          std::to_string(table.frames()) + " frames of " +
+                          std::to_string(samples_per_frame) + " samples each");
+    }
+    // ANALOG:RATE must be a whole multiple of POINT:RATE (readers derive the
+    // samples per frame from their ratio).
+    const double expected_rate = table.rate_hz * static_cast<double>(samples_per_frame);
+    if (std::abs(analog.rate_hz - expected_rate) > 1e-9 * expected_rate) {
+      ThrowInputError(name, "analog channels",
+                      "rate " + std::to_string(analog.rate_hz) + " Hz is not " +
+                          std::to_string(samples_per_frame) + " × the point rate " +
+                          std::to_string(table.rate_hz) + " Hz");
+    }
+    // One uint8 dimension per ANALOG:SCALE/OFFSET array; header word 3 is
+    // 16 bits.
+    if (channels > kMaxStringsPerParameter || channels * samples_per_frame > 65535) {
+      ThrowInputError(name, "analog channels",
+                      "the writer holds at most 255 channels and 65535 analog values per frame, "
+                      "found " +
+                          std::to_string(channels) + " × " + std::to_string(samples_per_frame));
+    }
+    for (const std::vector<std::string>* names : {&analog.labels, &analog.units}) {
+      for (const std::string& s : *names) {
+        if (s.size() > 255) {
+          ThrowInputError(
+              name, "analog channels",
+              "label or unit \"" + s.substr(0, 32) + "...\" is longer than 255 characters");
+        }
+      }
+    }
+  }
   if (table.markers() > 65535) {
     ThrowInputError(
         name, "marker table",
@@ -188,8 +232,16 @@ std::vector<std::uint8_t> Encode(const MarkerTable& table, const C3dWriteOptions
     params.Float(kPointGroup, "LONG_FRAMES", static_cast<float>(frames));
   }
   params.Group(kAnalogGroup, "ANALOG", "analog data parameters");
-  params.Words(kAnalogGroup, "USED", {0}, true);
-  params.Float(kAnalogGroup, "RATE", rate);
+  params.Words(kAnalogGroup, "USED", {static_cast<std::uint16_t>(channels)}, true);
+  params.Float(kAnalogGroup, "RATE", channels == 0 ? rate : static_cast<float>(analog.rate_hz));
+  if (channels > 0) {
+    // The values are stored already scaled: SCALE 1, OFFSET 0, GEN_SCALE 1.
+    params.Strings(kAnalogGroup, "LABELS", analog.labels);
+    params.Strings(kAnalogGroup, "UNITS", analog.units);
+    params.FloatArray(kAnalogGroup, "SCALE", std::vector<float>(channels, 1.0f));
+    params.Words(kAnalogGroup, "OFFSET", std::vector<std::uint16_t>(channels, 0), false);
+    params.Float(kAnalogGroup, "GEN_SCALE", 1.0f);
+  }
   if (long_trial) {
     params.Group(kTrialGroup, "TRIAL", "frame range beyond 65535 frames");
     params.Words(kTrialGroup, "ACTUAL_START_FIELD", TwoWords(first), false);
@@ -210,18 +262,20 @@ std::vector<std::uint8_t> Encode(const MarkerTable& table, const C3dWriteOptions
 
   // ---- Header (block 1) -------------------------------------------------------------
   const std::size_t markers = table.markers();
-  std::vector<std::uint8_t> out(kC3dBlockSize * (data_block - 1) + frames * markers * 16, 0);
+  const std::size_t analog_values = channels * samples_per_frame;
+  std::vector<std::uint8_t> out(
+      kC3dBlockSize * (data_block - 1) + frames * (markers * 16 + analog_values * 4), 0);
   out[0] = 2;
   out[1] = internal::kC3dMagic;
   EncodeIntelU16(static_cast<std::uint16_t>(markers), &out[2]);
-  EncodeIntelU16(0, &out[4]);  // analog values per frame
+  EncodeIntelU16(static_cast<std::uint16_t>(analog_values), &out[4]);
   const std::int64_t last = frames == 0 ? first : first + static_cast<std::int64_t>(frames) - 1;
   EncodeIntelU16(static_cast<std::uint16_t>(std::min<std::int64_t>(first, 65535)), &out[6]);
   EncodeIntelU16(static_cast<std::uint16_t>(std::min<std::int64_t>(last, 65535)), &out[8]);
   EncodeIntelU16(0, &out[10]);  // maximum interpolation gap
   EncodeIntelF32(scale, &out[12]);
   EncodeIntelU16(static_cast<std::uint16_t>(data_block), &out[16]);
-  EncodeIntelU16(0, &out[18]);  // analog samples per frame
+  EncodeIntelU16(static_cast<std::uint16_t>(samples_per_frame), &out[18]);
   EncodeIntelF32(rate, &out[20]);
 
   // ---- Parameter section (block 2 ...) ------------------------------------------------
@@ -257,6 +311,11 @@ std::vector<std::uint8_t> Encode(const MarkerTable& table, const C3dWriteOptions
       }
       EncodeIntelF32(static_cast<float>(word), data + 12);
     }
+    // The frame's analog samples, each holding every channel.
+    const double* values = analog.values.data() + f * analog_values;
+    for (std::size_t k = 0; k < analog_values; ++k, data += 4) {
+      EncodeIntelF32(static_cast<float>(values[k]), data);
+    }
   }
   return out;
 }
@@ -276,11 +335,21 @@ bool C3dWriteOptions::IsValid(std::string* error) const {
 }
 
 std::vector<std::uint8_t> EncodeC3d(const MarkerTable& table, const C3dWriteOptions& options) {
-  return Encode(table, options, "C3D output");
+  return Encode(table, C3dAnalog(), options, "C3D output");
+}
+
+std::vector<std::uint8_t> EncodeC3d(const C3dRecording& recording, const C3dWriteOptions& options) {
+  return Encode(recording.markers, recording.analog, options, "C3D output");
 }
 
 void WriteC3d(const std::string& path, const MarkerTable& table, const C3dWriteOptions& options) {
-  const std::vector<std::uint8_t> bytes = Encode(table, options, path);
+  WriteC3d(path, C3dRecording{table, C3dAnalog()}, options);
+}
+
+void WriteC3d(const std::string& path, const C3dRecording& recording,
+              const C3dWriteOptions& options) {
+  const std::vector<std::uint8_t> bytes =
+      Encode(recording.markers, recording.analog, options, path);
   AtomicOutputFile out(path);
   {
     std::ofstream stream(out.temp_path(), std::ios::binary);

@@ -95,6 +95,11 @@ MarkerTable ReadHdf5Markers(const std::string& path) {
   return MarkerTableFromRun(std::get<datasets::RunFile>(file), path);
 }
 
+C3dRecording ReadMarkerFileWithAnalog(const std::string& path) {
+  if (LowerExtension(path) == ".c3d") return ReadC3dRecording(path);
+  return C3dRecording{ReadMarkerFile(path), C3dAnalog()};
+}
+
 MarkerTable ReadMarkerFile(const std::string& path) {
   const std::string ext = LowerExtension(path);
   if (ext == ".c3d") return ReadC3d(path);
@@ -207,6 +212,87 @@ std::string InspectText(const MarkerTable& table) {
     out << "\n";
   }
   for (const std::string& warning : table.warnings) out << "warning: " << warning << "\n";
+  return out.str();
+}
+
+namespace {
+
+struct ChannelRange {
+  double min = 0.0;
+  double max = 0.0;
+  std::size_t finite = 0;
+  std::size_t non_finite = 0;
+};
+
+ChannelRange RangeOf(const C3dAnalog& analog, std::size_t channel) {
+  ChannelRange r;
+  for (std::size_t s = 0; s < analog.sample_count; ++s) {
+    const double v = analog.value(s, channel);
+    if (!std::isfinite(v)) {
+      ++r.non_finite;
+      continue;
+    }
+    r.min = r.finite == 0 ? v : std::min(r.min, v);
+    r.max = r.finite == 0 ? v : std::max(r.max, v);
+    ++r.finite;
+  }
+  return r;
+}
+
+}  // namespace
+
+nlohmann::json InspectAnalogJson(const C3dAnalog& analog) {
+  const auto utf8 = [](const std::string& s) { return internal::AsUtf8(s); };
+  nlohmann::json j;
+  j["channels"] = analog.channels();
+  j["rate_hz"] = analog.rate_hz;
+  j["samples_per_frame"] = analog.samples_per_frame;
+  j["samples"] = analog.sample_count;
+  j["gen_scale"] = analog.gen_scale;
+  j["unsigned_integers"] = analog.unsigned_integers;
+  nlohmann::json list = nlohmann::json::array();
+  for (std::size_t c = 0; c < analog.channels(); ++c) {
+    const ChannelRange r = RangeOf(analog, c);
+    nlohmann::json channel;
+    channel["label"] = utf8(analog.labels[c]);
+    channel["units"] = utf8(analog.units[c]);
+    channel["scale"] = analog.scale[c];
+    channel["offset"] = analog.offset[c];
+    channel["min"] = r.finite > 0 ? nlohmann::json(r.min) : nlohmann::json(nullptr);
+    channel["max"] = r.finite > 0 ? nlohmann::json(r.max) : nlohmann::json(nullptr);
+    channel["non_finite"] = r.non_finite;
+    list.push_back(channel);
+  }
+  j["list"] = list;
+  return j;
+}
+
+std::string InspectAnalogText(const C3dAnalog& analog) {
+  if (analog.channels() == 0) return std::string();
+  std::ostringstream out;
+  out << "\nanalog:          " << analog.channels() << " channel(s) at "
+      << FormatNumber(analog.rate_hz, 6) << " Hz (" << analog.samples_per_frame << " per frame, "
+      << analog.sample_count << " samples), GEN_SCALE " << FormatNumber(analog.gen_scale, 6)
+      << (analog.unsigned_integers ? ", unsigned" : "") << "\n";
+  std::size_t width = 5;
+  for (const std::string& label : analog.labels) width = std::max(width, label.size());
+  out << "\n  label" << std::string(width - 5, ' ')
+      << "  units      scale         offset    min .. max (scaled)\n";
+  for (std::size_t c = 0; c < analog.channels(); ++c) {
+    const ChannelRange r = RangeOf(analog, c);
+    char line[160];
+    std::snprintf(line, sizeof(line), "  %-*s  %-8s  %-12.6g  %-8g  ", static_cast<int>(width),
+                  analog.labels[c].c_str(), analog.units[c].c_str(), analog.scale[c],
+                  analog.offset[c]);
+    out << line;
+    if (r.finite > 0) {
+      out << FormatNumber(r.min, 6) << " .. " << FormatNumber(r.max, 6);
+    } else {
+      out << "no finite sample";
+    }
+    if (r.non_finite > 0) out << " (" << r.non_finite << " not finite)";
+    out << "\n";
+  }
   return out.str();
 }
 

@@ -150,6 +150,24 @@ class BadInputTable : public ::testing::Test {
     Write(d / "notes.c3d", "my notes, not a C3D file\n");
     fs::create_directory(d / "mine");
     Write(d / "mine" / "precious.txt", "the user's own file\n");
+    // Actuator logs and their maps (issue 27): six cables of the paper's arm.
+    std::string map = "schema: ccsrm-actuators/1\ntime: {column: t_s, unit: s}\ncables:\n";
+    std::string header = "t_s";
+    std::string row = "";
+    for (int c = 1; c <= 6; ++c) {
+      map += "  - {column: m" + std::to_string(c) +
+             ", signal: motor_angle, unit: deg, drum_radius_m: 0.01}\n";
+      header += ",m" + std::to_string(c);
+      row += ",1.5";
+    }
+    Write(d / "map.yaml", map);
+    Write(d / "nodrum.yaml", std::regex_replace(map, std::regex(", drum_radius_m: 0.01"), "",
+                                                std::regex_constants::format_first_only));
+    Write(d / "unknowncol.yaml", std::regex_replace(map, std::regex("column: m6"), "column: m7"));
+    Write(d / "log.csv", header + "\n0" + row + "\n0.01" + row + "\n0.02" + row + "\n");
+    Write(d / "nanlog.csv", header + "\n0" + row + "\n0.01,1,2,NaN,4,5,6\n");
+    Write(d / "backlog.csv", header + "\n0" + row + "\n0.02" + row + "\n0.01" + row + "\n");
+    Write(d / "gaplog.csv", header + "\n0" + row + "\n5" + row + "\n");
 
     // Made in a work folder, then moved in: the rows compare the scratch
     // folder with itself, and these are its inputs.
@@ -383,6 +401,43 @@ const std::vector<BadInput>& Rows() {
        {"{d}/inf.h5", "/mocap/markers"}},  // 4
       {"markers", "mocap inspect {d}/notes.c3d", {"{d}/notes.c3d"}},
       {"markers", "mocap process --in {d}/missing.c3d --out {d}/x.h5", {"{d}/missing.c3d"}},
+      // Actuator logs and maps (dataset assemble, issue 27).
+      {"actuators",
+       "dataset assemble --markers {d}/exp.h5 --actuators {d}/log.csv --actuator-map "
+       "{d}/nodrum.yaml --config {d}/c.yaml --sync offset=0 --out {d}/x.h5",
+       {"{d}/nodrum.yaml", "line 4", "cables[0].drum_radius_m", "missing"}},
+      {"actuators",
+       "dataset assemble --markers {d}/exp.h5 --actuators {d}/log.csv --actuator-map "
+       "{d}/unknowncol.yaml --config {d}/c.yaml --sync offset=0 --out {d}/x.h5",
+       {"{d}/log.csv", "line 1", "no column 'm7'", "cables[5].column"}},
+      {"actuators",
+       "dataset assemble --markers {d}/exp.h5 --actuators {d}/nanlog.csv --actuator-map "
+       "{d}/map.yaml --config {d}/c.yaml --sync offset=0 --out {d}/x.h5",
+       {"{d}/nanlog.csv", "line 3", "column 'm3'", "not a finite number"}},
+      {"actuators",
+       "dataset assemble --markers {d}/exp.h5 --actuators {d}/backlog.csv --actuator-map "
+       "{d}/map.yaml --config {d}/c.yaml --sync offset=0 --out {d}/x.h5",
+       {"{d}/backlog.csv", "line 4", "column 't_s'", "does not increase"}},
+      {"actuators",
+       "dataset assemble --markers {d}/exp.h5 --actuators {d}/gaplog.csv --actuator-map "
+       "{d}/map.yaml --config {d}/c.yaml --sync offset=0 --out {d}/x.h5",
+       {"{d}/gaplog.csv", "line 3", "a gap of 5 s"}},
+      {"actuators",
+       "dataset assemble --markers {d}/exp.h5 --actuators {d}/log.csv --actuator-map "
+       "{d}/map.yaml --config {d}/c.yaml --sync sometimes --out {d}/x.h5",
+       {"--sync", "sometimes"}},
+      {"actuators",
+       "dataset assemble --markers {d}/exp.h5 --actuators {d}/log.csv --actuator-map "
+       "{d}/map.yaml --config {d}/c.yaml --sync offset=0 --out {d}/x.h5",
+       {"{d}/log.csv", "actuator log", "covers mocap time"}},
+      {"actuators",
+       "dataset assemble --markers {d}/exp.h5 --actuators {d}/log.csv --actuator-map "
+       "{d}/map.yaml --config {d}/c.yaml --sync trigger --out {d}/x.h5",
+       {"{d}/map.yaml", "trigger", "missing"}},
+      {"outputs",
+       "dataset assemble --markers {d}/exp.h5 --actuators {d}/log.csv --actuator-map "
+       "{d}/map.yaml --config {d}/c.yaml --sync offset=0 --out {d}/log.csv",
+       {"{d}/log.csv", "--out", "input"}},
       // Output paths: nothing of the user's is replaced, no input written.
       {"outputs",
        "identify --data {d}/processed.h5 --free mu --out {d}/mine",

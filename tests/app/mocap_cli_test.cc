@@ -334,7 +334,10 @@ TEST(MocapExport, C3dOfAnExperimentProcessesToTheSameMeasurementAsTheExperiment)
   const std::string c3d = (dir / "exp.c3d").string();
   Outcome o = RunCcsrm("mocap export --in " + exp + " --out " + c3d);
   ASSERT_EQ(o.status, 0) << o.err;
-  EXPECT_THAT(o.out, HasSubstr("31 frames, 52 markers at 100 Hz (C3D, Intel, float storage, mm)"));
+  EXPECT_THAT(
+      o.out,
+      HasSubstr(
+          "31 frames, 52 markers at 100 Hz, 0 analog channel(s) (C3D, Intel, float storage, mm)"));
   // The experiment's own configuration, as a lab would keep it beside the C3D.
   const std::string config = (dir / "nominal.yaml").string();
   ccsrm::WriteTextFileAtomically(config, ccsrm::datasets::ReadExperimentFile(exp).config_yaml);
@@ -399,6 +402,49 @@ TEST(MocapExport, RefusesOtherFormatsAndItsOwnInput) {
   EXPECT_EQ(o.status, 2);
   EXPECT_EQ(ccsrm::testing::CountLines(o.err), 1) << o.err;
   EXPECT_FALSE(fs::exists(dir / "x.trc"));
+}
+
+// A C3D file with two analog channels (a trigger and a ramp, 4 samples per
+// frame): `mocap inspect` lists them and `mocap export` writes them back.
+TEST(MocapExport, AnalogChannelsAreListedAndWrittenBack) {
+  const fs::path dir = FreshDir("export_analog");
+  ccsrm::mocap::C3dRecording recording;
+  recording.markers = ccsrm::testing::LongLabelTable(3, 20);
+  ccsrm::mocap::C3dAnalog& analog = recording.analog;
+  analog.labels = {"trigger", "ramp"};
+  analog.units = {"V", "mV"};
+  analog.samples_per_frame = 4;
+  analog.rate_hz = 400.0;
+  analog.sample_count = 80;
+  analog.scale = {1.0, 1.0};
+  analog.offset = {0.0, 0.0};
+  for (std::size_t s = 0; s < analog.sample_count; ++s) {
+    analog.values.push_back(s >= 37 ? 5.0 : 0.0);
+    analog.values.push_back(0.25 * static_cast<double>(s));
+  }
+  const std::string in = (dir / "in.c3d").string();
+  ccsrm::mocap::WriteC3d(in, recording);
+  Outcome o = RunCcsrm("mocap inspect --json " + in);
+  ASSERT_EQ(o.status, 0) << o.err;
+  const nlohmann::json j = nlohmann::json::parse(o.out);
+  ASSERT_TRUE(j.contains("analog"));
+  EXPECT_EQ(j["analog"]["channels"], 2);
+  EXPECT_DOUBLE_EQ(j["analog"]["rate_hz"].get<double>(), 400.0);
+  EXPECT_EQ(j["analog"]["list"][0]["label"], "trigger");
+  EXPECT_EQ(j["analog"]["list"][1]["units"], "mV");
+  EXPECT_DOUBLE_EQ(j["analog"]["list"][1]["max"].get<double>(), 0.25 * 79);
+  o = RunCcsrm("mocap inspect " + in);
+  EXPECT_THAT(o.out,
+              HasSubstr("analog:          2 channel(s) at 400 Hz (4 per frame, 80 samples)"));
+
+  const std::string out = (dir / "out.c3d").string();
+  o = RunCcsrm("mocap export --in " + in + " --out " + out);
+  ASSERT_EQ(o.status, 0) << o.err;
+  EXPECT_THAT(o.out, HasSubstr("2 analog channel(s)"));
+  const ccsrm::mocap::C3dRecording back = ccsrm::mocap::ReadC3dRecording(out);
+  EXPECT_EQ(back.analog.labels, analog.labels);
+  EXPECT_EQ(back.analog.units, analog.units);
+  EXPECT_EQ(back.analog.values, analog.values);  // small whole and quarter values: exact in float
 }
 
 TEST(Generate, ListEffectsGivesEveryEffectWithUnitsBoundsAndRealisticMagnitude) {

@@ -33,6 +33,23 @@ struct RigidBody {
   Array local_position;
 };
 
+// Extension: how the inputs of a recorded experiment were put on the mocap
+// clock (`ccsrm dataset assemble`). The actuator log's clock reads
+//   t_log = offset_s + (1 + drift_ppm × 1e-6) × t_mocap,
+// t_mocap being /mocap/time; /input/time is on the mocap clock.
+struct ClockAlignment {
+  // "trigger" (edges of a C3D analog channel matched to the log's trigger
+  // column), "estimate" (the offset that best explains the measured joint
+  // angles), or "offset" (given by the user).
+  std::string method;
+  std::string actuator_log;  // the log's file name
+  double offset_s = 0.0;
+  double offset_uncertainty_s = 0.0;  // one standard deviation, s
+  double drift_ppm = 0.0;
+  double drift_uncertainty_ppm = 0.0;  // one standard deviation; 0 when not estimated
+  std::string note;                    // one line: what was matched, how well
+};
+
 struct ExperimentFile {
   // --- Root attributes -----------------------------------------------------
   std::string name;
@@ -48,6 +65,10 @@ struct ExperimentFile {
   // inputs that drove a generated one.
   std::string protocol_yaml;
   std::string inputs_file;
+  // Extension (optional attributes clock_alignment, actuator_log,
+  // clock_offset_s, clock_offset_uncertainty_s, clock_drift_ppm,
+  // clock_drift_uncertainty_ppm, clock_alignment_note; written when set).
+  std::optional<ClockAlignment> clock_alignment;
 
   // --- Datasets --------------------------------------------------------------
   Array input_time;                       // /input/time, N, s: strictly increasing, finite, N >= 1.

@@ -7,6 +7,7 @@
 
 #include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/datasets/run_file.h"
+#include "ccsrm/mocap/c3d.h"
 #include "ccsrm/mocap/marker_table.h"
 
 namespace ccsrm::mocap {
@@ -18,6 +19,10 @@ namespace ccsrm::mocap {
 // /mocap/markers, or a ccsrm-run/1 run's /markers (ReadHdf5Markers). Throws
 // InputError for an unknown extension or an unrecognised CSV.
 MarkerTable ReadMarkerFile(const std::string& path);
+
+// The same, with a C3D file's analog channels (ReadC3dRecording); other
+// formats give no channels. The file is read once.
+C3dRecording ReadMarkerFileWithAnalog(const std::string& path);
 
 // The markers of a ccsrm-dataset/1 experiment (/mocap/markers, format
 // "ccsrm-dataset") or of a ccsrm-run/1 run with /markers (format "ccsrm-run"),
@@ -44,5 +49,13 @@ nlohmann::json InspectJson(const MarkerTable& table);
 
 // The same summary as human-readable text (several lines).
 std::string InspectText(const MarkerTable& table);
+
+// A summary of analog channels: {channels, rate_hz, samples_per_frame,
+// samples, gen_scale, unsigned_integers, list: [{label, units, scale, offset,
+// min, max, non_finite}]} (min/max of the scaled values, null when none is
+// finite).
+nlohmann::json InspectAnalogJson(const C3dAnalog& analog);
+// The same as text (empty when there are no channels).
+std::string InspectAnalogText(const C3dAnalog& analog);
 
 }  // namespace ccsrm::mocap
