@@ -79,6 +79,12 @@ struct PaperRun {
 // file or value.
 PaperRun PreparePaperRun(const PaperRunOptions& options);
 
+// The same from a configuration already read (LoadConfig / ParseConfig):
+// its source_name and source_yaml stand for the file, and
+// options.config_path is not used. For callers that hold the configuration
+// (the Python module's model) and must not read the file again.
+PaperRun PreparePaperRun(const PaperRunOptions& options, Config config);
+
 // The run in words for any arm, the lines a command prints above the
 // simulation's summary: the case and the file (the paper's case only on the
 // paper's arm, sim/describe.h), the arm as configured and the protocol (or
