@@ -1,0 +1,198 @@
+// ccsrm.identify: `ccsrm identify` from Python (identify::Identify on
+// experiments loaded by identify::LoadExperiment), its summary and fit.json.
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "ccsrm/common/error.h"
+#include "ccsrm/identify/experiment.h"
+#include "ccsrm/identify/identification.h"
+
+namespace ccsrm::python {
+namespace {
+
+// A fit and the experiments it was made on (what writing its folder needs).
+struct Fit {
+  identify::IdentificationSummary summary;
+  std::vector<identify::Experiment> experiments;
+};
+
+// A list of names, or one comma-separated string as --free takes it.
+std::vector<std::string> Names(const py::object& names) {
+  if (py::isinstance<py::str>(names)) {
+    std::vector<std::string> out;
+    std::string text = names.cast<std::string>();
+    std::size_t begin = 0;
+    while (true) {
+      const std::size_t end = text.find(',', begin);
+      out.push_back(text.substr(begin, end == std::string::npos ? end : end - begin));
+      if (end == std::string::npos) break;
+      begin = end + 1;
+    }
+    for (std::string& n : out) {
+      const std::size_t first = n.find_first_not_of(" \t");
+      const std::size_t last = n.find_last_not_of(" \t");
+      n = first == std::string::npos ? "" : n.substr(first, last - first + 1);
+    }
+    return out;
+  }
+  return names.cast<std::vector<std::string>>();
+}
+
+// Values as --set takes them ("name=value"), from a dict or from strings.
+std::vector<std::string> Assignments(const py::object& values) {
+  if (values.is_none()) return {};
+  if (py::isinstance<py::dict>(values)) {
+    std::vector<std::string> out;
+    for (const auto& [name, value] : values.cast<py::dict>()) {
+      // repr of a float is the shortest text that reads back to the same
+      // double, so the value reaches the fit unchanged.
+      out.push_back(name.cast<std::string>() + "=" +
+                    py::repr(py::float_(value.cast<double>())).cast<std::string>());
+    }
+    return out;
+  }
+  return values.cast<std::vector<std::string>>();
+}
+
+std::shared_ptr<Fit> RunIdentify(const py::object& data, const py::object& free,
+                                 const py::object& params, const py::object& set,
+                                 std::optional<int> threads, int max_iterations,
+                                 double relative_step, std::optional<double> noise_deg,
+                                 bool central_throughout, const py::object& out) {
+  std::vector<std::string> paths;
+  if (py::isinstance<py::str>(data) || py::hasattr(data, "__fspath__")) {
+    paths.push_back(PathString(data));
+  } else {
+    for (const py::handle& p : data) paths.push_back(PathString(p));
+  }
+  if (paths.empty()) ThrowInputError("data", "", "give at least one experiment file");
+  identify::IdentificationOptions options;
+  if (threads) options.threads = *threads;
+  options.max_iterations = max_iterations;
+  options.relative_step = relative_step;
+  options.central_differences_throughout = central_throughout;
+  std::optional<std::vector<std::string>> free_names;
+  if (!free.is_none()) free_names = Names(free);
+  const std::string params_path = params.is_none() ? "" : PathString(params);
+  const std::vector<std::string> sets = Assignments(set);
+  const std::string out_dir = out.is_none() ? "" : PathString(out);
+
+  auto fit = std::make_shared<Fit>();
+  py::gil_scoped_release release;
+  // The command's order: options, then every experiment, before any run.
+  identify::ApplyFitParameters(free_names ? &*free_names : nullptr, params_path, sets, &options);
+  std::string error;
+  if (!options.IsValid(&error)) ThrowInputError("identify", "", error);
+  identify::ExperimentLoadOptions load;
+  if (noise_deg) load.noise_deg = *noise_deg;
+  for (const std::string& path : paths)
+    fit->experiments.push_back(identify::LoadExperiment(path, load));
+  fit->summary = identify::Identify(fit->experiments, options);
+  if (!out_dir.empty()) identify::WriteFitDirectory(fit->summary, fit->experiments, out_dir);
+  return fit;
+}
+
+}  // namespace
+
+void AddIdentification(py::module_& m) {
+  using identify::ParameterEstimate;
+  py::class_<ParameterEstimate>(m, "ParameterEstimate", "One parameter of a fit.")
+      .def_readonly("name", &ParameterEstimate::name)
+      .def_readonly("units", &ParameterEstimate::units)
+      .def_readonly("free", &ParameterEstimate::free)
+      .def_readonly("start", &ParameterEstimate::start)
+      .def_readonly("value", &ParameterEstimate::value)
+      .def_readonly("lower", &ParameterEstimate::lower)
+      .def_readonly("upper", &ParameterEstimate::upper)
+      .def_readonly("scale", &ParameterEstimate::scale)
+      .def_readonly("identifiable", &ParameterEstimate::identifiable)
+      .def_readonly("std_error", &ParameterEstimate::std_error, "NaN when not identifiable.")
+      .def_readonly("ci95_lower", &ParameterEstimate::ci95_lower)
+      .def_readonly("ci95_upper", &ParameterEstimate::ci95_upper)
+      .def_readonly("at_bound", &ParameterEstimate::at_bound)
+      .def("__repr__", [](const ParameterEstimate& p) {
+        return "<ParameterEstimate " + p.name + " = " +
+               py::repr(py::float_(p.value)).cast<std::string>() + " " + p.units + ">";
+      });
+
+  py::class_<Fit, std::shared_ptr<Fit>>(
+      m, "Fit",
+      "The result of ccsrm.identify: the identification summary (estimates, standard errors, "
+      "correlations, identifiability) and its fit.json.")
+      .def_property_readonly(
+          "termination",
+          [](const Fit& f) { return identify::TerminationName(f.summary.termination); })
+      .def_property_readonly("converged", [](const Fit& f) { return f.summary.converged(); })
+      .def_property_readonly("message", [](const Fit& f) { return f.summary.message; })
+      .def_property_readonly("iterations", [](const Fit& f) { return f.summary.iterations; })
+      .def_property_readonly("simulations", [](const Fit& f) { return f.summary.simulations; })
+      .def_property_readonly("wall_time_s", [](const Fit& f) { return f.summary.wall_time_s; })
+      .def_property_readonly("initial_cost", [](const Fit& f) { return f.summary.initial_cost; })
+      .def_property_readonly("final_cost", [](const Fit& f) { return f.summary.final_cost; })
+      .def_property_readonly("cost_history", [](const Fit& f) { return f.summary.cost_history; })
+      .def_property_readonly("free_names", [](const Fit& f) { return f.summary.free_names; })
+      .def_property_readonly(
+          "parameters", [](const Fit& f) { return f.summary.parameters; },
+          "Every parameter's estimate, the free ones first.")
+      .def_property_readonly(
+          "correlation", [](const Fit& f) { return f.summary.correlation; },
+          "free x free; NaN rows for parameters not identifiable.")
+      .def_property_readonly("singular_values",
+                             [](const Fit& f) { return f.summary.singular_values; })
+      .def_property_readonly(
+          "rms_deg", [](const Fit& f) { return f.summary.errors.rms_deg_overall; },
+          "RMS error of the fitted joint angles over every experiment [deg].")
+      .def("__getitem__",
+           [](const Fit& f, const std::string& name) {
+             const ParameterEstimate* p = f.summary.Find(name);
+             if (p == nullptr) throw py::key_error(name);
+             return *p;
+           })
+      .def("brief_report", [](const Fit& f) { return f.summary.BriefReport(); })
+      .def(
+          "full_report", [](const Fit& f) { return f.summary.FullReport(); },
+          "The table `ccsrm identify` prints.")
+      .def(
+          "json", [](const Fit& f) { return identify::ToJson(f.summary).dump(2) + "\n"; },
+          "The summary as JSON: fit.json without the names of the files of the fit folder "
+          "(those come with write()).")
+      .def(
+          "to_dict",
+          [](const Fit& f) {
+            return py::module_::import("json").attr("loads")(identify::ToJson(f.summary).dump());
+          },
+          "json() as a dict.")
+      .def(
+          "write",
+          [](const Fit& f, const py::object& directory) {
+            const std::string dir = PathString(directory);
+            py::gil_scoped_release release;
+            return identify::WriteFitDirectory(f.summary, f.experiments, dir);
+          },
+          py::arg("directory"),
+          "Writes the fit folder `ccsrm identify --out` writes; returns the paths.")
+      .def("__repr__", [](const Fit& f) { return "<ccsrm.Fit " + f.summary.BriefReport() + ">"; });
+
+  m.def("identify", &RunIdentify, py::arg("data"), py::kw_only(), py::arg("free") = py::none(),
+        py::arg("params") = py::none(), py::arg("set") = py::none(),
+        py::arg("threads") = py::none(),
+        py::arg("max_iterations") = identify::IdentificationOptions().max_iterations,
+        py::arg("relative_step") = identify::IdentificationOptions().relative_step,
+        py::arg("noise_deg") = py::none(), py::arg("central_throughout") = false,
+        py::arg("out") = py::none(),
+        "Fits parameters to recorded experiments as `ccsrm identify` does, with its options: "
+        "data (one or more ccsrm-dataset/1 files), free (names, a list or 'mu,T_p'; default "
+        "SPEC 6's nine), params (a parameter file), set (dict or 'name=value' strings), "
+        "threads (default every core), max_iterations, relative_step, noise_deg (default "
+        "estimated), central_throughout, out (also write the fit folder). Returns a Fit. The "
+        "GIL is released during the fit.");
+  m.def("default_threads", &identify::DefaultThreads, "Simulations at a time by default.");
+}
+
+}  // namespace ccsrm::python
