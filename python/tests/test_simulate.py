@@ -218,3 +218,13 @@ def test_two_threads_simulate_in_parallel(paper_model):
                     f"jobs (load {os.getloadavg()[0]:.1f} on {cores}): speed-up not measurable "
                     f"(ratios {', '.join(f'{r:.2f}' for r in ratios)})")
     assert min(ratios) < 0.9, ratios
+
+
+@pytest.mark.slow
+def test_paper_case_2_over_the_whole_protocol_equals_command_line(exe, paper_config, paper_model,
+                                                                   tmp_path):
+    out = tmp_path / "cli.h5"
+    run_ccsrm(exe, "simulate", "--config", paper_config, "--case", 2, "--quiet", "--out", out)
+    run = ccsrm.simulate(paper_model, case=2)
+    assert run.summary.completed and run.frames == 4801
+    assert_same_as_file(run, out)
