@@ -180,6 +180,25 @@ class MarkerTable:
     @property
     def markers(self) -> int: ...
 
+class ProcessedRecording:
+    @property
+    def dataset(self) -> Dataset: ...
+    @property
+    def warnings(self) -> list[str]: ...
+    def brief_report(self) -> str: ...
+    def full_report(self) -> str: ...
+    def write(self, path: _Path) -> None: ...
+
+def process_markers(
+    path: _Path,
+    *,
+    config: _Path | None = None,
+    rigid_bodies: _Path | None = None,
+    static_trial: _Path | None = None,
+    inputs: _Path | None = None,
+    name: str = "",
+) -> ProcessedRecording: ...
+
 class ParameterEstimate:
     name: str
     units: str

@@ -1,6 +1,6 @@
 // Experiment files (ccsrm-dataset/1) and marker files (C3D, TRC, Nexus and
 // Motive CSV, our HDF5 files): ccsrm.read_dataset, ccsrm.read_markers,
-// ccsrm.write_c3d.
+// ccsrm.write_c3d, and the mocap pipeline (ccsrm.process_markers).
 #include <pybind11/stl.h>
 
 #include <memory>
@@ -13,6 +13,7 @@
 #include "ccsrm/mocap/c3d.h"
 #include "ccsrm/mocap/marker_io.h"
 #include "ccsrm/mocap/marker_table.h"
+#include "ccsrm/mocap/recording.h"
 
 namespace ccsrm::python {
 namespace {
@@ -104,6 +105,56 @@ void AddData(py::module_& m) {
         return "<ccsrm.Dataset '" + e.name + "': " + std::to_string(e.input_time.rows()) +
                " input samples, " + std::to_string(e.mocap_time.rows()) + " mocap frames>";
       });
+
+  // The pipeline's outcome: the experiment it made and its quality summary.
+  struct Processed {
+    std::shared_ptr<ExperimentFile> dataset;
+    mocap::ProcessingSummary summary;
+  };
+  py::class_<Processed>(m, "ProcessedRecording",
+                        "What the mocap pipeline made of a recording (ccsrm.process_markers).")
+      .def_readonly("dataset", &Processed::dataset,
+                    "The experiment: markers, inputs, measured joint angles, link poses.")
+      .def("brief_report", [](const Processed& p) { return p.summary.BriefReport(); })
+      .def(
+          "full_report", [](const Processed& p) { return p.summary.FullReport(); },
+          "The quality figures `ccsrm mocap process` prints.")
+      .def_property_readonly("warnings", [](const Processed& p) { return p.summary.warnings; })
+      .def(
+          "write",
+          [](const Processed& p, const py::object& path) {
+            const std::string file = PathString(path);
+            py::gil_scoped_release release;
+            datasets::WriteExperimentFile(file, *p.dataset);
+          },
+          py::arg("path"), "Writes the experiment as `ccsrm mocap process --out` does.");
+
+  m.def(
+      "process_markers",
+      [](const py::object& in, const py::object& config, const py::object& rigid_bodies,
+         const py::object& static_trial, const py::object& inputs, const std::string& name) {
+        mocap::RecordingRequest request;
+        request.in = PathString(in);
+        if (!config.is_none()) request.config = PathString(config);
+        if (!rigid_bodies.is_none()) request.rigid_bodies = PathString(rigid_bodies);
+        if (!static_trial.is_none()) request.static_trial = PathString(static_trial);
+        if (!inputs.is_none()) request.inputs = PathString(inputs);
+        request.name = name;
+        std::string error;
+        if (!request.IsValid(&error)) ThrowInputError("process_markers", "", error);
+        py::gil_scoped_release release;
+        mocap::ProcessedRecording processed = mocap::ProcessRecording(request);
+        return Processed{std::make_shared<ExperimentFile>(std::move(processed.experiment)),
+                         std::move(processed.result.summary)};
+      },
+      py::arg("path"), py::kw_only(), py::arg("config") = py::none(),
+      py::arg("rigid_bodies") = py::none(), py::arg("static_trial") = py::none(),
+      py::arg("inputs") = py::none(), py::arg("name") = "",
+      "The mocap pipeline of `ccsrm mocap process` with default processing settings: a "
+      "marker file (C3D, TRC, CSV) or an experiment or run file to measured joint angles. "
+      "config: the arm (YAML); rigid_bodies: a ccsrm-rigid-bodies/1 file; static_trial: a "
+      "marker file of the straight arm; inputs: the run or experiment whose /input the "
+      "experiment records. Returns a ProcessedRecording (nothing is written).");
 
   m.def(
       "read_dataset",

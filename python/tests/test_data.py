@@ -1,8 +1,10 @@
-"""Experiment and marker files from Python."""
+"""Experiment and marker files, and the mocap pipeline, from Python."""
+import h5py
 import numpy as np
 import pytest
 
 import ccsrm
+from conftest import run_ccsrm
 
 
 def test_dataset_arrays(experiment):
@@ -38,3 +40,26 @@ def test_bad_marker_input(tmp_path):
     with pytest.raises(ccsrm.InputError) as e:
         ccsrm.write_c3d(tmp_path / "x.c3d", np.zeros((4, 2, 3)), ["a"], 100.0)
     assert "positions" in str(e.value)
+
+
+def test_mocap_pipeline_equals_command_line(exe, experiment, paper_config, tmp_path):
+    # The real-file route: markers as a C3D file, the arm and the inputs
+    # given apart, as `ccsrm mocap process` takes them.
+    markers = ccsrm.read_markers(experiment)
+    c3d = tmp_path / "trial.c3d"
+    ccsrm.write_c3d(c3d, markers, units="mm")
+    out = tmp_path / "cli.h5"
+    run_ccsrm(exe, "mocap", "process", "--quiet", "--in", c3d, "--config", paper_config,
+              "--inputs", experiment, "--out", out)
+    processed = ccsrm.process_markers(c3d, config=paper_config, inputs=experiment)
+    ours = processed.dataset
+    assert "frames" in processed.full_report()
+    with h5py.File(out, "r") as f:
+        for name, array in (("measured/joint_angles", ours.measured_joint_angles),
+                            ("measured/link_pose", ours.measured_link_pose),
+                            ("input/length_change", ours.input_length_change)):
+            assert array.tobytes() == f[name][()].astype(np.float64).tobytes(), name
+    written = tmp_path / "py.h5"
+    processed.write(written)
+    again = ccsrm.read_dataset(written)
+    assert again.measured_joint_angles.tobytes() == ours.measured_joint_angles.tobytes()
