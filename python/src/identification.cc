@@ -1,5 +1,6 @@
-// ccsrm.identify: `ccsrm identify` from Python (identify::Identify on
-// experiments loaded by identify::LoadExperiment), its summary and fit.json.
+// ccsrm.identify and ccsrm.loop: `ccsrm identify` and `ccsrm loop` from
+// Python (identify::Identify and identify::CloseLoop on experiments loaded by
+// identify::LoadExperiment), their summaries and JSON.
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
@@ -12,6 +13,7 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/identify/experiment.h"
 #include "ccsrm/identify/identification.h"
+#include "ccsrm/identify/loop.h"
 
 namespace ccsrm::python {
 namespace {
@@ -60,17 +62,73 @@ std::vector<std::string> Assignments(const py::object& values) {
   return values.cast<std::vector<std::string>>();
 }
 
-std::shared_ptr<Fit> RunIdentify(const py::object& data, const py::object& free,
-                                 const py::object& params, const py::object& set,
-                                 std::optional<int> threads, int max_iterations,
-                                 double relative_step, std::optional<double> noise_deg,
-                                 bool central_throughout, const py::object& out) {
+// A loop and the experiments it ran on.
+struct Loop {
+  identify::LoopSummary summary;
+  std::vector<identify::Experiment> training, holdout;
+};
+
+// One path or a sequence of them.
+std::vector<std::string> Paths(const py::object& data) {
   std::vector<std::string> paths;
+  if (data.is_none()) return paths;
   if (py::isinstance<py::str>(data) || py::hasattr(data, "__fspath__")) {
     paths.push_back(PathString(data));
   } else {
     for (const py::handle& p : data) paths.push_back(PathString(p));
   }
+  return paths;
+}
+
+std::vector<identify::Experiment> LoadAll(const std::vector<std::string>& paths,
+                                          std::optional<double> noise_deg) {
+  identify::ExperimentLoadOptions load;
+  if (noise_deg) load.noise_deg = *noise_deg;
+  std::vector<identify::Experiment> experiments;
+  for (const std::string& path : paths) experiments.push_back(identify::LoadExperiment(path, load));
+  return experiments;
+}
+
+std::shared_ptr<Loop> RunLoop(const py::object& data, const py::object& holdout,
+                              const py::object& candidates, const py::object& free,
+                              const py::object& params, const py::object& set,
+                              std::optional<int> threads, int max_rounds, int max_iterations,
+                              std::optional<double> noise_deg, const py::object& out) {
+  const std::vector<std::string> training_paths = Paths(data);
+  if (training_paths.empty()) ThrowInputError("data", "", "give at least one experiment file");
+  const std::vector<std::string> holdout_paths = Paths(holdout);
+  identify::LoopOptions options;
+  if (threads) options.fit.threads = *threads;
+  options.fit.max_iterations = max_iterations;
+  options.max_rounds = max_rounds;
+  std::optional<std::vector<std::string>> free_names;
+  if (!free.is_none()) free_names = Names(free);
+  if (!candidates.is_none()) options.candidates = Names(candidates);
+  const std::string params_path = params.is_none() ? "" : PathString(params);
+  const std::vector<std::string> sets = Assignments(set);
+  const std::string out_dir = out.is_none() ? "" : PathString(out);
+
+  auto loop = std::make_shared<Loop>();
+  py::gil_scoped_release release;
+  // The command's order: options, then every experiment, before any run.
+  identify::ApplyFitParameters(free_names ? &*free_names : nullptr, params_path, sets,
+                               &options.fit);
+  std::string error;
+  if (!options.IsValid(&error)) ThrowInputError("loop", "", error);
+  loop->training = LoadAll(training_paths, noise_deg);
+  loop->holdout = LoadAll(holdout_paths, noise_deg);
+  loop->summary = identify::CloseLoop(loop->training, loop->holdout, options);
+  if (!out_dir.empty())
+    identify::WriteLoopDirectory(loop->summary, loop->training, loop->holdout, out_dir);
+  return loop;
+}
+
+std::shared_ptr<Fit> RunIdentify(const py::object& data, const py::object& free,
+                                 const py::object& params, const py::object& set,
+                                 std::optional<int> threads, int max_iterations,
+                                 double relative_step, std::optional<double> noise_deg,
+                                 bool central_throughout, const py::object& out) {
+  const std::vector<std::string> paths = Paths(data);
   if (paths.empty()) ThrowInputError("data", "", "give at least one experiment file");
   identify::IdentificationOptions options;
   if (threads) options.threads = *threads;
@@ -89,10 +147,7 @@ std::shared_ptr<Fit> RunIdentify(const py::object& data, const py::object& free,
   identify::ApplyFitParameters(free_names ? &*free_names : nullptr, params_path, sets, &options);
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError("identify", "", error);
-  identify::ExperimentLoadOptions load;
-  if (noise_deg) load.noise_deg = *noise_deg;
-  for (const std::string& path : paths)
-    fit->experiments.push_back(identify::LoadExperiment(path, load));
+  fit->experiments = LoadAll(paths, noise_deg);
   fit->summary = identify::Identify(fit->experiments, options);
   if (!out_dir.empty()) identify::WriteFitDirectory(fit->summary, fit->experiments, out_dir);
   return fit;
@@ -192,6 +247,70 @@ void AddIdentification(py::module_& m) {
         "threads (default every core), max_iterations, relative_step, noise_deg (default "
         "estimated), central_throughout, out (also write the fit folder). Returns a Fit. The "
         "GIL is released during the fit.");
+  py::class_<Loop, std::shared_ptr<Loop>>(
+      m, "Loop",
+      "The result of ccsrm.loop: the declared model's fit, the effects added round by round "
+      "and the final fit, with loop.json.")
+      .def_property_readonly("added_effects", [](const Loop& l) { return l.summary.added_effects; })
+      .def_property_readonly("conclusion", [](const Loop& l) { return l.summary.conclusion; })
+      .def_property_readonly("rms_before_deg",
+                             [](const Loop& l) { return l.summary.rms_before_deg; })
+      .def_property_readonly("rms_after_deg", [](const Loop& l) { return l.summary.rms_after_deg; })
+      .def_property_readonly("holdout_rms_before_deg",
+                             [](const Loop& l) { return l.summary.holdout_rms_before_deg; })
+      .def_property_readonly("holdout_rms_after_deg",
+                             [](const Loop& l) { return l.summary.holdout_rms_after_deg; })
+      .def_property_readonly("simulations", [](const Loop& l) { return l.summary.simulations; })
+      .def_property_readonly("wall_time_s", [](const Loop& l) { return l.summary.wall_time_s; })
+      .def_property_readonly(
+          "declared",
+          [](const Loop& l) {
+            return std::make_shared<Fit>(Fit{l.summary.declared, l.training});
+          },
+          "The declared model's Fit.")
+      .def_property_readonly(
+          "final_fit",
+          [](const Loop& l) {
+            return std::make_shared<Fit>(Fit{l.summary.final_fit, l.training});
+          },
+          "The final model's Fit (the declared one when nothing was added).")
+      .def(
+          "full_report", [](const Loop& l) { return l.summary.FullReport(); },
+          "What `ccsrm loop` prints at the end.")
+      .def(
+          "json",
+          [](const Loop& l) {
+            return identify::ToJson(l.summary, l.training, l.holdout).dump(2) + "\n";
+          },
+          "loop.json's summary (schema ccsrm-loop/1).")
+      .def(
+          "to_dict",
+          [](const Loop& l) {
+            return py::module_::import("json").attr("loads")(
+                identify::ToJson(l.summary, l.training, l.holdout).dump());
+          },
+          "json() as a dict.")
+      .def(
+          "write",
+          [](const Loop& l, const py::object& directory) {
+            const std::string dir = PathString(directory);
+            py::gil_scoped_release release;
+            return identify::WriteLoopDirectory(l.summary, l.training, l.holdout, dir);
+          },
+          py::arg("directory"), "Writes the loop folder `ccsrm loop --out` writes.")
+      .def("__repr__", [](const Loop& l) { return "<ccsrm.Loop " + l.summary.conclusion + ">"; });
+
+  m.def("loop", &RunLoop, py::arg("data"), py::kw_only(), py::arg("holdout") = py::none(),
+        py::arg("candidates") = py::none(), py::arg("free") = py::none(),
+        py::arg("params") = py::none(), py::arg("set") = py::none(),
+        py::arg("threads") = py::none(), py::arg("max_rounds") = identify::LoopOptions().max_rounds,
+        py::arg("max_iterations") = identify::IdentificationOptions().max_iterations,
+        py::arg("noise_deg") = py::none(), py::arg("out") = py::none(),
+        "Closes the loop as `ccsrm loop` does, with its options: data (training experiments), "
+        "holdout (held-out experiments), candidates (effects, a list or 'a,b'; default every "
+        "effect that is off), free (the declared model's free parameters; default mu,mu_c,T_p), "
+        "params, set, threads, max_rounds, max_iterations, noise_deg, out (also write the loop "
+        "folder). Returns a Loop. The GIL is released while it runs.");
   m.def("default_threads", &identify::DefaultThreads, "Simulations at a time by default.");
 }
 

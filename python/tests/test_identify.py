@@ -56,3 +56,26 @@ def test_bad_experiment_names_the_file(tmp_path):
     with pytest.raises(ccsrm.InputError) as e:
         ccsrm.identify([bad], free="T_p")
     assert str(bad) in str(e.value)
+
+
+def test_loop_equals_command_lines_loop_json(exe, experiment, tmp_path):
+    # A small loop: one free parameter, two candidates, one round.
+    options = ["--candidates", "table_tilt,joint_friction", "--free", "T_p", "--set", "mu=0",
+               "--set", "mu_s=0", "--max-rounds", 1, "--max-iterations", 2, "--threads", 2]
+    out = tmp_path / "loop_cli"
+    run_ccsrm(exe, "loop", "--data", experiment, *options, "--quiet", "--out", out)
+    cli = json.loads((out / "loop.json").read_text())
+    loop = ccsrm.loop([experiment], candidates=["table_tilt", "joint_friction"], free="T_p",
+                      set=["mu=0", "mu_s=0"], max_rounds=1, max_iterations=2, threads=2,
+                      out=tmp_path / "loop_py")
+    written = json.loads((tmp_path / "loop_py" / "loop.json").read_text())
+    assert without_timing(written) == without_timing(cli)
+    assert without_timing(loop.to_dict()) == without_timing(written)
+    assert loop.conclusion.splitlines()[0] in loop.full_report()
+    assert loop.final_fit["T_p"].value == written["parameters"]["T_p"]["value"]
+
+
+def test_bad_loop_options(experiment):
+    with pytest.raises(ccsrm.InputError) as e:
+        ccsrm.loop(experiment, candidates="table_tilt,no_such_effect", free="T_p")
+    assert "no_such_effect" in str(e.value)
