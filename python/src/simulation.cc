@@ -352,8 +352,9 @@ void AddSimulation(py::module_& m) {
         py::arg("output_rate") = py::none(),
         py::arg("max_input_gap") = sim::RecordedInputOptions().max_gap_s,
         "Simulates the arm as `ccsrm simulate` does and returns a Run.\n\n"
-        "params: a Parameters object (the run's parameters) or a dict of values by name, "
-        "applied after the case (like --set). case: 1..4, the paper's friction switches. "
+        "params: a Parameters object (it replaces the configured parameters; a case then "
+        "switches friction off where the case says), or a dict of values by name, set after "
+        "the case (like --set). case: 1..4, the paper's friction switches. "
         "The motion: protocol (a ccsrm-protocol/1 file), or inputs (N x (1 + C) array: time "
         "[s], then each cable's pulled-in length [m]), or neither (the configuration's paper "
         "protocol). sample_times: frame times [s] (default every 1 / output_rate). The GIL is "
