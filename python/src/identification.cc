@@ -11,6 +11,7 @@
 
 #include "bindings.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/name_list.h"
 #include "ccsrm/identify/experiment.h"
 #include "ccsrm/identify/identification.h"
 #include "ccsrm/identify/loop.h"
@@ -24,25 +25,10 @@ struct Fit {
   std::vector<identify::Experiment> experiments;
 };
 
-// A list of names, or one comma-separated string as --free takes it.
-std::vector<std::string> Names(const py::object& names) {
-  if (py::isinstance<py::str>(names)) {
-    std::vector<std::string> out;
-    std::string text = names.cast<std::string>();
-    std::size_t begin = 0;
-    while (true) {
-      const std::size_t end = text.find(',', begin);
-      out.push_back(text.substr(begin, end == std::string::npos ? end : end - begin));
-      if (end == std::string::npos) break;
-      begin = end + 1;
-    }
-    for (std::string& n : out) {
-      const std::size_t first = n.find_first_not_of(" \t");
-      const std::size_t last = n.find_last_not_of(" \t");
-      n = first == std::string::npos ? "" : n.substr(first, last - first + 1);
-    }
-    return out;
-  }
+// A list of names, or one comma-separated string as the option `option`
+// takes it (read by the commands' reader, with their messages).
+std::vector<std::string> Names(const py::object& names, const std::string& option) {
+  if (py::isinstance<py::str>(names)) return SplitNameList(names.cast<std::string>(), option);
   return names.cast<std::vector<std::string>>();
 }
 
@@ -102,8 +88,8 @@ std::shared_ptr<Loop> RunLoop(const py::object& data, const py::object& holdout,
   options.fit.max_iterations = max_iterations;
   options.max_rounds = max_rounds;
   std::optional<std::vector<std::string>> free_names;
-  if (!free.is_none()) free_names = Names(free);
-  if (!candidates.is_none()) options.candidates = Names(candidates);
+  if (!free.is_none()) free_names = Names(free, "--free");
+  if (!candidates.is_none()) options.candidates = Names(candidates, "--candidates");
   const std::string params_path = params.is_none() ? "" : PathString(params);
   const std::vector<std::string> sets = Assignments(set);
   const std::string out_dir = out.is_none() ? "" : PathString(out);
@@ -136,7 +122,7 @@ std::shared_ptr<Fit> RunIdentify(const py::object& data, const py::object& free,
   options.relative_step = relative_step;
   options.central_differences_throughout = central_throughout;
   std::optional<std::vector<std::string>> free_names;
-  if (!free.is_none()) free_names = Names(free);
+  if (!free.is_none()) free_names = Names(free, "--free");
   const std::string params_path = params.is_none() ? "" : PathString(params);
   const std::vector<std::string> sets = Assignments(set);
   const std::string out_dir = out.is_none() ? "" : PathString(out);
