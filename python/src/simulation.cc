@@ -295,6 +295,13 @@ void AddSimulation(py::module_& m) {
           [](py::object self) { return View(self.cast<Run&>().file.stuck_nodes, self); },
           "T x C: stuck hole nodes per cable.")
       .def_property_readonly(
+          "slack_elements",
+          [](py::object self) -> py::object {
+            const auto& slack = self.cast<Run&>().file.slack_elements;
+            return slack ? py::object(View(*slack, self)) : py::object(py::none());
+          },
+          "T x C: elements of each cable that carry no tension (None in older files).")
+      .def_property_readonly(
           "constraint_violation",
           [](py::object self) { return View(self.cast<Run&>().file.constraint_violation, self); },
           "T.")

@@ -25,7 +25,7 @@ def assert_same_as_file(run, path):
             ("joint_rates", run.joint_rates), ("link_pose", run.link_pose),
             ("input_tension", run.input_tension),
             ("input_length_change", run.input_length_change),
-            ("stuck_nodes", run.stuck_nodes),
+            ("stuck_nodes", run.stuck_nodes), ("slack_elements", run.slack_elements),
             ("diagnostics/constraint_violation", run.constraint_violation),
             ("diagnostics/energy", run.energy),
         ]
@@ -137,6 +137,9 @@ def test_parameters_object_drives_the_run(paper_model):
     (lambda m: ccsrm.simulate(m, {"beta": 3}), "params: parameter 'beta' = 3 is outside [0, 0.1] s"),
     (lambda m: ccsrm.simulate(m, {"friction": 1}), "params: unknown parameter 'friction'"),
     (lambda m: ccsrm.simulate(m, case=7), "--case: must be 1, 2, 3 or 4, found 7"),
+    (lambda m: ccsrm.simulate(m, ccsrm.load_config(ccsrm.bundled_config("three-segment.yaml"))
+                              .parameters),
+     "params: parameters of an arm of 12 joints and 9 cables, the model has 12 and 6"),
     (lambda m: ccsrm.simulate(m, protocol="no/such/protocol.yaml"), "no/such/protocol.yaml"),
     (lambda m: ccsrm.simulate(m, protocol=TWO_AXIS, inputs=np.zeros((3, 7))),
      "--protocol: and --inputs exclude each other: give one"),
