@@ -1,7 +1,7 @@
 # Type stubs of the ccsrm package (the _core extension), for editors and
 # type checkers. The docstrings are in the module itself (help(ccsrm.simulate)).
 import os
-from typing import Iterator, Mapping, Sequence
+from typing import Callable, Iterator, Mapping, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -291,6 +291,7 @@ def identify(
     noise_deg: float | None = None,
     central_throughout: bool = False,
     out: _Path | None = None,
+    progress: Callable[[dict], object] | None = None,
 ) -> Fit: ...
 class Loop:
     @property
@@ -331,5 +332,6 @@ def loop(
     max_iterations: int = 30,
     noise_deg: float | None = None,
     out: _Path | None = None,
+    progress: Callable[[str], object] | None = None,
 ) -> Loop: ...
 def default_threads() -> int: ...

@@ -21,8 +21,13 @@ def main():
     parser.add_argument("--out", help="also write the fit folder here")
     args = parser.parse_args()
 
+    def progress(p):
+        values = ", ".join(f"{name}={value:.6g}" for name, value in p["values"].items())
+        print(f"  iteration {p['iteration']}: RMS {p['rms_deg']:.4f} deg, {values}", flush=True)
+
     fit = ccsrm.identify(args.recordings, free=args.free, set=args.set,
-                         max_iterations=args.max_iterations, threads=args.threads, out=args.out)
+                         max_iterations=args.max_iterations, threads=args.threads, out=args.out,
+                         progress=progress)
     print(f"{fit.termination} after {fit.iterations} iterations, {fit.simulations} simulations, "
           f"RMS {fit.rms_deg:.4f} deg")
     print(f"{'parameter':<12}{'start':>12}{'estimate':>14}{'std error':>12}  units")

@@ -48,6 +48,48 @@ std::vector<std::string> Assignments(const py::object& values) {
   return values.cast<std::vector<std::string>>();
 }
 
+// Calls a Python function from the fit's own thread (the GIL is released
+// around the fit): the iteration's figures as a dict, or the loop's progress
+// line. An exception the function raises cannot cross the optimiser: it is
+// kept, later calls are skipped, and it is raised once the fit returns.
+class ProgressRelay {
+ public:
+  explicit ProgressRelay(py::object function) : function_(std::move(function)) {}
+  bool active() const { return !function_.is_none(); }
+  template <typename MakeArgument>
+  void Call(const MakeArgument& make) {
+    py::gil_scoped_acquire gil;
+    if (error_) return;
+    try {
+      function_(make());
+    } catch (py::error_already_set& e) {
+      error_ = std::make_unique<py::error_already_set>(std::move(e));
+    }
+  }
+  // With the GIL held.
+  void RaiseIfFailed() {
+    if (error_) throw std::move(*error_);
+  }
+
+ private:
+  py::object function_;
+  std::unique_ptr<py::error_already_set> error_;
+};
+
+py::dict IterationDict(const identify::IterationProgress& p) {
+  py::dict values;
+  for (const auto& [name, value] : p.values) values[py::str(name)] = value;
+  py::dict d;
+  d["iteration"] = p.iteration;
+  d["cost"] = p.cost;
+  d["rms_deg"] = p.rms_deg;
+  d["step_accepted"] = p.step_accepted;
+  d["simulations"] = p.simulations;
+  d["wall_time_s"] = p.wall_time_s;
+  d["values"] = values;
+  return d;
+}
+
 // A loop and the experiments it ran on.
 struct Loop {
   identify::LoopSummary summary;
@@ -79,7 +121,8 @@ std::shared_ptr<Loop> RunLoop(const py::object& data, const py::object& holdout,
                               const py::object& candidates, const py::object& free,
                               const py::object& params, const py::object& set,
                               std::optional<int> threads, int max_rounds, int max_iterations,
-                              std::optional<double> noise_deg, const py::object& out) {
+                              std::optional<double> noise_deg, const py::object& out,
+                              const py::object& progress) {
   const std::vector<std::string> training_paths = Paths(data);
   if (training_paths.empty()) ThrowInputError("data", "", "give at least one experiment file");
   const std::vector<std::string> holdout_paths = Paths(holdout);
@@ -95,17 +138,26 @@ std::shared_ptr<Loop> RunLoop(const py::object& data, const py::object& holdout,
   const std::string out_dir = out.is_none() ? "" : PathString(out);
 
   auto loop = std::make_shared<Loop>();
-  py::gil_scoped_release release;
-  // The command's order: options, then every experiment, before any run.
-  identify::ApplyFitParameters(free_names ? &*free_names : nullptr, params_path, sets,
-                               &options.fit);
-  std::string error;
-  if (!options.IsValid(&error)) ThrowInputError("loop", "", error);
-  loop->training = LoadAll(training_paths, noise_deg);
-  loop->holdout = LoadAll(holdout_paths, noise_deg);
-  loop->summary = identify::CloseLoop(loop->training, loop->holdout, options);
-  if (!out_dir.empty())
-    identify::WriteLoopDirectory(loop->summary, loop->training, loop->holdout, out_dir);
+  ProgressRelay relay(progress);
+  if (relay.active()) {
+    options.on_progress = [&relay](const identify::LoopProgress& p) {
+      relay.Call([&] { return py::str(p.message); });
+    };
+  }
+  {
+    py::gil_scoped_release release;
+    // The command's order: options, then every experiment, before any run.
+    identify::ApplyFitParameters(free_names ? &*free_names : nullptr, params_path, sets,
+                                 &options.fit);
+    std::string error;
+    if (!options.IsValid(&error)) ThrowInputError("loop", "", error);
+    loop->training = LoadAll(training_paths, noise_deg);
+    loop->holdout = LoadAll(holdout_paths, noise_deg);
+    loop->summary = identify::CloseLoop(loop->training, loop->holdout, options);
+    if (!out_dir.empty())
+      identify::WriteLoopDirectory(loop->summary, loop->training, loop->holdout, out_dir);
+  }
+  relay.RaiseIfFailed();
   return loop;
 }
 
@@ -113,7 +165,8 @@ std::shared_ptr<Fit> RunIdentify(const py::object& data, const py::object& free,
                                  const py::object& params, const py::object& set,
                                  std::optional<int> threads, int max_iterations,
                                  double relative_step, std::optional<double> noise_deg,
-                                 bool central_throughout, const py::object& out) {
+                                 bool central_throughout, const py::object& out,
+                                 const py::object& progress) {
   const std::vector<std::string> paths = Paths(data);
   if (paths.empty()) ThrowInputError("data", "", "give at least one experiment file");
   identify::IdentificationOptions options;
@@ -128,14 +181,23 @@ std::shared_ptr<Fit> RunIdentify(const py::object& data, const py::object& free,
   const std::string out_dir = out.is_none() ? "" : PathString(out);
 
   auto fit = std::make_shared<Fit>();
-  py::gil_scoped_release release;
-  // The command's order: options, then every experiment, before any run.
-  identify::ApplyFitParameters(free_names ? &*free_names : nullptr, params_path, sets, &options);
-  std::string error;
-  if (!options.IsValid(&error)) ThrowInputError("identify", "", error);
-  fit->experiments = LoadAll(paths, noise_deg);
-  fit->summary = identify::Identify(fit->experiments, options);
-  if (!out_dir.empty()) identify::WriteFitDirectory(fit->summary, fit->experiments, out_dir);
+  ProgressRelay relay(progress);
+  if (relay.active()) {
+    options.on_iteration = [&relay](const identify::IterationProgress& p) {
+      relay.Call([&] { return IterationDict(p); });
+    };
+  }
+  {
+    py::gil_scoped_release release;
+    // The command's order: options, then every experiment, before any run.
+    identify::ApplyFitParameters(free_names ? &*free_names : nullptr, params_path, sets, &options);
+    std::string error;
+    if (!options.IsValid(&error)) ThrowInputError("identify", "", error);
+    fit->experiments = LoadAll(paths, noise_deg);
+    fit->summary = identify::Identify(fit->experiments, options);
+    if (!out_dir.empty()) identify::WriteFitDirectory(fit->summary, fit->experiments, out_dir);
+  }
+  relay.RaiseIfFailed();
   return fit;
 }
 
@@ -226,12 +288,14 @@ void AddIdentification(py::module_& m) {
         py::arg("max_iterations") = identify::IdentificationOptions().max_iterations,
         py::arg("relative_step") = identify::IdentificationOptions().relative_step,
         py::arg("noise_deg") = py::none(), py::arg("central_throughout") = false,
-        py::arg("out") = py::none(),
+        py::arg("out") = py::none(), py::arg("progress") = py::none(),
         "Fits parameters to recorded experiments as `ccsrm identify` does, with its options: "
         "data (one or more ccsrm-dataset/1 files), free (names, a list or 'mu,T_p'; default "
         "SPEC 6's nine), params (a parameter file), set (dict or 'name=value' strings), "
         "threads (default every core), max_iterations, relative_step, noise_deg (default "
-        "estimated), central_throughout, out (also write the fit folder). Returns a Fit. The "
+        "estimated), central_throughout, out (also write the fit folder), progress (called "
+        "after every iteration with a dict: iteration, cost, rms_deg, step_accepted, "
+        "simulations, wall_time_s, values). Returns a Fit. The "
         "GIL is released during the fit.");
   py::class_<Loop, std::shared_ptr<Loop>>(
       m, "Loop",
@@ -292,11 +356,13 @@ void AddIdentification(py::module_& m) {
         py::arg("threads") = py::none(), py::arg("max_rounds") = identify::LoopOptions().max_rounds,
         py::arg("max_iterations") = identify::IdentificationOptions().max_iterations,
         py::arg("noise_deg") = py::none(), py::arg("out") = py::none(),
+        py::arg("progress") = py::none(),
         "Closes the loop as `ccsrm loop` does, with its options: data (training experiments), "
         "holdout (held-out experiments), candidates (effects, a list or 'a,b'; default every "
         "effect that is off), free (the declared model's free parameters; default mu,mu_c,T_p), "
         "params, set, threads, max_rounds, max_iterations, noise_deg, out (also write the loop "
-        "folder). Returns a Loop. The GIL is released while it runs.");
+        "folder), progress (called with each progress line). Returns a Loop. The GIL is "
+        "released while it runs.");
   m.def("default_threads", &identify::DefaultThreads, "Simulations at a time by default.");
 }
 

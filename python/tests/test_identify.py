@@ -25,14 +25,19 @@ def test_fit_equals_command_lines_fit_json(exe, experiment, tmp_path):
     run_ccsrm(exe, "identify", "--data", experiment, "--free", "T_p", "--set", "mu=0",
               "--set", "mu_s=0", "--max-iterations", 2, "--threads", 2, "--quiet", "--out", out)
     cli = json.loads((out / "fit.json").read_text())
+    iterations = []
     fit = ccsrm.identify([experiment], free="T_p", set={"mu": 0, "mu_s": 0},
-                         max_iterations=2, threads=2, out=tmp_path / "fit_py")
+                         max_iterations=2, threads=2, out=tmp_path / "fit_py",
+                         progress=iterations.append)
     written = json.loads((tmp_path / "fit_py" / "fit.json").read_text())
     assert without_timing(written) == without_timing(cli)
     # The summary's JSON is fit.json without the names of the folder's files.
     for e in written["experiments"]:
         e.pop("angles_file"), e.pop("run_file")
     assert without_timing(fit.to_dict()) == without_timing(written)
+    # One report per iteration, from the start (iteration 0).
+    assert [p["iteration"] for p in iterations] == list(range(len(iterations)))
+    assert iterations[0]["cost"] == fit.cost_history[0] and "T_p" in iterations[-1]["values"]
     t_p = fit["T_p"]
     assert t_p.free and t_p.value == cli["parameters"]["T_p"]["value"]
     assert "T_p" in fit.full_report()
@@ -50,6 +55,14 @@ def test_bad_fit_options_raise_before_any_run(experiment, kwargs, message):
     with pytest.raises(ccsrm.InputError) as e:
         ccsrm.identify(experiment, **kwargs)
     assert message in str(e.value)
+
+
+def test_an_error_in_the_progress_function_is_raised_after_the_fit(experiment):
+    def progress(p):
+        raise RuntimeError(f"stop at {p['iteration']}")
+
+    with pytest.raises(RuntimeError, match="stop at 0"):
+        ccsrm.identify(experiment, free="T_p", max_iterations=1, threads=2, progress=progress)
 
 
 def test_bad_experiment_names_the_file(tmp_path):
