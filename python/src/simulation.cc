@@ -14,6 +14,7 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/datasets/run_file.h"
 #include "ccsrm/sim/config.h"
+#include "ccsrm/sim/effects.h"
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/paper_run.h"
 #include "ccsrm/sim/simulator.h"
@@ -206,6 +207,14 @@ void AddSimulation(py::module_& m) {
             return links;
           },
           "Links (= joints) of each segment, from the base.")
+      .def(
+          "effect_parameters",
+          [](const Model& mo, const std::string& effect) {
+            return sim::EffectParameterNames(effect, mo.config.arm.size(), "effect_parameters");
+          },
+          py::arg("effect"),
+          "The full names of an effect's parameters on this arm (per joint and per cable ones "
+          "once per joint or cable), as Parameters and --set take them.")
       .def_property_readonly(
           "joint_ranges_rad",
           [](const Model& mo) { return Copy(sim::JointRangesRad(mo.config.arm)); },

@@ -122,6 +122,11 @@ def test_parameters_by_the_command_lines_names_and_bounds(paper_model):
     assert "joint_friction.coulomb_nm" in p.keys()
     assert paper_model.parameters.effects_on == []  # the model is read-only
     assert [e.name for e in ccsrm.effects()][0] == "joint_friction"
+    offsets = paper_model.effect_parameters("mocap_offset")
+    assert offsets[:2] == ["mocap_offset.joint1_x_rad", "mocap_offset.joint1_y_rad"]
+    assert len(offsets) == 2 * paper_model.num_joints
+    with pytest.raises(ccsrm.InputError, match="unknown effect 'no_such'"):
+        paper_model.effect_parameters("no_such")
 
 
 def test_parameters_object_drives_the_run(paper_model):
