@@ -179,11 +179,14 @@ def test_ctrl_c_cancels_a_run(paper_model):
     start = time.monotonic()
     timer.start()
     with pytest.raises(KeyboardInterrupt):
-        ccsrm.simulate(paper_model, case=2, duration=30.0)
+        ccsrm.simulate(paper_model, case=2, duration=200.0)
     elapsed = time.monotonic() - start
     timer.join()
-    # 30 simulated seconds of case 2 take far longer than this.
-    assert elapsed < 3.0
+    # 200 simulated seconds of case 2 take about 16 s at its 12x real time
+    # (BENCHMARKS.md); a run that went on to its end and only then let the
+    # interruption through would fail this. The margin over 0.5 + 0.1 s is
+    # for a loaded machine.
+    assert elapsed < 2.5
 
 
 @pytest.mark.skipif(len(os.sched_getaffinity(0)) < 2, reason="needs two cores")
