@@ -138,19 +138,22 @@ def test_parameters_object_drives_the_run(paper_model):
 
 
 @pytest.mark.parametrize("call, message", [
-    (lambda m: ccsrm.load_config("no/such/arm.yaml"), "no/such/arm.yaml"),
+    (lambda m: ccsrm.load_config("no/such/arm.yaml"), "no/such/arm.yaml: cannot open for reading"),
     (lambda m: ccsrm.simulate(m, {"beta": 3}), "params: parameter 'beta' = 3 is outside [0, 0.1] s"),
     (lambda m: ccsrm.simulate(m, {"friction": 1}), "params: unknown parameter 'friction'"),
     (lambda m: ccsrm.simulate(m, case=7), "--case: must be 1, 2, 3 or 4, found 7"),
     (lambda m: ccsrm.simulate(m, ccsrm.load_config(ccsrm.bundled_config("three-segment.yaml"))
                               .parameters),
      "params: parameters of an arm of 12 joints and 9 cables, the model has 12 and 6"),
-    (lambda m: ccsrm.simulate(m, protocol="no/such/protocol.yaml"), "no/such/protocol.yaml"),
+    (lambda m: ccsrm.simulate(m, protocol="no/such/protocol.yaml"),
+     "no/such/protocol.yaml: cannot open for reading"),
     (lambda m: ccsrm.simulate(m, protocol=TWO_AXIS, inputs=np.zeros((3, 7))),
      "--protocol: and --inputs exclude each other: give one"),
-    (lambda m: ccsrm.simulate(m, inputs=np.zeros((3, 4))), "inputs"),
+    (lambda m: ccsrm.simulate(m, inputs=np.zeros((3, 4))),
+     "inputs: has 3 cable columns, the arm has 6 driving cables"),
     (lambda m: ccsrm.simulate(m, inputs=np.zeros(5)), "inputs: expected a 2-D array"),
-    (lambda m: ccsrm.simulate(m, duration=0.1, sample_times=[0.05, 0.01]), "sample_times"),
+    (lambda m: ccsrm.simulate(m, duration=0.1, sample_times=[0.05, 0.01]),
+     "sample_times: sample_times[1] = 0.010000 must be non-decreasing and within [0, duration]"),
     (lambda m: ccsrm.simulate(m, duration=-1), "--duration: must be > 0 s"),
 ])
 def test_bad_arguments_raise_the_librarys_message(paper_model, call, message):
