@@ -159,7 +159,7 @@ std::shared_ptr<Run> SimulateRun(const Model& model, const py::object& params,
   InterruptWatch watch;
   {
     py::gil_scoped_release release;
-    sim::PaperRun prepared = sim::PreparePaperRun(options, std::move(config));
+    sim::PaperRun prepared = sim::PreparePaperRun(options, std::move(config), model.model.get());
     // The case was applied above; the run names it as the command does.
     prepared.case_number = case_number.value_or(0);
     sim::SimulationOptions simulation = prepared.simulation;

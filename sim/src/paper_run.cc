@@ -60,7 +60,7 @@ PaperRun PreparePaperRun(const PaperRunOptions& o) {
   return PreparePaperRun(o, ParseConfig(ReadTextFile(path), path));
 }
 
-PaperRun PreparePaperRun(const PaperRunOptions& o, Config config) {
+PaperRun PreparePaperRun(const PaperRunOptions& o, Config config, const ArmModel* built) {
   const std::string path = config.source_name;
   std::string text = config.source_yaml;
   if (o.case_number != 0) ApplyPaperCase(o.case_number, &config.parameters);
@@ -97,7 +97,8 @@ PaperRun PreparePaperRun(const PaperRunOptions& o, Config config) {
     config.solver.output_rate_hz = o.output_rate_hz;
     ValidateSolver(config.solver, "--output-rate");
   }
-  ArmModel model(config.arm);
+  // A copy of a model already built is cheap: its sparse layout is shared.
+  ArmModel model = built != nullptr ? *built : ArmModel(config.arm);
   std::optional<Protocol> protocol;
   std::string inputs_note;
   std::optional<CableInputs> recorded;
