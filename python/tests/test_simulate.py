@@ -40,8 +40,16 @@ def assert_same_as_file(run, path):
             assert ours.tobytes() == theirs.astype(np.float64).tobytes(), name
         for attr in ("steps", "rejected_steps", "rhs_evaluations"):
             assert int(f.attrs[attr]) == getattr(run.summary, attr), attr
-        assert run.case_name == f.attrs["case"].decode() if isinstance(
-            f.attrs["case"], bytes) else f.attrs["case"]
+        def text(name):
+            value = f.attrs.get(name, "")
+            return value.decode() if isinstance(value, bytes) else value
+
+        # What the file records of the run's origin: case, configuration,
+        # protocol (absent for the configuration's own paper protocol).
+        assert run.case_name == text("case")
+        assert run.config_yaml == text("config_yaml")
+        assert run.protocol_yaml == text("protocol_yaml")
+        assert run.status == "completed"
 
 
 def test_protocol_run_equals_command_line_run_file(exe, paper_config, paper_model, tmp_path):
