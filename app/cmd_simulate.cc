@@ -44,11 +44,8 @@ int RunSimulate(const SimulateArgs& a) {
   }
   const sim::SimulationResult result =
       sim::Simulate(run.model, run.config.parameters, run.inputs, options);
-  const std::string case_name =
-      a.run.case_number != 0 ? std::to_string(a.run.case_number) : "custom";
-  datasets::WriteRunFile(a.out, sim_io::ToRunFile(run.model, result,
-                                                  {case_name, sim::ToYaml(run.config),
-                                                   ProtocolYamlOf(run), run.inputs_source}));
+  datasets::WriteRunFile(a.out,
+                         sim_io::ToRunFile(run.model, result, sim_io::PaperRunFileInfo(run)));
   std::printf("%s", sim::DescribeRun(run).c_str());
   std::printf("%s", result.summary.FullReport().c_str());
   std::printf("  output:                    %s (%zu frames)\n", a.out.c_str(),

@@ -16,16 +16,9 @@ namespace fs = std::filesystem;
 void ApplyFitOptions(const std::optional<std::string>& free, const std::string& params,
                      const std::vector<std::string>& set,
                      identify::IdentificationOptions* options) {
-  if (free) options->free_parameters = SplitList(*free, "--free");
-  for (const std::string& name : options->free_parameters) sim::FindParameter(name, "--free");
-  if (!params.empty()) identify::ApplyParameterFile(ReadTextFile(params), params, options);
-  for (const std::string& text : set) {
-    const auto [name, value] = sim::ParseParameterAssignment(text, "--set");
-    const std::string problem =
-        sim::ParameterValueProblem(sim::FindParameter(name, "--set"), value);
-    if (!problem.empty()) ThrowInputError("--set", "", problem);
-    options->values[name] = value;
-  }
+  std::vector<std::string> names;
+  if (free) names = SplitList(*free, "--free");
+  identify::ApplyFitParameters(free ? &names : nullptr, params, set, options);
 }
 
 std::vector<identify::Experiment> LoadExperiments(const std::vector<std::string>& paths,

@@ -3,6 +3,8 @@
 # Idempotent: on a machine that has everything it prints one line and exits 0.
 # gnuplot-nox draws the reports' figures (in DejaVu Sans); chromium renders
 # them headless for the report screenshot test, which skips without it.
+# python3-dev and python3-pybind11 build the Python module (python/), whose
+# tests and examples use python3-pytest, -numpy, -h5py and -matplotlib.
 set -euo pipefail
 
 packages=(
@@ -10,7 +12,7 @@ packages=(
   libeigen3-dev libceres-dev libsuitesparse-dev libopencv-dev libhdf5-dev libgsl-dev
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev gnuplot-nox fonts-dejavu-core
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3-h5py python3-numpy
+  python3-h5py python3-numpy python3-dev python3-pybind11 python3-pytest python3-matplotlib
   chromium
 )
 

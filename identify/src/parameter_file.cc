@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/yaml_document.h"
 #include "ccsrm/identify/identification.h"
+#include "ccsrm/sim/parameters.h"
 
 namespace ccsrm::identify {
 namespace {
@@ -114,6 +116,22 @@ void ApplyParameterFile(const std::string& yaml_text, const std::string& file,
     }
   }
   *options = std::move(updated);
+}
+
+void ApplyFitParameters(const std::vector<std::string>* free, const std::string& params_path,
+                        const std::vector<std::string>& sets, IdentificationOptions* options) {
+  if (free != nullptr) options->free_parameters = *free;
+  for (const std::string& name : options->free_parameters) sim::FindParameter(name, "--free");
+  if (!params_path.empty()) {
+    ApplyParameterFile(ReadTextFile(params_path), params_path, options);
+  }
+  for (const std::string& text : sets) {
+    const auto [name, value] = sim::ParseParameterAssignment(text, "--set");
+    const std::string problem =
+        sim::ParameterValueProblem(sim::FindParameter(name, "--set"), value);
+    if (!problem.empty()) ThrowInputError("--set", "", problem);
+    options->values[name] = value;
+  }
 }
 
 }  // namespace ccsrm::identify

@@ -57,8 +57,12 @@ std::string BundledPaperProtocolPath() { return BundledConfigPath("protocols/pap
 
 PaperRun PreparePaperRun(const PaperRunOptions& o) {
   const std::string path = ConfigPathOrBundled(o.config_path);
-  std::string text = ReadTextFile(path);
-  Config config = ParseConfig(text, path);
+  return PreparePaperRun(o, ParseConfig(ReadTextFile(path), path));
+}
+
+PaperRun PreparePaperRun(const PaperRunOptions& o, Config config, const ArmModel* built) {
+  const std::string path = config.source_name;
+  std::string text = config.source_yaml;
   if (o.case_number != 0) ApplyPaperCase(o.case_number, &config.parameters);
   if (!o.params_path.empty()) {
     ApplyParameterYaml(ReadTextFile(o.params_path), o.params_path, &config.parameters);
@@ -101,7 +105,8 @@ PaperRun PreparePaperRun(const PaperRunOptions& o) {
     config.solver.output_rate_hz = o.output_rate_hz;
     ValidateSolver(config.solver, "--output-rate");
   }
-  ArmModel model(config.arm);
+  // A copy of a model already built is cheap: its sparse layout is shared.
+  ArmModel model = built != nullptr ? *built : ArmModel(config.arm);
   std::optional<Protocol> protocol;
   std::string inputs_note;
   std::optional<CableInputs> recorded;

@@ -82,4 +82,13 @@ datasets::RunFile ToRunFile(const sim::ArmModel& model, const sim::SimulationRes
   return run;
 }
 
+RunFileInfo PaperRunFileInfo(const sim::PaperRun& run) {
+  RunFileInfo info;
+  info.case_name = run.case_number != 0 ? std::to_string(run.case_number) : "custom";
+  info.config_yaml = sim::ToYaml(run.config);
+  if (run.protocol && !run.default_protocol) info.protocol_yaml = run.protocol->ToYaml();
+  info.inputs_file = run.inputs_source;
+  return info;
+}
+
 }  // namespace ccsrm::sim_io

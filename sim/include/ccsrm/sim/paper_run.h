@@ -85,6 +85,15 @@ struct PaperRun {
 // file or value.
 PaperRun PreparePaperRun(const PaperRunOptions& options);
 
+// The same from a configuration already read (LoadConfig / ParseConfig):
+// its source_name and source_yaml stand for the file, and
+// options.config_path is not used. `model`, when not null, is the model of
+// config.arm already built (precondition), used instead of building it
+// again. For callers that hold the configuration and its model (the Python
+// module) and must not read the file or rebuild the model for every run.
+PaperRun PreparePaperRun(const PaperRunOptions& options, Config config,
+                         const ArmModel* model = nullptr);
+
 // The run in words for any arm, the lines a command prints above the
 // simulation's summary: the case and the file (the paper's case only on the
 // paper's arm, sim/describe.h), the arm as configured and the protocol (or

@@ -6,6 +6,7 @@
 
 #include "ccsrm/datasets/run_file.h"
 #include "ccsrm/sim/model.h"
+#include "ccsrm/sim/paper_run.h"
 #include "ccsrm/sim/simulator.h"
 
 namespace ccsrm::sim_io {
@@ -17,6 +18,12 @@ struct RunFileInfo {
   std::string protocol_yaml;         // the protocol followed (sim::Protocol::ToYaml), or empty
   std::string inputs_file;           // the recorded inputs followed, or empty
 };
+
+// What `ccsrm simulate` records of a prepared run: its case ("custom" for
+// case 0), its configuration (sim::ToYaml), the protocol followed unless it
+// is the configuration's own paper protocol (which config_yaml records), or
+// the recorded inputs' file.
+RunFileInfo PaperRunFileInfo(const sim::PaperRun& run);
 
 // Every frame of `result.trajectory` and its solver statistics and status.
 // Precondition: the trajectory was simulated on `model`.

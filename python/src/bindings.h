@@ -1,0 +1,36 @@
+#pragma once
+// Shared pieces of the Python module (python/src/*.cc): numpy views of the
+// library's arrays and the registration function of each part.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstddef>
+#include <vector>
+
+#include "ccsrm/datasets/array.h"
+
+namespace ccsrm::python {
+
+namespace py = pybind11;
+
+// A read-only numpy view of `values` (row-major, of `shape`) that keeps
+// `owner` (the Python object holding the memory) alive: no copy is made.
+// Read-only because the owner's other views and summaries describe the same
+// numbers; .copy() gives a writable array.
+py::array View(const double* values, const std::vector<std::size_t>& shape,
+               const py::object& owner);
+py::array View(const datasets::Array& array, const py::object& owner);
+
+// A copy of `values` as a new numpy array (for small vectors built on the fly).
+py::array Copy(const std::vector<double>& values);
+
+// Reads a path argument (str or os.PathLike) as a string.
+std::string PathString(const py::handle& path);
+
+void AddErrors(py::module_& m);
+void AddParameters(py::module_& m);
+void AddSimulation(py::module_& m);
+void AddData(py::module_& m);
+void AddIdentification(py::module_& m);
+
+}  // namespace ccsrm::python

@@ -1,0 +1,369 @@
+// ccsrm.identify and ccsrm.loop: `ccsrm identify` and `ccsrm loop` from
+// Python (identify::Identify and identify::CloseLoop on experiments loaded by
+// identify::LoadExperiment), their summaries and JSON.
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "ccsrm/common/error.h"
+#include "ccsrm/common/name_list.h"
+#include "ccsrm/identify/experiment.h"
+#include "ccsrm/identify/identification.h"
+#include "ccsrm/identify/loop.h"
+
+namespace ccsrm::python {
+namespace {
+
+// A fit and the experiments it was made on (what writing its folder needs).
+struct Fit {
+  identify::IdentificationSummary summary;
+  std::vector<identify::Experiment> experiments;
+};
+
+// A list of names, or one comma-separated string as the option `option`
+// takes it (read by the commands' reader, with their messages).
+std::vector<std::string> Names(const py::object& names, const std::string& option) {
+  if (py::isinstance<py::str>(names)) return SplitNameList(names.cast<std::string>(), option);
+  return names.cast<std::vector<std::string>>();
+}
+
+// Values as --set takes them ("name=value"), from a dict or from strings.
+std::vector<std::string> Assignments(const py::object& values) {
+  if (values.is_none()) return {};
+  if (py::isinstance<py::dict>(values)) {
+    std::vector<std::string> out;
+    for (const auto& [name, value] : values.cast<py::dict>()) {
+      // repr of a float is the shortest text that reads back to the same
+      // double, so the value reaches the fit unchanged.
+      out.push_back(name.cast<std::string>() + "=" +
+                    py::repr(py::float_(value.cast<double>())).cast<std::string>());
+    }
+    return out;
+  }
+  return values.cast<std::vector<std::string>>();
+}
+
+// Calls a Python function from the fit's own thread (the GIL is released
+// around the fit): the iteration's figures as a dict, or the loop's progress
+// line. An exception the function raises cannot cross the optimiser: it is
+// kept, later calls are skipped, and it is raised once the fit returns.
+class ProgressRelay {
+ public:
+  explicit ProgressRelay(py::object function) : function_(std::move(function)) {}
+  bool active() const { return !function_.is_none(); }
+  template <typename MakeArgument>
+  void Call(const MakeArgument& make) {
+    py::gil_scoped_acquire gil;
+    if (error_) return;
+    try {
+      function_(make());
+    } catch (py::error_already_set& e) {
+      error_ = std::make_unique<py::error_already_set>(std::move(e));
+    }
+  }
+  // With the GIL held.
+  void RaiseIfFailed() {
+    if (error_) throw std::move(*error_);
+  }
+
+ private:
+  py::object function_;
+  std::unique_ptr<py::error_already_set> error_;
+};
+
+py::dict IterationDict(const identify::IterationProgress& p) {
+  py::dict values;
+  for (const auto& [name, value] : p.values) values[py::str(name)] = value;
+  py::dict d;
+  d["iteration"] = p.iteration;
+  d["cost"] = p.cost;
+  d["rms_deg"] = p.rms_deg;
+  d["step_accepted"] = p.step_accepted;
+  d["simulations"] = p.simulations;
+  d["wall_time_s"] = p.wall_time_s;
+  d["values"] = values;
+  return d;
+}
+
+// A loop and the experiments it ran on.
+struct Loop {
+  identify::LoopSummary summary;
+  std::vector<identify::Experiment> training, holdout;
+};
+
+// One path or a sequence of them.
+std::vector<std::string> Paths(const py::object& data) {
+  std::vector<std::string> paths;
+  if (data.is_none()) return paths;
+  if (py::isinstance<py::str>(data) || py::hasattr(data, "__fspath__")) {
+    paths.push_back(PathString(data));
+  } else {
+    for (const py::handle& p : data) paths.push_back(PathString(p));
+  }
+  return paths;
+}
+
+std::vector<identify::Experiment> LoadAll(const std::vector<std::string>& paths,
+                                          std::optional<double> noise_deg) {
+  identify::ExperimentLoadOptions load;
+  if (noise_deg) load.noise_deg = *noise_deg;
+  std::vector<identify::Experiment> experiments;
+  for (const std::string& path : paths) experiments.push_back(identify::LoadExperiment(path, load));
+  return experiments;
+}
+
+std::shared_ptr<Loop> RunLoop(const py::object& data, const py::object& holdout,
+                              const py::object& candidates, const py::object& free,
+                              const py::object& params, const py::object& set,
+                              std::optional<int> threads, int max_rounds, int max_iterations,
+                              std::optional<double> noise_deg, const py::object& out,
+                              const py::object& progress) {
+  const std::vector<std::string> training_paths = Paths(data);
+  if (training_paths.empty()) ThrowInputError("data", "", "give at least one experiment file");
+  const std::vector<std::string> holdout_paths = Paths(holdout);
+  identify::LoopOptions options;
+  if (threads) options.fit.threads = *threads;
+  options.fit.max_iterations = max_iterations;
+  options.max_rounds = max_rounds;
+  std::optional<std::vector<std::string>> free_names;
+  if (!free.is_none()) free_names = Names(free, "--free");
+  if (!candidates.is_none()) options.candidates = Names(candidates, "--candidates");
+  const std::string params_path = params.is_none() ? "" : PathString(params);
+  const std::vector<std::string> sets = Assignments(set);
+  const std::string out_dir = out.is_none() ? "" : PathString(out);
+
+  auto loop = std::make_shared<Loop>();
+  ProgressRelay relay(progress);
+  if (relay.active()) {
+    options.on_progress = [&relay](const identify::LoopProgress& p) {
+      relay.Call([&] { return py::str(p.message); });
+    };
+  }
+  {
+    py::gil_scoped_release release;
+    // The command's order: options, then every experiment, before any run.
+    identify::ApplyFitParameters(free_names ? &*free_names : nullptr, params_path, sets,
+                                 &options.fit);
+    std::string error;
+    if (!options.IsValid(&error)) ThrowInputError("loop", "", error);
+    loop->training = LoadAll(training_paths, noise_deg);
+    loop->holdout = LoadAll(holdout_paths, noise_deg);
+    loop->summary = identify::CloseLoop(loop->training, loop->holdout, options);
+    if (!out_dir.empty())
+      identify::WriteLoopDirectory(loop->summary, loop->training, loop->holdout, out_dir);
+  }
+  relay.RaiseIfFailed();
+  return loop;
+}
+
+std::shared_ptr<Fit> RunIdentify(const py::object& data, const py::object& free,
+                                 const py::object& params, const py::object& set,
+                                 std::optional<int> threads, int max_iterations,
+                                 double relative_step, std::optional<double> noise_deg,
+                                 bool central_throughout, const py::object& out,
+                                 const py::object& progress) {
+  const std::vector<std::string> paths = Paths(data);
+  if (paths.empty()) ThrowInputError("data", "", "give at least one experiment file");
+  identify::IdentificationOptions options;
+  if (threads) options.threads = *threads;
+  options.max_iterations = max_iterations;
+  options.relative_step = relative_step;
+  options.central_differences_throughout = central_throughout;
+  std::optional<std::vector<std::string>> free_names;
+  if (!free.is_none()) free_names = Names(free, "--free");
+  const std::string params_path = params.is_none() ? "" : PathString(params);
+  const std::vector<std::string> sets = Assignments(set);
+  const std::string out_dir = out.is_none() ? "" : PathString(out);
+
+  auto fit = std::make_shared<Fit>();
+  ProgressRelay relay(progress);
+  if (relay.active()) {
+    options.on_iteration = [&relay](const identify::IterationProgress& p) {
+      relay.Call([&] { return IterationDict(p); });
+    };
+  }
+  {
+    py::gil_scoped_release release;
+    // The command's order: options, then every experiment, before any run.
+    identify::ApplyFitParameters(free_names ? &*free_names : nullptr, params_path, sets, &options);
+    std::string error;
+    if (!options.IsValid(&error)) ThrowInputError("identify", "", error);
+    fit->experiments = LoadAll(paths, noise_deg);
+    fit->summary = identify::Identify(fit->experiments, options);
+    if (!out_dir.empty()) identify::WriteFitDirectory(fit->summary, fit->experiments, out_dir);
+  }
+  relay.RaiseIfFailed();
+  return fit;
+}
+
+}  // namespace
+
+void AddIdentification(py::module_& m) {
+  using identify::ParameterEstimate;
+  py::class_<ParameterEstimate>(m, "ParameterEstimate", "One parameter of a fit.")
+      .def_readonly("name", &ParameterEstimate::name)
+      .def_readonly("units", &ParameterEstimate::units)
+      .def_readonly("free", &ParameterEstimate::free)
+      .def_readonly("start", &ParameterEstimate::start)
+      .def_readonly("value", &ParameterEstimate::value)
+      .def_readonly("lower", &ParameterEstimate::lower)
+      .def_readonly("upper", &ParameterEstimate::upper)
+      .def_readonly("scale", &ParameterEstimate::scale)
+      .def_readonly("identifiable", &ParameterEstimate::identifiable)
+      .def_readonly("std_error", &ParameterEstimate::std_error, "NaN when not identifiable.")
+      .def_readonly("ci95_lower", &ParameterEstimate::ci95_lower)
+      .def_readonly("ci95_upper", &ParameterEstimate::ci95_upper)
+      .def_readonly("at_bound", &ParameterEstimate::at_bound)
+      .def("__repr__", [](const ParameterEstimate& p) {
+        return "<ParameterEstimate " + p.name + " = " +
+               py::repr(py::float_(p.value)).cast<std::string>() + " " + p.units + ">";
+      });
+
+  py::class_<Fit, std::shared_ptr<Fit>>(
+      m, "Fit",
+      "The result of ccsrm.identify: the identification summary (estimates, standard errors, "
+      "correlations, identifiability) and its fit.json.")
+      .def_property_readonly(
+          "termination",
+          [](const Fit& f) { return identify::TerminationName(f.summary.termination); })
+      .def_property_readonly("converged", [](const Fit& f) { return f.summary.converged(); })
+      .def_property_readonly("message", [](const Fit& f) { return f.summary.message; })
+      .def_property_readonly("iterations", [](const Fit& f) { return f.summary.iterations; })
+      .def_property_readonly("simulations", [](const Fit& f) { return f.summary.simulations; })
+      .def_property_readonly("wall_time_s", [](const Fit& f) { return f.summary.wall_time_s; })
+      .def_property_readonly("initial_cost", [](const Fit& f) { return f.summary.initial_cost; })
+      .def_property_readonly("final_cost", [](const Fit& f) { return f.summary.final_cost; })
+      .def_property_readonly("cost_history", [](const Fit& f) { return f.summary.cost_history; })
+      .def_property_readonly("free_names", [](const Fit& f) { return f.summary.free_names; })
+      .def_property_readonly(
+          "parameters", [](const Fit& f) { return f.summary.parameters; },
+          "Every parameter's estimate, the free ones first.")
+      .def_property_readonly(
+          "correlation", [](const Fit& f) { return f.summary.correlation; },
+          "free x free; NaN rows for parameters not identifiable.")
+      .def_property_readonly("singular_values",
+                             [](const Fit& f) { return f.summary.singular_values; })
+      .def_property_readonly(
+          "rms_deg", [](const Fit& f) { return f.summary.errors.rms_deg_overall; },
+          "RMS error of the fitted joint angles over every experiment [deg].")
+      .def("__getitem__",
+           [](const Fit& f, const std::string& name) {
+             const ParameterEstimate* p = f.summary.Find(name);
+             if (p == nullptr) throw py::key_error(name);
+             return *p;
+           })
+      .def("brief_report", [](const Fit& f) { return f.summary.BriefReport(); })
+      .def(
+          "full_report", [](const Fit& f) { return f.summary.FullReport(); },
+          "The table `ccsrm identify` prints.")
+      .def(
+          "json", [](const Fit& f) { return identify::ToJson(f.summary).dump(2) + "\n"; },
+          "The summary as JSON: fit.json without the names of the files of the fit folder "
+          "(those come with write()).")
+      .def(
+          "to_dict",
+          [](const Fit& f) {
+            return py::module_::import("json").attr("loads")(identify::ToJson(f.summary).dump());
+          },
+          "json() as a dict.")
+      .def(
+          "write",
+          [](const Fit& f, const py::object& directory) {
+            const std::string dir = PathString(directory);
+            py::gil_scoped_release release;
+            return identify::WriteFitDirectory(f.summary, f.experiments, dir);
+          },
+          py::arg("directory"),
+          "Writes the fit folder `ccsrm identify --out` writes; returns the paths.")
+      .def("__repr__", [](const Fit& f) { return "<ccsrm.Fit " + f.summary.BriefReport() + ">"; });
+
+  m.def("identify", &RunIdentify, py::arg("data"), py::kw_only(), py::arg("free") = py::none(),
+        py::arg("params") = py::none(), py::arg("set") = py::none(),
+        py::arg("threads") = py::none(),
+        py::arg("max_iterations") = identify::IdentificationOptions().max_iterations,
+        py::arg("relative_step") = identify::IdentificationOptions().relative_step,
+        py::arg("noise_deg") = py::none(), py::arg("central_throughout") = false,
+        py::arg("out") = py::none(), py::arg("progress") = py::none(),
+        "Fits parameters to recorded experiments as `ccsrm identify` does, with its options: "
+        "data (one or more ccsrm-dataset/1 files), free (names, a list or 'mu,T_p'; default "
+        "SPEC 6's nine), params (a parameter file), set (dict or 'name=value' strings), "
+        "threads (default every core), max_iterations, relative_step, noise_deg (default "
+        "estimated), central_throughout, out (also write the fit folder), progress (called "
+        "after every iteration with a dict: iteration, cost, rms_deg, step_accepted, "
+        "simulations, wall_time_s, values). Returns a Fit. The "
+        "GIL is released during the fit.");
+  py::class_<Loop, std::shared_ptr<Loop>>(
+      m, "Loop",
+      "The result of ccsrm.loop: the declared model's fit, the effects added round by round "
+      "and the final fit, with loop.json.")
+      .def_property_readonly("added_effects", [](const Loop& l) { return l.summary.added_effects; })
+      .def_property_readonly("conclusion", [](const Loop& l) { return l.summary.conclusion; })
+      .def_property_readonly("rms_before_deg",
+                             [](const Loop& l) { return l.summary.rms_before_deg; })
+      .def_property_readonly("rms_after_deg", [](const Loop& l) { return l.summary.rms_after_deg; })
+      .def_property_readonly("holdout_rms_before_deg",
+                             [](const Loop& l) { return l.summary.holdout_rms_before_deg; })
+      .def_property_readonly("holdout_rms_after_deg",
+                             [](const Loop& l) { return l.summary.holdout_rms_after_deg; })
+      .def_property_readonly("simulations", [](const Loop& l) { return l.summary.simulations; })
+      .def_property_readonly("wall_time_s", [](const Loop& l) { return l.summary.wall_time_s; })
+      .def_property_readonly(
+          "declared",
+          [](const Loop& l) {
+            return std::make_shared<Fit>(Fit{l.summary.declared, l.training});
+          },
+          "The declared model's Fit.")
+      .def_property_readonly(
+          "final_fit",
+          [](const Loop& l) {
+            return std::make_shared<Fit>(Fit{l.summary.final_fit, l.training});
+          },
+          "The final model's Fit (the declared one when nothing was added).")
+      .def(
+          "full_report", [](const Loop& l) { return l.summary.FullReport(); },
+          "What `ccsrm loop` prints at the end.")
+      .def(
+          "json",
+          [](const Loop& l) {
+            return identify::ToJson(l.summary, l.training, l.holdout).dump(2) + "\n";
+          },
+          "loop.json's summary (schema ccsrm-loop/1).")
+      .def(
+          "to_dict",
+          [](const Loop& l) {
+            return py::module_::import("json").attr("loads")(
+                identify::ToJson(l.summary, l.training, l.holdout).dump());
+          },
+          "json() as a dict.")
+      .def(
+          "write",
+          [](const Loop& l, const py::object& directory) {
+            const std::string dir = PathString(directory);
+            py::gil_scoped_release release;
+            return identify::WriteLoopDirectory(l.summary, l.training, l.holdout, dir);
+          },
+          py::arg("directory"), "Writes the loop folder `ccsrm loop --out` writes.")
+      .def("__repr__", [](const Loop& l) { return "<ccsrm.Loop " + l.summary.conclusion + ">"; });
+
+  m.def("loop", &RunLoop, py::arg("data"), py::kw_only(), py::arg("holdout") = py::none(),
+        py::arg("candidates") = py::none(), py::arg("free") = py::none(),
+        py::arg("params") = py::none(), py::arg("set") = py::none(),
+        py::arg("threads") = py::none(), py::arg("max_rounds") = identify::LoopOptions().max_rounds,
+        py::arg("max_iterations") = identify::IdentificationOptions().max_iterations,
+        py::arg("noise_deg") = py::none(), py::arg("out") = py::none(),
+        py::arg("progress") = py::none(),
+        "Closes the loop as `ccsrm loop` does, with its options: data (training experiments), "
+        "holdout (held-out experiments), candidates (effects, a list or 'a,b'; default every "
+        "effect that is off), free (the declared model's free parameters; default mu,mu_c,T_p), "
+        "params, set, threads, max_rounds, max_iterations, noise_deg, out (also write the loop "
+        "folder), progress (called with each progress line). Returns a Loop. The GIL is "
+        "released while it runs.");
+  m.def("default_threads", &identify::DefaultThreads, "Simulations at a time by default.");
+}
+
+}  // namespace ccsrm::python

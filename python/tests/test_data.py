@@ -1,0 +1,65 @@
+"""Experiment and marker files, and the mocap pipeline, from Python."""
+import h5py
+import numpy as np
+import pytest
+
+import ccsrm
+from conftest import run_ccsrm
+
+
+def test_dataset_arrays(experiment):
+    d = ccsrm.read_dataset(experiment)
+    assert d.source == "generated"
+    n, c = d.input_length_change.shape
+    assert n == d.input_time.size and c == 6
+    f, m, three = d.mocap_markers.shape
+    assert f == d.mocap_time.size and m == len(d.marker_names) and three == 3
+    assert d.measured_joint_angles is None  # a generated file has markers only
+    assert not d.input_time.flags.writeable
+
+
+def test_c3d_round_trip(experiment, tmp_path):
+    markers = ccsrm.read_markers(experiment)
+    path = tmp_path / "markers.c3d"
+    ccsrm.write_c3d(path, markers.positions, markers.labels, markers.rate_hz, units="mm")
+    back = ccsrm.read_markers(path)
+    assert back.format == "c3d" and back.labels == markers.labels
+    assert back.rate_hz == pytest.approx(markers.rate_hz, rel=1e-6)
+    # C3D stores float32 millimetres: 1e-7 relative of a metre-sized value.
+    seen = np.isfinite(markers.positions)
+    assert (np.isfinite(back.positions) == seen).all()
+    np.testing.assert_allclose(back.positions[seen], markers.positions[seen], atol=1e-6)
+
+
+def test_bad_marker_input(tmp_path):
+    bad = tmp_path / "broken.c3d"
+    bad.write_bytes(b"\x02\x50" + b"\x00" * 20)
+    with pytest.raises(ccsrm.InputError) as e:
+        ccsrm.read_markers(bad)
+    assert str(bad) in str(e.value)
+    with pytest.raises(ccsrm.InputError) as e:
+        ccsrm.write_c3d(tmp_path / "x.c3d", np.zeros((4, 2, 3)), ["a"], 100.0)
+    assert "positions" in str(e.value)
+
+
+def test_mocap_pipeline_equals_command_line(exe, experiment, paper_config, tmp_path):
+    # The real-file route: markers as a C3D file, the arm and the inputs
+    # given apart, as `ccsrm mocap process` takes them.
+    markers = ccsrm.read_markers(experiment)
+    c3d = tmp_path / "trial.c3d"
+    ccsrm.write_c3d(c3d, markers, units="mm")
+    out = tmp_path / "cli.h5"
+    run_ccsrm(exe, "mocap", "process", "--quiet", "--in", c3d, "--config", paper_config,
+              "--inputs", experiment, "--out", out)
+    processed = ccsrm.process_markers(c3d, config=paper_config, inputs=experiment)
+    ours = processed.dataset
+    assert "frames" in processed.full_report()
+    with h5py.File(out, "r") as f:
+        for name, array in (("measured/joint_angles", ours.measured_joint_angles),
+                            ("measured/link_pose", ours.measured_link_pose),
+                            ("input/length_change", ours.input_length_change)):
+            assert array.tobytes() == f[name][()].astype(np.float64).tobytes(), name
+    written = tmp_path / "py.h5"
+    processed.write(written)
+    again = ccsrm.read_dataset(written)
+    assert again.measured_joint_angles.tobytes() == ours.measured_joint_angles.tobytes()

@@ -1,0 +1,96 @@
+"""ccsrm.identify against `ccsrm identify`: the same fit.json."""
+import json
+
+import pytest
+
+import ccsrm
+from conftest import run_ccsrm
+
+# What differs between two identical fits: time and the paths of the files.
+TIMING = {"wall_time_s", "real_time_factor"}
+
+
+def without_timing(value):
+    if isinstance(value, dict):
+        return {k: without_timing(v) for k, v in value.items() if k not in TIMING}
+    if isinstance(value, list):
+        return [without_timing(v) for v in value]
+    return value
+
+
+def test_fit_equals_command_lines_fit_json(exe, experiment, tmp_path):
+    # The fit of tests/identify/cli_test.cc: one free parameter, two
+    # iterations, on the generated experiment.
+    out = tmp_path / "fit_cli"
+    run_ccsrm(exe, "identify", "--data", experiment, "--free", "T_p", "--set", "mu=0",
+              "--set", "mu_s=0", "--max-iterations", 2, "--threads", 2, "--quiet", "--out", out)
+    cli = json.loads((out / "fit.json").read_text())
+    iterations = []
+    fit = ccsrm.identify([experiment], free="T_p", set={"mu": 0, "mu_s": 0},
+                         max_iterations=2, threads=2, out=tmp_path / "fit_py",
+                         progress=iterations.append)
+    written = json.loads((tmp_path / "fit_py" / "fit.json").read_text())
+    assert without_timing(written) == without_timing(cli)
+    # The summary's JSON is fit.json without the names of the folder's files.
+    for e in written["experiments"]:
+        e.pop("angles_file"), e.pop("run_file")
+    assert without_timing(fit.to_dict()) == without_timing(written)
+    # One report per iteration, from the start (iteration 0).
+    assert [p["iteration"] for p in iterations] == list(range(len(iterations)))
+    assert iterations[0]["cost"] == fit.cost_history[0] and "T_p" in iterations[-1]["values"]
+    t_p = fit["T_p"]
+    assert t_p.free and t_p.value == cli["parameters"]["T_p"]["value"]
+    assert "T_p" in fit.full_report()
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(free="mu,friction"), "--free: unknown parameter 'friction'"),
+    (dict(free=" "), "--free: is empty: give at least one name"),
+    (dict(free="mu,,T_p"), "--free: empty item in 'mu,,T_p'"),
+    (dict(free="T_p", set={"beta": 3}), "--set: parameter 'beta' = 3 is outside [0, 0.1] s"),
+    (dict(free="T_p", threads=0), "identify: threads must be >= 1"),
+    (dict(free="T_p", relative_step=0.5), "identify: relative_step must be in (0, 0.1]"),
+])
+def test_bad_fit_options_raise_before_any_run(experiment, kwargs, message):
+    with pytest.raises(ccsrm.InputError) as e:
+        ccsrm.identify(experiment, **kwargs)
+    assert message in str(e.value)
+
+
+def test_an_error_in_the_progress_function_is_raised_after_the_fit(experiment):
+    def progress(p):
+        raise RuntimeError(f"stop at {p['iteration']}")
+
+    with pytest.raises(RuntimeError, match="stop at 0"):
+        ccsrm.identify(experiment, free="T_p", max_iterations=1, threads=2, progress=progress)
+
+
+def test_bad_experiment_names_the_file(tmp_path):
+    bad = tmp_path / "not-an-experiment.h5"
+    bad.write_bytes(b"no hdf5 here")
+    with pytest.raises(ccsrm.InputError) as e:
+        ccsrm.identify([bad], free="T_p")
+    assert str(bad) in str(e.value)
+
+
+def test_loop_equals_command_lines_loop_json(exe, experiment, tmp_path):
+    # A small loop: one free parameter, two candidates, one round.
+    options = ["--candidates", "table_tilt,joint_friction", "--free", "T_p", "--set", "mu=0",
+               "--set", "mu_s=0", "--max-rounds", 1, "--max-iterations", 2, "--threads", 2]
+    out = tmp_path / "loop_cli"
+    run_ccsrm(exe, "loop", "--data", experiment, *options, "--quiet", "--out", out)
+    cli = json.loads((out / "loop.json").read_text())
+    loop = ccsrm.loop([experiment], candidates=["table_tilt", "joint_friction"], free="T_p",
+                      set=["mu=0", "mu_s=0"], max_rounds=1, max_iterations=2, threads=2,
+                      out=tmp_path / "loop_py")
+    written = json.loads((tmp_path / "loop_py" / "loop.json").read_text())
+    assert without_timing(written) == without_timing(cli)
+    assert without_timing(loop.to_dict()) == without_timing(written)
+    assert loop.conclusion.splitlines()[0] in loop.full_report()
+    assert loop.final_fit["T_p"].value == written["parameters"]["T_p"]["value"]
+
+
+def test_bad_loop_options(experiment):
+    with pytest.raises(ccsrm.InputError) as e:
+        ccsrm.loop(experiment, candidates="table_tilt,no_such_effect", free="T_p")
+    assert "no_such_effect" in str(e.value)
