@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ccsrm/common/error.h"
@@ -36,6 +37,13 @@ PlannedExperiment Planned(const Experiment& recording, const sim::ArmParameters&
   return planned;
 }
 
+DesignCandidate Candidate(const std::string& name, std::vector<PlannedExperiment> experiments) {
+  DesignCandidate candidate;
+  candidate.name = name;
+  candidate.experiments = std::move(experiments);
+  return candidate;
+}
+
 DesignOptions Options() {
   DesignOptions options;
   options.free_parameters = {"mu_c", "T_p"};
@@ -47,7 +55,7 @@ TEST(Design, PredictsTheStandardErrorsAFitOfSuchARecordingReports) {
   const sim::ArmParameters truth = Truth();
   const Experiment recording = MakeExperiment(Record(truth, 0.03, 7), "seed7.h5", {});
   const DesignSummary design =
-      EvaluateDesigns({DesignCandidate{"one recording", {Planned(recording, truth)}}}, Options());
+      EvaluateDesigns({Candidate("one recording", {Planned(recording, truth)})}, Options());
   ASSERT_EQ(design.candidates.size(), 1u);
   const CandidateInformation& predicted = design.candidates[0];
   ASSERT_TRUE(predicted.completed) << predicted.message;
@@ -80,8 +88,7 @@ TEST(Design, InformationAddsOverAPlansExperiments) {
   const Experiment recording = MakeExperiment(Record(truth, 0.03, 1), "seed1.h5", {});
   const PlannedExperiment planned = Planned(recording, truth);
   const DesignSummary design = EvaluateDesigns(
-      {DesignCandidate{"once", {planned}}, DesignCandidate{"twice", {planned, planned}}},
-      Options());
+      {Candidate("once", {planned}), Candidate("twice", {planned, planned})}, Options());
   const CandidateInformation& once = design.candidates[0];
   const CandidateInformation& twice = design.candidates[1];
   ASSERT_TRUE(once.completed && twice.completed) << once.message << twice.message;
@@ -97,7 +104,7 @@ TEST(Design, InformationAddsOverAPlansExperiments) {
   // Half the noise: half the errors.
   DesignOptions quieter = Options();
   quieter.noise_deg = 0.015;
-  const DesignSummary quiet = EvaluateDesigns({DesignCandidate{"once", {planned}}}, quieter);
+  const DesignSummary quiet = EvaluateDesigns({Candidate("once", {planned})}, quieter);
   EXPECT_NEAR(quiet.candidates[0].std_error[1], 0.5 * once.std_error[1], 1e-9 * once.std_error[1]);
 }
 
@@ -136,12 +143,12 @@ TEST(Design, RefusesAPriorOfZeroAndAPlanWithoutExperiments) {
   DesignOptions options = Options();
   options.free_parameters = {"mu"};  // 0 in case 4's friction
   try {
-    EvaluateDesigns({DesignCandidate{"once", {Planned(recording, truth)}}}, options);
+    EvaluateDesigns({Candidate("once", {Planned(recording, truth)})}, options);
     ADD_FAILURE() << "a prior of 0 was accepted";
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), ::testing::HasSubstr("its prior value is 0"));
   }
-  EXPECT_THROW(EvaluateDesigns({DesignCandidate{"empty", {}}}, Options()), InputError);
+  EXPECT_THROW(EvaluateDesigns({Candidate("empty", {})}, Options()), InputError);
   DesignOptions bad = Options();
   bad.effective_sample_fraction = 1.5;
   std::string error;
