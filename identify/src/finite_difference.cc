@@ -39,20 +39,8 @@ double ParameterScale(const sim::ParameterInfo& info, double value,
   return scale_at_zero ? std::abs(sim::GetParameter(*scale_at_zero, info.name)) : 0.0;
 }
 
-const char* RunStatusWord(sim::SimulationStatus status) {
-  switch (status) {
-    case sim::SimulationStatus::kCompleted:
-      return "completed";
-    case sim::SimulationStatus::kDiverged:
-      return "diverged";
-    case sim::SimulationStatus::kCancelled:
-      return "cancelled";
-  }
-  return "?";
-}
-
 nlohmann::json RunJson(const sim::SimulationSummary& s) {
-  return {{"status", RunStatusWord(s.status)},
+  return {{"status", sim::SimulationStatusName(s.status)},
           {"message", s.message},
           {"simulated_s", s.simulated_s},
           {"wall_time_s", s.wall_time_s},

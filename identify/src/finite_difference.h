@@ -28,10 +28,6 @@ std::optional<DifferencePlan> PlanDifference(double value, double step, double l
 double ParameterScale(const sim::ParameterInfo& info, double value,
                       const std::optional<sim::ArmParameters>& scale_at_zero);
 
-// "ccsrm derivatives"-style status words of a run: "completed", "diverged",
-// "cancelled".
-const char* RunStatusWord(sim::SimulationStatus status);
-
 // A run's summary as JSON (status, message and counters).
 nlohmann::json RunJson(const sim::SimulationSummary& summary);
 

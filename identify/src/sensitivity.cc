@@ -54,7 +54,7 @@ void FormDerivative(const StepRuns& runs, const std::vector<internal::RunOutcome
   for (const internal::RunOutcome* o : {needs_base ? &base : nullptr, &a, &b}) {
     if (o != nullptr && !o->summary.completed()) {
       if (note->empty())
-        *note = "run " + std::string(internal::RunStatusWord(o->summary.status)) + ": " +
+        *note = "run " + std::string(sim::SimulationStatusName(o->summary.status)) + ": " +
                 o->summary.message;
       return;
     }

@@ -185,7 +185,7 @@ std::string SweepSummary::FullReport() const {
                   k + 1, values[k], 100.0 * (values[k] - value) / scale,
                   fitted ? Format("%.6g", change_rms_deg[k]).c_str() : "-",
                   fitted ? Format("%.3g", residual_rms_deg[k]).c_str() : "-",
-                  internal::RunStatusWord(run.status), static_cast<long long>(run.steps));
+                  sim::SimulationStatusName(run.status), static_cast<long long>(run.steps));
     out << line;
   }
   if (all_runs_completed()) {

@@ -38,18 +38,6 @@ struct Run {
   std::string description;
 };
 
-const char* StatusName(sim::SimulationStatus status) {
-  switch (status) {
-    case sim::SimulationStatus::kCompleted:
-      return "completed";
-    case sim::SimulationStatus::kDiverged:
-      return "diverged";
-    case sim::SimulationStatus::kCancelled:
-      return "cancelled";
-  }
-  return "unknown";
-}
-
 // Ctrl-C during a run. The simulator calls its progress callback from the
 // simulating thread every `progress_interval_s` of wall time; there the GIL
 // is taken for a moment and Python's signal handlers run (they only run in
@@ -252,7 +240,8 @@ void AddSimulation(py::module_& m) {
   py::class_<sim::SimulationSummary>(m, "SimulationSummary",
                                      "How a run went (sim::SimulationSummary).")
       .def_property_readonly(
-          "status", [](const sim::SimulationSummary& s) { return StatusName(s.status); },
+          "status",
+          [](const sim::SimulationSummary& s) { return sim::SimulationStatusName(s.status); },
           "'completed', 'diverged' or 'cancelled'.")
       .def_property_readonly("completed", &sim::SimulationSummary::completed)
       .def_readonly("message", &sim::SimulationSummary::message)

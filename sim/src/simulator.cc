@@ -29,18 +29,6 @@ std::string FormatTime(double t) {
   return text;
 }
 
-const char* StatusWord(SimulationStatus status) {
-  switch (status) {
-    case SimulationStatus::kCompleted:
-      return "completed";
-    case SimulationStatus::kDiverged:
-      return "diverged";
-    case SimulationStatus::kCancelled:
-      return "cancelled";
-  }
-  return "?";
-}
-
 // One run's step loop: explicit steps with error control that land exactly
 // on every sample time, the stick-slip treatment after each accepted step,
 // and the checks that stop a run (divergence, cancellation).
@@ -278,6 +266,18 @@ class StepLoop {
 
 }  // namespace
 
+const char* SimulationStatusName(SimulationStatus status) {
+  switch (status) {
+    case SimulationStatus::kCompleted:
+      return "completed";
+    case SimulationStatus::kDiverged:
+      return "diverged";
+    case SimulationStatus::kCancelled:
+      return "cancelled";
+  }
+  return "?";
+}
+
 bool SimulationOptions::IsValid(std::string* error) const {
   if (!(duration_s > 0.0) || !std::isfinite(duration_s)) {
     *error = "duration must be > 0 s";
@@ -305,14 +305,14 @@ bool SimulationOptions::IsValid(std::string* error) const {
 std::string SimulationSummary::BriefReport() const {
   char text[256];
   std::snprintf(text, sizeof(text), "%s at t = %.4g s: %.3g s wall, %.3gx real time, %lld steps",
-                StatusWord(status), simulated_s, wall_time_s, real_time_factor,
+                SimulationStatusName(status), simulated_s, wall_time_s, real_time_factor,
                 static_cast<long long>(steps));
   return text;
 }
 
 std::string SimulationSummary::FullReport() const {
   std::ostringstream out;
-  std::string word = StatusWord(status);
+  std::string word = SimulationStatusName(status);
   if (!completed()) {
     for (char& c : word) c = static_cast<char>(std::toupper(c));
   }

@@ -81,6 +81,9 @@ struct Trajectory {
 
 enum class SimulationStatus { kCompleted, kDiverged, kCancelled };
 
+// "completed", "diverged" or "cancelled".
+const char* SimulationStatusName(SimulationStatus status);
+
 // A stretch of time in which a driving cable was slack: at least one of its
 // elements carried no tension (a cable cannot push; docs/model-notes.md row
 // 26). Times are those of the frames, so a stretch is known to the frame
