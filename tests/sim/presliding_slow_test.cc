@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -34,7 +35,8 @@ struct Friction {
 const Friction kPresliding{"presliding", "presliding"};
 
 // configs/paper.yaml with a 60 s hold and the given friction treatments,
-// written beside the test binary.
+// written to the temporary directory (never the working directory, which may
+// be the source tree).
 std::string HoldConfig(const Friction& friction) {
   std::ifstream in(std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml");
   std::stringstream text;
@@ -51,7 +53,10 @@ std::string HoldConfig(const Friction& friction) {
   set("hold_s", "60.0");
   set("hole_friction", friction.holes);
   set("conduit_friction", friction.conduits);
-  const std::string path = "presliding_hold_" + friction.holes + "_" + friction.conduits + ".yaml";
+  const std::string path =
+      (std::filesystem::temp_directory_path() /
+       ("ccsrm_presliding_hold_" + friction.holes + "_" + friction.conduits + ".yaml"))
+          .string();
   std::ofstream(path) << yaml;
   return path;
 }
