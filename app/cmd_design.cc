@@ -21,6 +21,7 @@
 #include "fit_inputs.h"
 #include "option_checks.h"
 #include "output_kinds.h"
+#include "paper_run.h"
 
 namespace ccsrm::app {
 namespace {
@@ -39,6 +40,9 @@ struct DesignArgs {
   std::string noise_from;
   bool propose = false;
   identify::ProposalSpace space;
+  std::vector<std::string> chirps;     // start:end [Hz]
+  std::vector<std::string> prior_box;  // name=lower:upper
+  int robust_candidates = identify::DesignOptions().robust_candidates;
   std::string out;
   bool quiet = false;
 };
@@ -56,31 +60,12 @@ std::vector<std::string> Split(const std::string& text, char separator) {
 
 // One experiment of a plan: "file.yaml" or "file.yaml@name=value,name=value".
 identify::PlannedExperiment PlanExperiment(const std::string& spec, const DesignArgs& a) {
-  const std::string where = "--plans '" + spec + "'";
-  const std::size_t at = spec.find('@');
   sim::PaperRunOptions run;
   run.config_path = a.config;
   run.case_number = a.case_number;
   run.params_path = a.params;
   run.sets = a.set;
-  run.protocol_path = spec.substr(0, at);
-  run.protocol_parameters_source = where;
-  if (run.protocol_path.empty()) ThrowInputError(where, "", "names no protocol file");
-  if (at != std::string::npos) {
-    for (const std::string& assignment : Split(spec.substr(at + 1), ',')) {
-      const std::size_t eq = assignment.find('=');
-      if (eq == std::string::npos || eq == 0) {
-        ThrowInputError(where, "", "expected name=value after '@', found '" + assignment + "'");
-      }
-      const std::string name = assignment.substr(0, eq);
-      double value = 0.0;
-      const std::string problem = ParseNumberText(assignment.substr(eq + 1), &value);
-      if (!problem.empty()) ThrowInputError(where, name, problem);
-      // Protocol parameters are given in the file's units (deg for _deg).
-      const bool degrees = name.size() > 4 && name.compare(name.size() - 4, 4, "_deg") == 0;
-      run.protocol_parameters[name] = degrees ? value * M_PI / 180.0 : value;
-    }
-  }
+  ApplyProtocolSpec(spec, "--plans '" + spec + "'", &run);
   sim::PaperRun prepared = sim::PreparePaperRun(run);
   identify::PlannedExperiment e;
   e.name = spec;
@@ -146,10 +131,38 @@ int RunDesign(const DesignArgs& a) {
   options.frame_rate_hz = a.frame_rate_hz;
   options.threads = a.threads;
   if (!a.noise_from.empty()) NoiseFromFit(a.noise_from, &options);
+  for (const std::string& text : a.prior_box) {
+    const std::string where = "--prior-box '" + text + "'";
+    const std::size_t eq = text.find('='), colon = text.find(':', eq);
+    if (eq == std::string::npos || eq == 0 || colon == std::string::npos) {
+      ThrowInputError(where, "", "expected name=lower:upper (mu=0.15:0.27)");
+    }
+    identify::PriorRange range;
+    range.name = text.substr(0, eq);
+    for (const auto& [part, value] : {std::pair{text.substr(eq + 1, colon - eq - 1), &range.lower},
+                                      std::pair{text.substr(colon + 1), &range.upper}}) {
+      const std::string problem = ParseNumberText(part, value);
+      if (!problem.empty()) ThrowInputError(where, range.name, problem);
+    }
+    options.prior_box.push_back(range);
+  }
+  options.robust_candidates = a.robust_candidates;
+  identify::ProposalSpace space = a.space;
+  for (const std::string& band : a.chirps) {
+    const std::size_t colon = band.find(':');
+    double start = 0.0, end = 0.0;
+    if (colon == std::string::npos || !ParseNumberText(band.substr(0, colon), &start).empty() ||
+        !ParseNumberText(band.substr(colon + 1), &end).empty()) {
+      ThrowInputError("--chirps '" + band + "'", "", "expected start:end in Hz (0.05:0.5)");
+    }
+    space.chirp_bands_hz.emplace_back(start, end);
+  }
   std::string error;
-  if (!options.IsValid(&error)) ThrowInputError("--free", "", error);
+  if (!options.IsValid(&error)) {
+    ThrowInputError(error.rfind("prior_box", 0) == 0 ? "--prior-box" : "--free", "", error);
+  }
   std::string space_error;
-  if (a.propose && !a.space.IsValid(&space_error)) ThrowInputError("--propose", "", space_error);
+  if (a.propose && !space.IsValid(&space_error)) ThrowInputError("--propose", "", space_error);
   if (!a.propose && a.plans.empty()) {
     ThrowInputError("--plans", "", "give the plans to compare, or --propose (or both)");
   }
@@ -172,15 +185,15 @@ int RunDesign(const DesignArgs& a) {
   if (!a.quiet) options.on_run = RunProgress();
   std::vector<std::string> skipped;
   identify::DesignSummary summary;
+  // The prior: the arm with the case, --params and --set, as a plan's.
+  sim::PaperRunOptions prior_run;
+  prior_run.config_path = a.config;
+  prior_run.case_number = a.case_number;
+  prior_run.params_path = a.params;
+  prior_run.sets = a.set;
+  const sim::Config prior = sim::PreparePaperRun(prior_run).config;
   if (a.propose) {
-    // The prior: the arm with the case, --params and --set, as a plan's.
-    sim::PaperRunOptions prior;
-    prior.config_path = a.config;
-    prior.case_number = a.case_number;
-    prior.params_path = a.params;
-    prior.sets = a.set;
-    summary = identify::ProposeDesign(sim::PreparePaperRun(prior).config, a.space, candidates,
-                                      options, &skipped);
+    summary = identify::ProposeDesign(prior, space, candidates, options, &skipped);
   } else {
     summary = identify::EvaluateDesigns(candidates, options);
   }
@@ -188,7 +201,9 @@ int RunDesign(const DesignArgs& a) {
   for (const std::string& why : skipped) std::printf("  left out: %s\n", why.c_str());
   AtomicOutputDirectory out(a.out);
   const std::filesystem::path tmp(out.temp_path());
-  WriteTextFileAtomically((tmp / "design.json").string(), identify::ToJson(summary).dump(2) + "\n");
+  nlohmann::json json = identify::ToJson(summary);
+  json["config_yaml"] = prior.source_yaml;  // the arm, for the report's page
+  WriteTextFileAtomically((tmp / "design.json").string(), json.dump(2) + "\n");
   // The best proposed motion, ready for the lab and for `ccsrm generate`.
   const identify::CandidateInformation* best = nullptr;
   for (const std::size_t k : summary.ranking) {
@@ -198,12 +213,19 @@ int RunDesign(const DesignArgs& a) {
       break;
     }
   }
-  if (best != nullptr)
+  if (best != nullptr) {
     WriteTextFileAtomically((tmp / "proposed.yaml").string(), best->protocol_yaml);
+    WriteTextFileAtomically(
+        (tmp / "proposed.inputs.csv").string(),
+        identify::PlannedMotionCsv(prior, best->protocol_yaml, best->name, options.frame_rate_hz));
+  }
   out.Commit();
   std::printf("  output: %s/design.json\n", a.out.c_str());
   if (best != nullptr) {
-    std::printf("  proposed: %s/proposed.yaml (%s)\n", a.out.c_str(), best->name.c_str());
+    std::printf(
+        "  proposed: %s/proposed.yaml (%s), planned inputs and angles in %s/"
+        "proposed.inputs.csv\n",
+        a.out.c_str(), best->name.c_str(), a.out.c_str());
   }
   for (const identify::CandidateInformation& c : summary.candidates) {
     if (!c.completed) {
@@ -239,9 +261,10 @@ void AddDesignCommand(CLI::App& root) {
                   "(paper.yaml@amplitude_deg=6+paper.yaml@amplitude_deg=-5)")
       ->expected(1, -1);
   cmd->add_flag("--propose", a->propose,
-                "Also search reversal motions (every segment between +A and -A, --amplitudes x "
-                "--move-times, segments together and opposed) filling --budget-s, and write the "
-                "best as proposed.yaml");
+                "Also search motions filling --budget-s: reversals (every segment between +A and "
+                "-A, --amplitudes x --move-times), and sines and chirps when --sines or --chirps "
+                "are given, in each of --planes, segments together and opposed; write the best as "
+                "proposed.yaml");
   cmd->add_option("--budget-s", a->space.budget_s, "Recording time of a proposed plan [s]")
       ->capture_default_str()
       ->check(Above(0.0, "s"));
@@ -251,6 +274,26 @@ void AddDesignCommand(CLI::App& root) {
   cmd->add_option("--move-times", a->space.move_times_s, "Times of one move the proposal tries [s]")
       ->delimiter(',')
       ->capture_default_str();
+  cmd->add_option("--sines", a->space.sine_frequencies_hz,
+                  "Also propose sines A sin(2 pi f t) filling --budget-s, at these frequencies "
+                  "[Hz] (default: none)")
+      ->delimiter(',');
+  cmd->add_option("--chirps", a->chirps,
+                  "Also propose chirps filling --budget-s, the frequency swept linearly over each "
+                  "band start:end [Hz] (0.05:0.5,...; default: none)")
+      ->delimiter(',');
+  cmd->add_option("--planes", a->space.planes_deg,
+                  "Bending planes the proposal tries [deg] (0: toward +x, 90: toward +y; default: "
+                  "theta_x alone, the paper's plane)")
+      ->delimiter(',');
+  cmd->add_option("--prior-box", a->prior_box,
+                  "Range of a parameter the truth may lie in, name=lower:upper (repeatable, up "
+                  "to 6): the best plans at the prior are evaluated at every corner of the box "
+                  "too and ranked by their worst case (robust design)");
+  cmd->add_option("--robust-top", a->robust_candidates,
+                  "How many of the best plans at the prior --prior-box evaluates at its corners")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--config", a->config,
                   "Arm configuration (YAML); default: the bundled paper.yaml");
   cmd->add_option("--case", a->case_number,

@@ -213,7 +213,8 @@ int RunGenerate(const GenerateArgs& a) {
   const std::string truth_h5_path = stem + ".truth.h5";
   // Check the output paths before spending minutes on the run.
   const std::vector<std::string> inputs = {a.run.config_path, a.run.params_path, a.effects_path,
-                                           a.run.protocol_path, a.motion.inputs_path};
+                                           ProtocolFileOf(a.run.protocol_path),
+                                           a.motion.inputs_path};
   CheckOut(a.out, ExperimentFileOutput(), inputs);
   CheckOut(truth_yaml_path, YamlFileOutput("ccsrm-truth/1", "ccsrm truth file"), inputs);
   CheckOut(truth_h5_path, RunFileOutput(), inputs);

@@ -75,8 +75,157 @@ bool DesignOptions::IsValid(std::string* error) const {
     return fail("relative_step must be in (0, 0.1]");
   }
   if (threads < 1) return fail("threads must be >= 1");
+  std::set<std::string> boxed;
+  for (const PriorRange& range : prior_box) {
+    if (!boxed.insert(range.name).second) {
+      return fail("prior_box: '" + range.name + "' given twice");
+    }
+    if (!std::isfinite(range.lower) || !std::isfinite(range.upper) ||
+        !(range.lower < range.upper)) {
+      return fail("prior_box: '" + range.name + "' needs finite lower < upper");
+    }
+  }
+  if (prior_box.size() > 6) return fail("prior_box: at most 6 ranges (64 corners)");
+  if (robust_candidates < 1) return fail("robust_candidates must be >= 1");
   return true;
 }
+
+namespace {
+
+// One candidate with the parameters of its experiments' configurations.
+CandidateInformation EvaluateCandidate(const DesignCandidate& candidate,
+                                       const DesignOptions& options) {
+  CandidateInformation info;
+  info.name = candidate.name;
+  info.protocol_yaml = candidate.protocol_yaml;
+  info.parameters = options.free_parameters;
+  std::vector<Experiment> experiments;
+  for (const PlannedExperiment& planned : candidate.experiments) {
+    experiments.push_back(AsExperiment(planned, options));
+    info.experiments.push_back(planned.name);
+    info.duration_s += planned.duration_s;
+  }
+  const sim::Config& first = candidate.experiments.front().config;
+  const sim::ArmSize arm = first.arm.size();
+  IdentificationOptions fit;
+  fit.free_parameters = options.free_parameters;
+  for (const std::string& name : options.free_parameters) {
+    sim::FindParameter(name, "--free", arm);  // throws for an unknown name
+    const double prior = sim::GetParameter(first.parameters, name);
+    if (prior == 0.0 || !std::isfinite(prior)) {
+      ThrowInputError("--free", name,
+                      "its prior value is 0, where a relative standard error means nothing: "
+                      "give a prior (--set " +
+                          name + "=..., --params)");
+    }
+    info.prior.push_back(prior);
+    // The scaled space is relative to the prior: u = p / |prior|.
+    fit.scales[name] = std::abs(prior);
+  }
+  fit.relative_step = options.relative_step;
+  fit.threads = options.threads;
+  fit.backend = options.backend;
+  fit.on_run = options.on_run;
+
+  // The prior's own angles as the measurement: one run per experiment.
+  {
+    std::unique_ptr<SimulationBackend> own;
+    SimulationBackend* backend = options.backend.get();
+    if (backend == nullptr) {
+      own = MakeThreadBackend(&experiments, options.threads);
+      backend = own.get();
+    }
+    std::vector<RunRequest> requests(experiments.size());
+    for (std::size_t e = 0; e < experiments.size(); ++e) {
+      requests[e].experiment = e;
+      requests[e].parameters = candidate.experiments[e].config.parameters;
+    }
+    const std::vector<RunResult> runs = backend->RunBatch(requests, options.on_run);
+    info.simulations += static_cast<std::int64_t>(runs.size());
+    for (std::size_t e = 0; e < experiments.size(); ++e) {
+      if (!runs[e].summary.completed()) {
+        info.message = experiments[e].name +
+                       ": the run at the prior did not complete: " + runs[e].summary.message;
+        break;
+      }
+      experiments[e].measured_rad = runs[e].angles_rad;
+    }
+  }
+  if (info.message.empty()) {
+    // No iteration: the Jacobian at the start, second order, is all that
+    // is wanted.
+    fit.max_iterations = 0;
+    fit.converged_step_fraction = 0.0;
+    fit.min_effective_chi2_decrease = 0.0;
+    const IdentificationSummary at_prior = Identify(experiments, fit);
+    info.simulations += at_prior.simulations;
+    if (at_prior.jacobian.size() == 0) {
+      info.message = "the Jacobian at the prior failed: " + at_prior.covariance_message;
+    } else {
+      const Eigen::MatrixXd& j = at_prior.jacobian;  // residuals / noise per relative change
+      info.samples = static_cast<std::size_t>(j.rows());
+      info.fisher_relative = options.effective_sample_fraction * j.transpose() * j;
+      info.completed = true;
+    }
+  }
+  const std::size_t p = options.free_parameters.size();
+  info.std_error.assign(p, kInf);
+  info.relative_std_error.assign(p, kInf);
+  info.worst_relative_std_error = kInf;
+  info.d_criterion = info.a_criterion = info.worst_direction_relative_std_error = kInf;
+  if (info.completed) {
+    // C = F⁻¹ through F's eigen-decomposition: an eigenvalue below 1e-12 of
+    // the largest is a direction the plan does not inform (infinite error).
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(info.fisher_relative);
+    const Eigen::VectorXd lambda = eigen.eigenvalues();  // ascending
+    const Eigen::MatrixXd v = eigen.eigenvectors();
+    const double floor = 1e-12 * std::max(lambda.maxCoeff(), 0.0);
+    Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(p, p);
+    bool informed = lambda.minCoeff() > floor;
+    if (informed) {
+      covariance = v * lambda.cwiseInverse().asDiagonal() * v.transpose();
+      double log_det = 0.0;
+      for (Eigen::Index k = 0; k < lambda.size(); ++k) log_det -= std::log(lambda[k]);
+      info.d_criterion = std::sqrt(std::exp(log_det / static_cast<double>(p)));
+      info.a_criterion = std::sqrt(covariance.trace() / static_cast<double>(p));
+      info.worst_direction_relative_std_error = 1.0 / std::sqrt(lambda[0]);
+    }
+    // The worst direction: the least informed eigenvector, in any case.
+    std::vector<std::pair<std::string, double>> direction;
+    for (std::size_t i = 0; i < p; ++i) direction.emplace_back(info.parameters[i], v(i, 0));
+    std::sort(direction.begin(), direction.end(),
+              [](const auto& a, const auto& b) { return std::abs(a.second) > std::abs(b.second); });
+    if (!direction.empty() && direction.front().second < 0.0) {
+      for (auto& [name, c] : direction) c = -c;
+    }
+    info.worst_direction = direction;
+    info.worst_relative_std_error = 0.0;
+    for (std::size_t i = 0; i < p; ++i) {
+      const double relative = informed ? std::sqrt(covariance(i, i)) : kInf;
+      info.relative_std_error[i] = relative;
+      info.std_error[i] = relative * std::abs(info.prior[i]);
+      if (!(relative <= info.worst_relative_std_error)) {
+        info.worst_relative_std_error = relative;
+        info.worst_parameter = info.parameters[i];
+      }
+    }
+  }
+  info.robust_worst_relative_std_error = info.worst_relative_std_error;
+  return info;
+}
+
+// The values of the box's parameters at corner `index` (bit k: range k's
+// upper end).
+std::vector<std::pair<std::string, double>> Corner(const std::vector<PriorRange>& box,
+                                                   std::size_t index) {
+  std::vector<std::pair<std::string, double>> values;
+  for (std::size_t k = 0; k < box.size(); ++k) {
+    values.emplace_back(box[k].name, (index >> k) & 1U ? box[k].upper : box[k].lower);
+  }
+  return values;
+}
+
+}  // namespace
 
 DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
                               const DesignOptions& options) {
@@ -90,134 +239,82 @@ DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
     if (candidate.experiments.empty()) {
       ThrowInputError("design candidate '" + candidate.name + "'", "", "has no experiments");
     }
-    CandidateInformation info;
-    info.name = candidate.name;
-    info.protocol_yaml = candidate.protocol_yaml;
-    info.parameters = options.free_parameters;
-    std::vector<Experiment> experiments;
-    for (const PlannedExperiment& planned : candidate.experiments) {
-      experiments.push_back(AsExperiment(planned, options));
-      info.experiments.push_back(planned.name);
-      info.duration_s += planned.duration_s;
-    }
-    const sim::Config& first = candidate.experiments.front().config;
-    const sim::ArmSize arm = first.arm.size();
-    IdentificationOptions fit;
-    fit.free_parameters = options.free_parameters;
-    for (const std::string& name : options.free_parameters) {
-      sim::FindParameter(name, "--free", arm);  // throws for an unknown name
-      const double prior = sim::GetParameter(first.parameters, name);
-      if (prior == 0.0 || !std::isfinite(prior)) {
-        ThrowInputError("--free", name,
-                        "its prior value is 0, where a relative standard error means nothing: "
-                        "give a prior (--set " +
-                            name + "=..., --params)");
-      }
-      info.prior.push_back(prior);
-      // The scaled space is relative to the prior: u = p / |prior|.
-      fit.scales[name] = std::abs(prior);
-    }
-    fit.relative_step = options.relative_step;
-    fit.threads = options.threads;
-    fit.backend = options.backend;
-    fit.on_run = options.on_run;
-
-    // The prior's own angles as the measurement: one run per experiment.
-    {
-      std::unique_ptr<SimulationBackend> own;
-      SimulationBackend* backend = options.backend.get();
-      if (backend == nullptr) {
-        own = MakeThreadBackend(&experiments, options.threads);
-        backend = own.get();
-      }
-      std::vector<RunRequest> requests(experiments.size());
-      for (std::size_t e = 0; e < experiments.size(); ++e) {
-        requests[e].experiment = e;
-        requests[e].parameters = candidate.experiments[e].config.parameters;
-      }
-      const std::vector<RunResult> runs = backend->RunBatch(requests, options.on_run);
-      info.simulations += static_cast<std::int64_t>(runs.size());
-      for (std::size_t e = 0; e < experiments.size(); ++e) {
-        if (!runs[e].summary.completed()) {
-          info.message = experiments[e].name +
-                         ": the run at the prior did not complete: " + runs[e].summary.message;
-          break;
-        }
-        experiments[e].measured_rad = runs[e].angles_rad;
-      }
-    }
-    if (info.message.empty()) {
-      // No iteration: the Jacobian at the start, second order, is all that
-      // is wanted.
-      fit.max_iterations = 0;
-      fit.converged_step_fraction = 0.0;
-      fit.min_effective_chi2_decrease = 0.0;
-      const IdentificationSummary at_prior = Identify(experiments, fit);
-      info.simulations += at_prior.simulations;
-      if (at_prior.jacobian.size() == 0) {
-        info.message = "the Jacobian at the prior failed: " + at_prior.covariance_message;
-      } else {
-        const Eigen::MatrixXd& j = at_prior.jacobian;  // residuals / noise per relative change
-        info.samples = static_cast<std::size_t>(j.rows());
-        info.fisher_relative = options.effective_sample_fraction * j.transpose() * j;
-        info.completed = true;
-      }
-    }
-    const std::size_t p = options.free_parameters.size();
-    info.std_error.assign(p, kInf);
-    info.relative_std_error.assign(p, kInf);
-    info.worst_relative_std_error = kInf;
-    info.d_criterion = info.a_criterion = info.worst_direction_relative_std_error = kInf;
-    if (info.completed) {
-      // C = F⁻¹ through F's eigen-decomposition: an eigenvalue below 1e-12 of
-      // the largest is a direction the plan does not inform (infinite error).
-      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(info.fisher_relative);
-      const Eigen::VectorXd lambda = eigen.eigenvalues();  // ascending
-      const Eigen::MatrixXd v = eigen.eigenvectors();
-      const double floor = 1e-12 * std::max(lambda.maxCoeff(), 0.0);
-      Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(p, p);
-      bool informed = lambda.minCoeff() > floor;
-      if (informed) {
-        covariance = v * lambda.cwiseInverse().asDiagonal() * v.transpose();
-        double log_det = 0.0;
-        for (Eigen::Index k = 0; k < lambda.size(); ++k) log_det -= std::log(lambda[k]);
-        info.d_criterion = std::sqrt(std::exp(log_det / static_cast<double>(p)));
-        info.a_criterion = std::sqrt(covariance.trace() / static_cast<double>(p));
-        info.worst_direction_relative_std_error = 1.0 / std::sqrt(lambda[0]);
-      }
-      // The worst direction: the least informed eigenvector, in any case.
-      std::vector<std::pair<std::string, double>> direction;
-      for (std::size_t i = 0; i < p; ++i) direction.emplace_back(info.parameters[i], v(i, 0));
-      std::sort(direction.begin(), direction.end(), [](const auto& a, const auto& b) {
-        return std::abs(a.second) > std::abs(b.second);
-      });
-      if (!direction.empty() && direction.front().second < 0.0) {
-        for (auto& [name, c] : direction) c = -c;
-      }
-      info.worst_direction = direction;
-      info.worst_relative_std_error = 0.0;
-      for (std::size_t i = 0; i < p; ++i) {
-        const double relative = informed ? std::sqrt(covariance(i, i)) : kInf;
-        info.relative_std_error[i] = relative;
-        info.std_error[i] = relative * std::abs(info.prior[i]);
-        if (!(relative <= info.worst_relative_std_error)) {
-          info.worst_relative_std_error = relative;
-          info.worst_parameter = info.parameters[i];
-        }
-      }
-    }
-    summary.simulations += info.simulations;
-    summary.candidates.push_back(std::move(info));
   }
+  // The box's values are checked against the arm's parameter table before
+  // any run.
+  for (const PriorRange& range : options.prior_box) {
+    for (const DesignCandidate& candidate : candidates) {
+      sim::ArmParameters check = candidate.experiments.front().config.parameters;
+      for (const double value : {range.lower, range.upper}) {
+        sim::SetParameter(range.name, value, "--prior-box", &check);
+      }
+      const auto& free = options.free_parameters;
+      if (std::find(free.begin(), free.end(), range.name) != free.end() &&
+          (range.lower == 0.0 || range.upper == 0.0)) {
+        ThrowInputError("--prior-box", range.name,
+                        "a free parameter's range ends at 0, where a relative standard error "
+                        "means nothing");
+      }
+    }
+  }
+  for (const DesignCandidate& candidate : candidates) {
+    summary.candidates.push_back(EvaluateCandidate(candidate, options));
+    summary.simulations += summary.candidates.back().simulations;
+  }
+  const auto by_worst = [&](std::size_t a, std::size_t b) {
+    const CandidateInformation& x = summary.candidates[a];
+    const CandidateInformation& y = summary.candidates[b];
+    if (x.completed != y.completed) return x.completed;
+    return x.worst_relative_std_error < y.worst_relative_std_error;
+  };
   summary.ranking.resize(summary.candidates.size());
   std::iota(summary.ranking.begin(), summary.ranking.end(), std::size_t{0});
-  std::stable_sort(summary.ranking.begin(), summary.ranking.end(),
-                   [&](std::size_t a, std::size_t b) {
-                     const CandidateInformation& x = summary.candidates[a];
-                     const CandidateInformation& y = summary.candidates[b];
-                     if (x.completed != y.completed) return x.completed;
-                     return x.worst_relative_std_error < y.worst_relative_std_error;
-                   });
+  std::stable_sort(summary.ranking.begin(), summary.ranking.end(), by_worst);
+  if (!options.prior_box.empty()) {
+    // The best at the prior, again at every corner of the box.
+    const std::size_t corners = std::size_t{1} << options.prior_box.size();
+    std::vector<std::size_t> robust;
+    for (const std::size_t k : summary.ranking) {
+      if (robust.size() == static_cast<std::size_t>(options.robust_candidates)) break;
+      if (summary.candidates[k].completed) robust.push_back(k);
+    }
+    for (const std::size_t k : robust) {
+      CandidateInformation& info = summary.candidates[k];
+      for (std::size_t c = 0; c < corners; ++c) {
+        DesignCandidate at_corner = candidates[k];
+        CornerInformation corner;
+        corner.values = Corner(options.prior_box, c);
+        for (PlannedExperiment& e : at_corner.experiments) {
+          for (const auto& [name, value] : corner.values) {
+            sim::SetParameter(name, value, "--prior-box", &e.config.parameters);
+          }
+        }
+        const CandidateInformation there = EvaluateCandidate(at_corner, options);
+        info.simulations += there.simulations;
+        summary.simulations += there.simulations;
+        corner.completed = there.completed;
+        corner.message = there.message;
+        corner.relative_std_error = there.relative_std_error;
+        corner.worst_relative_std_error = there.worst_relative_std_error;
+        corner.worst_parameter = there.worst_parameter;
+        info.robust_worst_relative_std_error =
+            std::max(info.robust_worst_relative_std_error,
+                     there.completed ? there.worst_relative_std_error : kInf);
+        info.corners.push_back(std::move(corner));
+      }
+    }
+    // Those evaluated at the corners first, by their worst case.
+    std::stable_sort(
+        summary.ranking.begin(), summary.ranking.end(), [&](std::size_t a, std::size_t b) {
+          const CandidateInformation& x = summary.candidates[a];
+          const CandidateInformation& y = summary.candidates[b];
+          if (x.corners.empty() != y.corners.empty()) return !x.corners.empty();
+          if (!x.corners.empty()) {
+            return x.robust_worst_relative_std_error < y.robust_worst_relative_std_error;
+          }
+          return by_worst(a, b);
+        });
+  }
   summary.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
   return summary;
@@ -228,43 +325,103 @@ bool ProposalSpace::IsValid(std::string* error) const {
     if (error != nullptr) *error = why;
     return false;
   };
+  const auto positive = [](const std::vector<double>& values) {
+    return std::all_of(values.begin(), values.end(),
+                       [](double v) { return v > 0.0 && std::isfinite(v); });
+  };
   if (amplitudes_deg.empty()) return fail("amplitudes_deg: none given");
-  if (move_times_s.empty()) return fail("move_times_s: none given");
-  for (const double a : amplitudes_deg) {
-    if (!(a > 0.0) || !std::isfinite(a)) return fail("amplitudes_deg: each must be > 0");
+  if (!positive(amplitudes_deg)) return fail("amplitudes_deg: each must be > 0");
+  if (!positive(move_times_s)) return fail("move_times_s: each must be > 0");
+  if (!positive(sine_frequencies_hz)) return fail("sine_frequencies_hz: each must be > 0");
+  for (const auto& [start, end] : chirp_bands_hz) {
+    if (!(start > 0.0) || !(start < end) || !std::isfinite(end)) {
+      return fail("chirp_bands_hz: each must be 0 < start < end");
+    }
   }
-  for (const double m : move_times_s) {
-    if (!(m > 0.0) || !std::isfinite(m)) return fail("move_times_s: each must be > 0");
+  for (const double plane : planes_deg) {
+    if (!std::isfinite(plane)) return fail("planes_deg: each must be finite");
+  }
+  if (move_times_s.empty() && sine_frequencies_hz.empty() && chirp_bands_hz.empty()) {
+    return fail("no motion to try: give move times, sine frequencies or chirp bands");
   }
   if (!(hold_s >= 0.0) || !std::isfinite(hold_s)) return fail("hold_s must be >= 0");
-  const double shortest = *std::min_element(move_times_s.begin(), move_times_s.end());
-  if (!(budget_s >= 2.0 * (shortest + hold_s)) || !std::isfinite(budget_s)) {
-    return fail("budget_s must hold at least two moves and holds (" +
-                Format("%.3g", 2.0 * (shortest + hold_s)) + " s)");
+  if (!(budget_s > 0.0) || !std::isfinite(budget_s)) return fail("budget_s must be > 0");
+  if (!move_times_s.empty()) {
+    const double shortest = *std::min_element(move_times_s.begin(), move_times_s.end());
+    if (budget_s < 2.0 * (shortest + hold_s)) {
+      return fail("budget_s must hold at least two moves and holds (" +
+                  Format("%.3g", 2.0 * (shortest + hold_s)) + " s)");
+    }
   }
   return true;
 }
 
-std::string ReversalProtocolYaml(double amplitude_deg, double move_s, bool opposed,
-                                 const ProposalSpace& space, int segments, std::string* name) {
-  const int moves = static_cast<int>(std::floor(space.budget_s / (move_s + space.hold_s) + 1e-9));
-  *name = "reversals A=" + Format("%g", amplitude_deg) + " move=" + Format("%g", move_s) +
-          (opposed ? " opposed" : "");
-  std::string text = "schema: ccsrm-protocol/1\nname: " + *name +
-                     "\ndescription: every segment swings between +" + Format("%g", amplitude_deg) +
-                     " and -" + Format("%g", amplitude_deg) + " deg in theta_x, " +
-                     std::to_string(moves) + " moves of " + Format("%g", move_s) + " s" +
-                     (opposed ? ", neighbouring segments in opposite directions" : "") +
-                     " (ccsrm design)\nsegments:\n";
-  for (int s = 0; s < (opposed ? segments : 1); ++s) {
-    text += opposed ? "  " + std::to_string(s + 1) + ":\n" : std::string("  all:\n");
-    const double sign = (opposed && s % 2 == 1) ? -1.0 : 1.0;
-    for (int k = 0; k < moves; ++k) {
-      // +A, −A, +A, ... and the last move back to straight.
-      const double target = k + 1 == moves ? 0.0 : sign * (k % 2 == 0 ? 1.0 : -1.0) * amplitude_deg;
-      text += "    - move: {to: {theta_x_deg: " + Format("%.17g", target + 0.0) +
-              "}, duration_s: " + Format("%.17g", move_s) + "}\n";
-      text += "    - hold: {duration_s: " + Format("%.17g", space.hold_s) + "}\n";
+std::string ProposalProtocolYaml(const ProposedMotion& m, const ProposalSpace& space, int segments,
+                                 std::string* name) {
+  using Kind = ProposedMotion::Kind;
+  const std::string a = Format("%g", m.amplitude_deg);
+  const std::string plane = m.in_plane ? " plane=" + Format("%g", m.plane_deg) : "";
+  const std::string opposed = m.opposed ? " opposed" : "";
+  // A bending state of `value` degrees in the motion's plane.
+  const auto state = [&](double value) {
+    const std::string v = Format("%.17g", value + 0.0);
+    return m.in_plane ? "{plane_deg: " + Format("%.17g", m.plane_deg) + ", bend_deg: " + v + "}"
+                      : "{theta_x_deg: " + v + "}";
+  };
+  const std::string where =
+      m.in_plane ? "in the plane at " + Format("%g", m.plane_deg) + " deg" : "in theta_x";
+  const std::string together =
+      m.opposed ? ", neighbouring segments in opposite directions" : std::string();
+  std::string description;
+  std::vector<std::string> pieces;  // of a segment swinging with sign +1; {S} is the sign
+  int moves = 0;
+  switch (m.kind) {
+    case Kind::kReversals:
+      moves = static_cast<int>(std::floor(space.budget_s / (m.move_s + space.hold_s) + 1e-9));
+      *name = "reversals A=" + a + " move=" + Format("%g", m.move_s) + plane + opposed;
+      description = "every segment swings between +" + a + " and -" + a + " deg " + where + ", " +
+                    std::to_string(moves) + " moves of " + Format("%g", m.move_s) + " s";
+      break;
+    case Kind::kSine:
+      *name = "sine A=" + a + " f=" + Format("%g", m.frequency_hz) + plane + opposed;
+      description = "every segment swings " + a + " deg " + where + " at " +
+                    Format("%g", m.frequency_hz) + " Hz for " + Format("%g", space.budget_s) + " s";
+      break;
+    case Kind::kChirp:
+      *name = "chirp A=" + a + " f=" + Format("%g", m.frequency_hz) + "-" + Format("%g", m.end_hz) +
+              plane + opposed;
+      description = "every segment swings " + a + " deg " + where + ", the frequency swept from " +
+                    Format("%g", m.frequency_hz) + " to " + Format("%g", m.end_hz) + " Hz over " +
+                    Format("%g", space.budget_s) + " s";
+      break;
+  }
+  std::string text = "schema: ccsrm-protocol/1\nname: " + *name + "\ndescription: " + description +
+                     together + " (ccsrm design)\nsegments:\n";
+  for (int s = 0; s < (m.opposed ? segments : 1); ++s) {
+    text += m.opposed ? "  " + std::to_string(s + 1) + ":\n" : std::string("  all:\n");
+    const double sign = (m.opposed && s % 2 == 1) ? -1.0 : 1.0;
+    switch (m.kind) {
+      case Kind::kReversals:
+        for (int k = 0; k < moves; ++k) {
+          // +A, −A, +A, ... and the last move back to straight.
+          const double target =
+              k + 1 == moves ? 0.0 : sign * (k % 2 == 0 ? 1.0 : -1.0) * m.amplitude_deg;
+          text += "    - move: {to: " + state(target) +
+                  ", duration_s: " + Format("%.17g", m.move_s) + "}\n";
+          text += "    - hold: {duration_s: " + Format("%.17g", space.hold_s) + "}\n";
+        }
+        break;
+      case Kind::kSine:
+        text += "    - sine: {amplitude: " + state(sign * m.amplitude_deg) +
+                ", frequency_hz: " + Format("%.17g", m.frequency_hz) +
+                ", duration_s: " + Format("%.17g", space.budget_s) + "}\n";
+        break;
+      case Kind::kChirp:
+        text += "    - chirp: {amplitude: " + state(sign * m.amplitude_deg) +
+                ", start_hz: " + Format("%.17g", m.frequency_hz) +
+                ", end_hz: " + Format("%.17g", m.end_hz) +
+                ", duration_s: " + Format("%.17g", space.budget_s) + "}\n";
+        break;
     }
   }
   return text;
@@ -290,29 +447,101 @@ DesignSummary ProposeDesign(const sim::Config& prior, const ProposalSpace& space
   if (!space.IsValid(&error)) ThrowInputError("design proposal space", "", error);
   std::vector<DesignCandidate> candidates = given;
   const int segments = static_cast<int>(prior.arm.segments.size());
+  std::vector<ProposedMotion> motions;
+  std::vector<std::pair<bool, double>> planes;  // (in a plane, its angle)
+  if (space.planes_deg.empty()) planes.emplace_back(false, 0.0);
+  for (const double plane : space.planes_deg) planes.emplace_back(true, plane);
   for (const bool opposed : {false, true}) {
     if (opposed && (!space.opposed_segments || segments < 2)) continue;
-    for (const double amplitude : space.amplitudes_deg) {
-      for (const double move_s : space.move_times_s) {
-        if (space.budget_s < 2.0 * (move_s + space.hold_s)) continue;
-        std::string name;
-        const std::string text =
-            ReversalProtocolYaml(amplitude, move_s, opposed, space, segments, &name);
-        try {
-          const sim::Protocol protocol = sim::ParseProtocol(text, name, prior.arm);
-          DesignCandidate candidate;
-          candidate.name = name;
-          candidate.protocol_yaml = text;
-          candidate.experiments.push_back(PlanExperiment(prior, protocol, name));
-          candidates.push_back(std::move(candidate));
-        } catch (const InputError& e) {
-          // Past the joints' range or the cable limits: not a motion to run.
-          if (skipped != nullptr) skipped->push_back(e.what());
+    for (const auto& [in_plane, plane] : planes) {
+      for (const double amplitude : space.amplitudes_deg) {
+        ProposedMotion m;
+        m.amplitude_deg = amplitude;
+        m.in_plane = in_plane;
+        m.plane_deg = plane;
+        m.opposed = opposed;
+        for (const double move_s : space.move_times_s) {
+          if (space.budget_s < 2.0 * (move_s + space.hold_s)) continue;
+          m.kind = ProposedMotion::Kind::kReversals;
+          m.move_s = move_s;
+          motions.push_back(m);
+        }
+        for (const double f : space.sine_frequencies_hz) {
+          m.kind = ProposedMotion::Kind::kSine;
+          m.frequency_hz = f;
+          motions.push_back(m);
+        }
+        for (const auto& [start, end] : space.chirp_bands_hz) {
+          m.kind = ProposedMotion::Kind::kChirp;
+          m.frequency_hz = start;
+          m.end_hz = end;
+          motions.push_back(m);
         }
       }
     }
   }
+  for (const ProposedMotion& m : motions) {
+    std::string name;
+    const std::string text = ProposalProtocolYaml(m, space, segments, &name);
+    try {
+      const sim::Protocol protocol = sim::ParseProtocol(text, name, prior.arm);
+      DesignCandidate candidate;
+      candidate.name = name;
+      candidate.protocol_yaml = text;
+      candidate.experiments.push_back(PlanExperiment(prior, protocol, name));
+      candidates.push_back(std::move(candidate));
+    } catch (const InputError& e) {
+      // Past the joints' range or the cable limits: not a motion to run.
+      if (skipped != nullptr) skipped->push_back(e.what());
+    }
+  }
   return EvaluateDesigns(candidates, options);
+}
+
+std::string PlannedMotionCsv(const sim::Config& prior, const std::string& protocol_yaml,
+                             const std::string& name, double rate_hz) {
+  const sim::Protocol protocol = sim::ParseProtocol(protocol_yaml, name, prior.arm);
+  const PlannedExperiment planned = PlanExperiment(prior, protocol, name);
+  const int cables = planned.inputs->num_cables();
+  const int joints = planned.model->num_joints();
+  std::string csv = "# " + name +
+                    " (proposed.yaml) as ccsrm design planned it on the prior arm: cable input "
+                    "lengths (pulled in = positive; ccsrm simulate --inputs reads them), their "
+                    "speeds, and the planned joint angles\ntime_s";
+  for (int c = 1; c <= cables; ++c) csv += ",cable" + std::to_string(c) + "_m";
+  for (int c = 1; c <= cables; ++c) csv += ",speed_cable" + std::to_string(c) + "_m_s";
+  for (int j = 1; j <= joints; ++j) {
+    csv +=
+        ",planned_thetax" + std::to_string(j) + "_deg,planned_thetay" + std::to_string(j) + "_deg";
+  }
+  csv += "\n";
+  const int frames = static_cast<int>(std::floor(planned.duration_s * rate_hz + 1e-9)) + 1;
+  char cell[40];
+  for (int f = 0; f < frames; ++f) {
+    const double t = f / rate_hz;
+    std::snprintf(cell, sizeof(cell), "%.6f", t);
+    csv += cell;
+    std::vector<double> rates(static_cast<std::size_t>(cables));
+    for (int c = 0; c < cables; ++c) {
+      double value = 0.0, accel = 0.0;
+      planned.inputs->Evaluate(c, t, &value, &rates[static_cast<std::size_t>(c)], &accel);
+      std::snprintf(cell, sizeof(cell), ",%.9g", std::abs(value) < 1e-15 ? 0.0 : value);
+      csv += cell;
+    }
+    for (const double rate : rates) {
+      // The spline's rate at rest is a denormal, not a speed: below a nm/s
+      // it is written as 0 (a reader may refuse denormals).
+      std::snprintf(cell, sizeof(cell), ",%.6g", std::abs(rate) < 1e-9 ? 0.0 : rate);
+      csv += cell;
+    }
+    for (const Eigen::Vector2d& angle : protocol.PlannedAngles(t)) {
+      std::snprintf(cell, sizeof(cell), ",%.6f,%.6f", angle.x() * 180.0 / M_PI,
+                    angle.y() * 180.0 / M_PI);
+      csv += cell;
+    }
+    csv += "\n";
+  }
+  return csv;
 }
 
 std::string DesignSummary::FullReport() const {
@@ -356,6 +585,38 @@ std::string DesignSummary::FullReport() const {
     }
     out += "\n";
   }
+  if (!options.prior_box.empty()) {
+    std::string box;
+    for (const PriorRange& r : options.prior_box) {
+      box += (box.empty() ? "" : ", ") + r.name + " " + Format("%.4g", r.lower) + ".." +
+             Format("%.4g", r.upper);
+    }
+    out += "  over the prior box (" + box + "; " +
+           std::to_string(std::size_t{1} << options.prior_box.size()) +
+           " corners), the best plans at the prior: worst relative standard error (%)\n";
+    for (const std::size_t k : ranking) {
+      const CandidateInformation& c = candidates[k];
+      if (c.corners.empty()) continue;
+      const CornerInformation* worst = nullptr;
+      for (const CornerInformation& corner : c.corners) {
+        if (worst == nullptr || !(corner.completed && corner.worst_relative_std_error <=
+                                                          worst->worst_relative_std_error)) {
+          worst = &corner;
+        }
+      }
+      std::string at;
+      for (const auto& [name, value] : worst->values) {
+        at += (at.empty() ? "" : ", ") + name + " = " + Format("%.4g", value);
+      }
+      std::snprintf(line, sizeof(line), "  %-32s at the prior %s, over the box %s (%s at %s)\n",
+                    (c.name.size() > 32 ? c.name.substr(0, 29) + "..." : c.name).c_str(),
+                    percent(c.worst_relative_std_error).c_str(),
+                    percent(c.robust_worst_relative_std_error).c_str(),
+                    worst->completed ? worst->worst_parameter.c_str() : "not evaluated",
+                    at.c_str());
+      out += line;
+    }
+  }
   return out;
 }
 
@@ -377,6 +638,19 @@ nlohmann::json ToJson(const DesignSummary& s) {
     nlohmann::json direction = nlohmann::json::array();
     for (const auto& [name, component] : c.worst_direction) {
       direction.push_back({{"name", name}, {"component", component}});
+    }
+    nlohmann::json corners = nlohmann::json::array();
+    for (const CornerInformation& corner : c.corners) {
+      nlohmann::json values = nlohmann::json::object();
+      for (const auto& [name, value] : corner.values) values[name] = value;
+      nlohmann::json relative = nlohmann::json::array();
+      for (const double x : corner.relative_std_error) relative.push_back(number(x));
+      corners.push_back({{"values", values},
+                         {"completed", corner.completed},
+                         {"message", corner.message},
+                         {"relative_std_error", relative},
+                         {"worst_relative_std_error", number(corner.worst_relative_std_error)},
+                         {"worst_parameter", corner.worst_parameter}});
     }
     nlohmann::json fisher = nlohmann::json::array();
     for (Eigen::Index i = 0; i < c.fisher_relative.rows(); ++i) {
@@ -402,7 +676,13 @@ nlohmann::json ToJson(const DesignSummary& s) {
          {"worst_direction_relative_std_error", number(c.worst_direction_relative_std_error)},
          {"worst_direction", direction},
          {"fisher_relative", fisher},
+         {"corners", corners},
+         {"robust_worst_relative_std_error", number(c.robust_worst_relative_std_error)},
          {"simulations", c.simulations}});
+  }
+  nlohmann::json box = nlohmann::json::array();
+  for (const PriorRange& r : s.options.prior_box) {
+    box.push_back({{"name", r.name}, {"lower", r.lower}, {"upper", r.upper}});
   }
   return {{"schema", "ccsrm-design/1"},
           {"free_parameters", s.options.free_parameters},
@@ -410,6 +690,8 @@ nlohmann::json ToJson(const DesignSummary& s) {
           {"effective_sample_fraction", s.options.effective_sample_fraction},
           {"frame_rate_hz", s.options.frame_rate_hz},
           {"relative_step", s.options.relative_step},
+          {"prior_box", box},
+          {"robust_candidates", s.options.robust_candidates},
           {"ranking", s.ranking},
           {"threads", s.threads},
           {"simulations", s.simulations},

@@ -14,6 +14,7 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/output_policy.h"
 #include "ccsrm/datasets/inspect.h"
+#include "design_folder.h"
 #include "fit_folder.h"
 #include "loop_folder.h"
 #include "prediction_folder.h"
@@ -126,23 +127,27 @@ ReportSummary MakeReport(const std::string& input, const std::string& output_fol
   if (!fs::exists(input, ec)) ThrowInputError(input, "", "no such file");
   const bool folder = fs::is_directory(input, ec);
   const std::string name = fs::path(input).filename().string();
-  if (!folder && (name == "fit.json" || name == "loop.json" || name == "pred.json")) {
+  if (!folder &&
+      (name == "fit.json" || name == "loop.json" || name == "pred.json" || name == "design.json")) {
     const fs::path parent = fs::path(input).parent_path();
     ThrowInputError(input, "",
                     std::string(name == "fit.json"    ? "a fit"
                                 : name == "loop.json" ? "a loop"
-                                                      : "a prediction") +
+                                : name == "pred.json" ? "a prediction"
+                                                      : "a design") +
                         " is reported from its folder: ccsrm report --in " +
                         (parent.empty() ? std::string(".") : parent.string()));
   }
   // A loop folder holds fit folders but no fit.json of its own.
   const bool loop = folder && internal::LooksLikeLoopFolder(input);
   const bool prediction = folder && !loop && internal::LooksLikePredictionFolder(input);
-  if (folder && !loop && !prediction && !internal::LooksLikeFitFolder(input)) {
+  const bool design = folder && !loop && !prediction && internal::LooksLikeDesignFolder(input);
+  if (folder && !loop && !prediction && !design && !internal::LooksLikeFitFolder(input)) {
     ThrowInputError(input, "",
-                    "not a fit, loop or prediction folder (no fit.json, loop.json or pred.json); "
-                    "expected a ccsrm-run/1 or ccsrm-dataset/1 file, or a folder written by ccsrm "
-                    "identify, ccsrm loop or ccsrm predict");
+                    "not a fit, loop, prediction or design folder (no fit.json, loop.json, "
+                    "pred.json or design.json); expected a ccsrm-run/1 or ccsrm-dataset/1 file, "
+                    "or a folder written by ccsrm identify, ccsrm loop, ccsrm predict or ccsrm "
+                    "design");
   }
   CheckOutputFolder(output_folder, input);
   Document document;
@@ -150,6 +155,7 @@ ReportSummary MakeReport(const std::string& input, const std::string& output_fol
     FindGnuplot(options.plot);
     document = loop         ? BuildLoopDocument(input, options)
                : prediction ? BuildPredictionDocument(input, options)
+               : design     ? BuildDesignDocument(input, options)
                             : BuildFitDocument(input, options);
   } else {
     const datasets::AnyFile file = datasets::ReadAnyFile(input);

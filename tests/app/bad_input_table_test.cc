@@ -345,6 +345,20 @@ const std::vector<BadInput>& Rows() {
       {"overrides",
        "design --free mu --plans {d}/proto.yaml --noise-from {d}/p.yaml --out {d}/design",
        {"{d}/p.yaml", "not JSON"}},
+      {"overrides",
+       "design --free mu --plans {d}/proto.yaml --prior-box mu=0.3 --out {d}/design",
+       {"--prior-box 'mu=0.3'", "expected name=lower:upper"}},
+      {"overrides",
+       "design --free mu --plans {d}/proto.yaml --prior-box mu=0.3:0.1 --out {d}/design",
+       {"--prior-box", "'mu' needs finite lower < upper"}},
+      {"overrides",
+       "design --free mu --plans {d}/proto.yaml --prior-box mu=0.1:0.3 --prior-box "
+       "wobble=1:2 --out {d}/design",
+       {"--prior-box", "wobble"}},
+      // A protocol's parameters after '@' on every command that runs one.
+      {"overrides",
+       "generate --protocol {d}/proto.yaml@ramp_s --out {d}/exp2.h5",
+       {"--protocol '{d}/proto.yaml@ramp_s'", "expected name=value after '@'"}},
       // HDF5 files: an experiment is checked against its own config_yaml at
       // every door (inspect, process, identify).
       {"hdf5",

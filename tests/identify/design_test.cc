@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -135,6 +136,108 @@ TEST(Design, ProposesMotionsWithinTheJointsRangeAndWritesWhatItEvaluated) {
     EXPECT_THAT(c.protocol_yaml, ::testing::HasSubstr("theta_x_deg: 4}"));
   }
   EXPECT_THAT(design.candidates[1].name, ::testing::HasSubstr("opposed"));
+}
+
+TEST(Design, RanksTheBestPlansByTheirWorstCornerOfThePriorBox) {
+  const sim::ArmParameters truth = Truth();
+  const Experiment recording = MakeExperiment(Record(truth, 0.03, 1), "seed1.h5", {});
+  const PlannedExperiment all = Planned(recording, truth);
+  PlannedExperiment half = all;  // the first half of the motion: less information
+  half.duration_s = 0.5 * all.duration_s;
+  DesignOptions options = Options();
+  // mu_c from the prior to twice it: corner 0 is the prior itself.
+  options.prior_box = {{"mu_c", truth.mu_c, 2.0 * truth.mu_c}};
+  options.robust_candidates = 1;
+  const DesignSummary design =
+      EvaluateDesigns({Candidate("half", {half}), Candidate("whole", {all})}, options);
+  const CandidateInformation& first_half = design.candidates[0];
+  const CandidateInformation& whole = design.candidates[1];
+  // Only the best plan at the prior (the whole motion) goes to the corners.
+  EXPECT_TRUE(first_half.corners.empty());
+  ASSERT_EQ(whole.corners.size(), 2u);
+  EXPECT_EQ(design.ranking.front(), 1u);
+  // The corner at the prior is the prior's evaluation: the same runs, so the
+  // same numbers to the bit.
+  ASSERT_TRUE(whole.corners[0].completed) << whole.corners[0].message;
+  EXPECT_EQ(whole.corners[0].values.front().second, truth.mu_c);
+  EXPECT_EQ(whole.corners[0].relative_std_error, whole.relative_std_error);
+  // The other corner is another arm: other errors; the robust criterion is
+  // the worst of the prior and both corners.
+  ASSERT_TRUE(whole.corners[1].completed) << whole.corners[1].message;
+  EXPECT_NE(whole.corners[1].relative_std_error, whole.relative_std_error);
+  EXPECT_EQ(whole.robust_worst_relative_std_error,
+            std::max(whole.worst_relative_std_error, whole.corners[1].worst_relative_std_error));
+  EXPECT_THAT(design.FullReport(), ::testing::HasSubstr("over the prior box (mu_c"));
+  const nlohmann::json json = ToJson(design);
+  EXPECT_EQ(json["candidates"][1]["corners"].size(), 2u);
+  EXPECT_EQ(json["prior_box"][0]["name"], "mu_c");
+
+  // A free parameter's range may not end at 0; a range must be ordered.
+  DesignOptions bad = Options();
+  bad.prior_box = {{"mu_c", 0.0, 0.2}};
+  EXPECT_THROW(EvaluateDesigns({Candidate("half", {half})}, bad), InputError);
+  bad.prior_box = {{"mu_c", 0.3, 0.2}};
+  std::string error;
+  EXPECT_FALSE(bad.IsValid(&error));
+  EXPECT_THAT(error, ::testing::HasSubstr("lower < upper"));
+}
+
+// The largest |angle| of joint 1's axis `c` over the protocol, sampled at 100 Hz.
+double LargestAngleDeg(const sim::Protocol& protocol, int c) {
+  double largest = 0.0;
+  for (double t = 0.0; t <= protocol.duration_s(); t += 0.01) {
+    largest = std::max(largest, std::abs(protocol.PlannedAngles(t)[0][c]) * 180.0 / M_PI);
+  }
+  return largest;
+}
+
+TEST(Design, ProposesSinesChirpsAndReversalsInAnyBendingPlane) {
+  const sim::Config prior = Nominal();
+  ProposalSpace space;
+  space.budget_s = 8.0;
+  ProposedMotion m;
+  m.amplitude_deg = 10.0;
+  // A sine in the plane at 0 deg bends toward +x: θy swings, θx stays 0
+  // (docs/protocols.md); it fills the budget.
+  m.kind = ProposedMotion::Kind::kSine;
+  m.frequency_hz = 0.5;
+  m.in_plane = true;
+  std::string name;
+  sim::Protocol sine =
+      sim::ParseProtocol(ProposalProtocolYaml(m, space, 2, &name), name, prior.arm);
+  EXPECT_EQ(name, "sine A=10 f=0.5 plane=0");
+  EXPECT_DOUBLE_EQ(sine.duration_s(), 8.0);
+  EXPECT_NEAR(LargestAngleDeg(sine, 1), 10.0, 0.05);  // a peak at full envelope
+  EXPECT_NEAR(LargestAngleDeg(sine, 0), 0.0, 1e-9);
+  // A chirp from 0.1 to 1 Hz in θx, segments opposed.
+  m.kind = ProposedMotion::Kind::kChirp;
+  m.frequency_hz = 0.1;
+  m.end_hz = 1.0;
+  m.in_plane = false;
+  m.opposed = true;
+  sim::Protocol chirp =
+      sim::ParseProtocol(ProposalProtocolYaml(m, space, 2, &name), name, prior.arm);
+  EXPECT_EQ(name, "chirp A=10 f=0.1-1 opposed");
+  EXPECT_DOUBLE_EQ(chirp.duration_s(), 8.0);
+  EXPECT_GT(LargestAngleDeg(chirp, 0), 9.0);
+  // Segment 2 (joint 7) swings against segment 1 (joint 1).
+  const double t = 4.0;
+  EXPECT_NEAR(chirp.PlannedAngles(t)[6][0], -chirp.PlannedAngles(t)[0][0], 1e-12);
+  // Reversals in the plane at 90 deg (toward +y): θx = −A at the first target.
+  m.kind = ProposedMotion::Kind::kReversals;
+  m.move_s = 2.0;
+  m.in_plane = true;
+  m.plane_deg = 90.0;
+  m.opposed = false;
+  sim::Protocol reversals =
+      sim::ParseProtocol(ProposalProtocolYaml(m, space, 2, &name), name, prior.arm);
+  EXPECT_EQ(name, "reversals A=10 move=2 plane=90");
+  EXPECT_NEAR(reversals.PlannedAngles(2.5)[0][0] * 180.0 / M_PI, -10.0, 1e-9);
+  // The space refuses a chirp band that does not rise.
+  space.chirp_bands_hz = {{1.0, 0.5}};
+  std::string error;
+  EXPECT_FALSE(space.IsValid(&error));
+  EXPECT_THAT(error, ::testing::HasSubstr("chirp_bands_hz"));
 }
 
 TEST(Design, RefusesAPriorOfZeroAndAPlanWithoutExperiments) {

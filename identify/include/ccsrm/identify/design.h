@@ -47,6 +47,14 @@ struct DesignCandidate {
   std::string protocol_yaml;
 };
 
+// A range of a parameter's value the design should hold over: the truth
+// may be anywhere in it.
+struct PriorRange {
+  std::string name;  // a parameter (sim::Parameters()), free or not
+  double lower = 0.0;
+  double upper = 0.0;
+};
+
 struct DesignOptions {
   // The parameters a fit would free, by name (sim::Parameters()). Required.
   std::vector<std::string> free_parameters;
@@ -69,12 +77,33 @@ struct DesignOptions {
   std::shared_ptr<SimulationBackend> backend;
   // Called after every simulation; may be empty.
   RunFinishedCallback on_run;
+  // Prior uncertainty (robust design): the best robust_candidates plans at
+  // the prior are evaluated again at every corner of this box (2^k corners,
+  // k <= 6 ranges), each relative error taken against the corner's value,
+  // and ranked by their worst case over the prior and the corners, ahead of
+  // the plans evaluated at the prior only. Screening at the prior keeps the
+  // cost at 2^k × robust_candidates evaluations instead of 2^k × all plans.
+  // Empty (default): the prior alone.
+  std::vector<PriorRange> prior_box;
+  int robust_candidates = 3;
 
   // False with the reason naming the field: no free parameter, an unknown or
   // repeated name, noise_deg or frame_rate_hz not positive,
   // effective_sample_fraction outside (0, 1], relative_step outside (0, 0.1],
-  // threads < 1.
+  // threads < 1, a prior_box range not finite or not lower < upper, a name
+  // given twice, more than 6 ranges, robust_candidates < 1.
   bool IsValid(std::string* error) const;
+};
+
+// A plan's predicted errors with the parameters at one corner of the prior
+// box.
+struct CornerInformation {
+  std::vector<std::pair<std::string, double>> values;  // the box's parameters there
+  bool completed = false;
+  std::string message;                     // why not
+  std::vector<double> relative_std_error;  // of each free parameter, against its value there
+  double worst_relative_std_error = 0.0;
+  std::string worst_parameter;
 };
 
 // What a candidate plan would tell about the free parameters.
@@ -107,12 +136,19 @@ struct CandidateInformation {
   std::vector<std::pair<std::string, double>> worst_direction;
   // Fisher information in relative units (C = its inverse), p × p.
   Eigen::MatrixXd fisher_relative;
+  // At the corners of DesignOptions::prior_box, for the plans evaluated
+  // there (empty otherwise), and the worst relative error over the prior
+  // and those corners (worst_relative_std_error when there are none).
+  std::vector<CornerInformation> corners;
+  double robust_worst_relative_std_error = 0.0;
   std::int64_t simulations = 0;
 };
 
 struct DesignSummary {
   std::vector<CandidateInformation> candidates;  // in the order given
-  std::vector<std::size_t> ranking;  // candidate indices, smallest worst relative error first
+  // Candidate indices, smallest worst relative error first: with a prior
+  // box, those evaluated at its corners first, by their robust worst.
+  std::vector<std::size_t> ranking;
   DesignOptions options;
   int threads = 0;
   std::int64_t simulations = 0;
@@ -122,37 +158,65 @@ struct DesignSummary {
   std::string FullReport() const;
 };
 
-// The motions ProposeDesign searches: every segment swings between +A and
-// −A in θx along quintic moves of move_s, holding hold_s after each, as
-// many moves as fill budget_s, the last back to straight. Reversals make
-// the cables slide both ways through their holes and stop between, where
-// the static and kinetic friction and the pre-tension show.
+// The motions ProposeDesign searches, each filling budget_s, for every
+// amplitude A, in every bending plane, with the segments together and (when
+// opposed_segments) neighbouring segments in opposite directions:
+// - reversals: every segment swings between +A and −A along quintic moves
+//   of move_s, holding hold_s after each, as many moves as fill the budget,
+//   the last back to straight. They make the cables slide both ways through
+//   their holes and stop between, where the static and kinetic friction and
+//   the pre-tension show;
+// - sines: A·sin(2π f t) over the whole budget (faded in and out over a
+//   period), for every f of sine_frequencies_hz;
+// - chirps: A·sin φ(t), the frequency swept linearly over the budget, for
+//   every band of chirp_bands_hz.
+// Sines and chirps are tried only when given (none by default).
 struct ProposalSpace {
   std::vector<double> amplitudes_deg = {5.0, 10.0, 20.0};  // A
   std::vector<double> move_times_s = {2.0, 4.0, 8.0};      // move_s
+  std::vector<double> sine_frequencies_hz;                 // f
+  std::vector<std::pair<double, double>> chirp_bands_hz;   // (start, end)
+  // Bending planes φ [deg] (docs/protocols.md: toward (cos φ, sin φ)).
+  // Empty (default): θx alone, the paper's plane.
+  std::vector<double> planes_deg;
   // Also try the segments swinging in opposite directions (segment 2 at −A
   // while segment 1 is at +A, ...).
   bool opposed_segments = true;
   double hold_s = 1.0;
   double budget_s = 24.0;  // the recording's length [s]
 
-  // False with the reason naming the field: an empty list, a value not
-  // positive, budget_s shorter than two moves and holds.
+  // False with the reason naming the field: no amplitude, a value not
+  // positive or not finite, a chirp band not start < end, budget_s shorter
+  // than two moves and holds when move times are given, no motion at all.
   bool IsValid(std::string* error) const;
+};
+
+// One point of the space.
+struct ProposedMotion {
+  enum class Kind { kReversals, kSine, kChirp };
+  Kind kind = Kind::kReversals;
+  double amplitude_deg = 0.0;
+  double move_s = 0.0;        // reversals
+  double frequency_hz = 0.0;  // a sine's, a chirp's start
+  double end_hz = 0.0;        // a chirp's end
+  bool in_plane = false;      // false: θx; true: the plane plane_deg
+  double plane_deg = 0.0;
+  bool opposed = false;
 };
 
 // The protocol (ccsrm-protocol/1 text) of one point of the space on an arm
 // of `segments` segments; its name says the point ("reversals A=10 move=4
-// opposed").
-std::string ReversalProtocolYaml(double amplitude_deg, double move_s, bool opposed,
-                                 const ProposalSpace& space, int segments, std::string* name);
+// opposed", "sine A=10 f=0.25 plane=45").
+std::string ProposalProtocolYaml(const ProposedMotion& motion, const ProposalSpace& space,
+                                 int segments, std::string* name);
 
 // One experiment of `protocol` on the arm of `prior` (its parameters the
 // prior), recorded over the protocol's duration.
 PlannedExperiment PlanExperiment(const sim::Config& prior, const sim::Protocol& protocol,
                                  const std::string& name);
 
-// Evaluates every candidate at the prior. Throws InputError for invalid
+// Evaluates every candidate at the prior (and the best at the corners of
+// options.prior_box). Throws InputError for invalid
 // options, a free parameter whose prior value is 0 (its relative error has
 // no meaning: give a prior), or a candidate without experiments. A run
 // that diverges is reported in the candidate (completed = false), not
@@ -167,6 +231,15 @@ DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
 DesignSummary ProposeDesign(const sim::Config& prior, const ProposalSpace& space,
                             const std::vector<DesignCandidate>& given, const DesignOptions& options,
                             std::vector<std::string>* skipped);
+
+// A proposed motion (its protocol text) as planned on the arm of `prior`,
+// sampled at rate_hz from 0 to its end: proposed.inputs.csv, a '#' comment
+// line naming it, then the header time_s, cable<k>_m (the input lengths,
+// pulled in = positive: the table `--inputs` reads), speed_cable<k>_m_s
+// (their rates), planned_thetax<j>_deg and planned_thetay<j>_deg, for the
+// lab's controller and the report's page.
+std::string PlannedMotionCsv(const sim::Config& prior, const std::string& protocol_yaml,
+                             const std::string& name, double rate_hz);
 
 // design.json (schema ccsrm-design/1): every number of the summary.
 nlohmann::json ToJson(const DesignSummary& summary);

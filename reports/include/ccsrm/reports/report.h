@@ -38,7 +38,7 @@ struct ReportOptions {
 struct ReportSummary {
   std::string input;   // the file reported on
   std::string output;  // the report folder
-  std::string kind;    // "run", "experiment", "fit", "loop" or "prediction"
+  std::string kind;    // "run", "experiment", "fit", "loop", "prediction" or "design"
   std::string title;
   int figures = 0;
   int tables = 0;
@@ -102,6 +102,16 @@ Document BuildLoopDocument(const std::string& folder, const ReportOptions& optio
 // (no pred.json)", a pred.json of another schema, or a missing key or
 // malformed file (naming the file and the key or line).
 Document BuildPredictionDocument(const std::string& folder, const ReportOptions& options);
+
+// The page of a design folder written by `ccsrm design` (design.json of
+// schema ccsrm-design/1; proposed.inputs.csv when a motion was proposed):
+// the candidate plans' predicted relative standard errors side by side,
+// which parameter each informs, the proposed motion's planned joint angles,
+// cable lengths and speeds, and the errors at the prior box's corners.
+// Throws InputError for invalid options, "<folder>: not a design folder (no
+// design.json)", a design.json of another schema, or a missing key or
+// malformed file (naming the file and the key or line).
+Document BuildDesignDocument(const std::string& folder, const ReportOptions& options);
 
 // Renders every figure of `document` with gnuplot into <folder>/figures,
 // then writes <folder>/index.html and <folder>/summary.json, all inside a
