@@ -32,6 +32,21 @@ double Percent(double x) { return 100.0 * x; }  // NaN stays NaN: "–"
 
 bool Proposed(const DesignCandidateRow& c) { return !c.protocol_yaml.empty(); }
 
+// A plan's name with room to wrap: "a.yaml@x=1,y=2+b.yaml" shows as
+// "a.yaml@x=1, y=2 + b.yaml".
+std::string Shown(const std::string& name) {
+  std::string text;
+  for (const char c : name) {
+    if (c == '+') {
+      text += " + ";
+    } else {
+      text += c;
+      if (c == ',') text += ' ';
+    }
+  }
+  return text;
+}
+
 // "0.98 mu_c − 0.21 mu", the shares below 0.2 left out.
 std::string Direction(const DesignCandidateRow& c) {
   std::string text;
@@ -65,13 +80,14 @@ Section SummarySection(const DesignFolder& d) {
       Show(d.noise_deg, NumberFormat::Significant(3)) + " deg per angle, N_eff/N " +
       Show(d.effective_sample_fraction, NumberFormat::Significant(3)) + "). ";
   if (best.completed) {
-    text += "The best is " + best.name + " (" + Show(best.duration_s, NumberFormat::Fixed(1)) +
+    text += "The best is " + Shown(best.name) + " (" +
+            Show(best.duration_s, NumberFormat::Fixed(1)) +
             " s of recording): its least determined parameter, " + best.worst_parameter + ", to " +
             Show(Percent(best.worst_relative_std_error), kPercent) + " %. ";
   }
   const DesignCandidateRow* given = BestGiven(d);
   if (given != nullptr && Proposed(best) && best.completed) {
-    text += "The best plan given to compare, " + given->name + ", reaches " +
+    text += "The best plan given to compare, " + Shown(given->name) + ", reaches " +
             Show(Percent(given->worst_relative_std_error), kPercent) + " % (" +
             given->worst_parameter + "): the proposed motion's worst error is " +
             Show(given->worst_relative_std_error / best.worst_relative_std_error,
@@ -136,7 +152,7 @@ Section ErrorsSection(const DesignFolder& d) {
   }
   for (std::size_t r = 0; r < d.ranking.size(); ++r) {
     const DesignCandidateRow& c = d.candidates[d.ranking[r]];
-    std::vector<Cell> row = {Cell::Number(static_cast<double>(r + 1)), Cell::Text(c.name),
+    std::vector<Cell> row = {Cell::Number(static_cast<double>(r + 1)), Cell::Text(Shown(c.name)),
                              Cell::Text(Proposed(c) ? "proposed" : "given"),
                              Cell::Number(c.duration_s)};
     for (const double x : c.relative_std_error) row.push_back(Cell::Number(Percent(x)));
@@ -329,7 +345,7 @@ Section BoxSection(const DesignFolder& d) {
       for (const auto& [name, value] : corner.values) {
         at += (at.empty() ? "" : ", ") + name + " = " + Show(value, NumberFormat::Significant(4));
       }
-      std::vector<Cell> row = {Cell::Text(c.name), Cell::Text(at)};
+      std::vector<Cell> row = {Cell::Text(Shown(c.name)), Cell::Text(at)};
       for (std::size_t i = 0; i < d.free.size(); ++i) {
         row.push_back(i < corner.relative_std_error.size()
                           ? Cell::Number(Percent(corner.relative_std_error[i]))
