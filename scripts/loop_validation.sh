@@ -122,11 +122,12 @@ for s in scenarios:
         ", ".join(f"{k}={v:g}" for k, v in changed.items()) or "none")
     if os.path.exists(built_path):
         declared_arm = open("datasets/samples/loop/arm.yaml").read().splitlines()
-        edits = [f"{a.strip()} → {b.split(':', 1)[1].strip()}"
+        edits = [f"{a.split('#')[0].strip()} → {b.split(':', 1)[1].split('#')[0].strip()}"
                  for a, b in zip(declared_arm, open(built_path).read().splitlines()) if a != b]
         label = "declared value: " + "; ".join(edits)
     first = j["rounds"][0]["candidates"][0]["name"] if j["rounds"] and j["rounds"][0]["candidates"] else "-"
     added = ", ".join(j["added_effects"]) or "none"
+    parts_declared = []
     for c in j.get("declared_corrections", []):
         alt = f" (or {', '.join(c['indistinguishable'])})" if c["indistinguishable"] else ""
         added += f"; corrected {c['parameter']}{alt}"
@@ -134,7 +135,6 @@ for s in scenarios:
         ci_text = f"[{ci[0]:+.4f}, {ci[1]:+.4f}]" if ci[0] is not None else "[not identifiable]"
         parts_declared.append(f"{c['parameter']} {c['relative']:+.4f} {ci_text}")
     parts = []
-    parts_declared = []
     for name, p in j["parameters"].items():
         if "." not in name:
             continue

@@ -106,9 +106,11 @@ Table DeclaredCorrectionTable(const LoopFolder& loop) {
       "and the corrected configuration's values (calibrated.yaml in the loop folder). "
       "Relative error: (corrected - declared) / declared, with its 95 % interval. Values the "
       "data cannot tell apart from it are listed: it stands for their combination.";
+  // Six digits: a correction of a tenth of a per cent must show.
+  const NumberFormat kConfig = NumberFormat::Significant(6);
   table.columns = {
-      {"value", "configuration key", "", kCount}, {"declared", "declared", "", kValue},
-      {"corrected", "corrected", "", kValue},     {"relative", "relative error", "", kValue},
+      {"value", "configuration key", "", kCount}, {"declared", "declared", "", kConfig},
+      {"corrected", "corrected", "", kConfig},    {"relative", "relative error", "", kValue},
       {"ci", "95 % interval", "", kCount},        {"alike", "indistinguishable from", "", kCount}};
   for (const LoopDeclaredCorrection& d : loop.declared_corrections) {
     const std::string ci =
