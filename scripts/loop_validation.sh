@@ -15,7 +15,8 @@
 # Usage: scripts/loop_validation.sh OUT_DIR [SCENARIO ...]
 # Scenarios: null backlash mocap_offset table_tilt joint_friction
 #            actuator_delay two outside (default: all), and the declared
-#            values: hole_radius pulley_radius link_length disk_gap
+#            values: hole_radius hole_radius_s1 pulley_radius link_length
+#            disk_gap
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:?usage: scripts/loop_validation.sh OUT_DIR [SCENARIO ...]}
@@ -42,7 +43,7 @@ flags() {
     # third above their kinetic friction (the configuration declares them
     # equal), and the loop does not fit it.
     outside) echo "--set mu_c_s=0.28" ;;
-    hole_radius | pulley_radius | link_length | disk_gap) echo "" ;;
+    hole_radius | hole_radius_s1 | pulley_radius | link_length | disk_gap) echo "" ;;
     *) echo "unknown scenario $1" >&2; exit 2 ;;
   esac
 }
@@ -54,6 +55,8 @@ built() {
   case "$1" in
     # Segment 2's hole circle drilled 0.8 mm (5 %) small.
     hole_radius) sed '35s/hole_circle_radius_m: 0.016/hole_circle_radius_m: 0.0152/' "$config" ;;
+    # Segment 1's hole circle drilled 0.5 mm (2.4 %) small.
+    hole_radius_s1) sed '20s/hole_circle_radius_m: 0.021/hole_circle_radius_m: 0.0205/' "$config" ;;
     # Segment 1's large-S pulleys 5 % large.
     pulley_radius) sed '28s/pulley_radius_m: 0.016 /pulley_radius_m: 0.0168 /' "$config" ;;
     # Segment 2's links 1 mm (1 %) long.
