@@ -203,13 +203,15 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
   std::vector<Spec> specs;
   for (const std::string& c : candidates) {
     if (c == internal::kDeclaredCandidates) {
+      // A declared value the fit already frees is no candidate, nor in its block.
+      const auto is_free = [&](const std::string& name) {
+        return std::find(options.fit.free_parameters.begin(), options.fit.free_parameters.end(),
+                         name) != options.fit.free_parameters.end();
+      };
       for (Spec& d : internal::DeclaredValueCandidates(training.front().config.arm)) {
-        // A declared value the fit already frees is no candidate.
-        if (std::find(options.fit.free_parameters.begin(), options.fit.free_parameters.end(),
-                      d.name) != options.fit.free_parameters.end()) {
-          continue;
-        }
-        specs.push_back(std::move(d));
+        d.parameters.erase(std::remove_if(d.parameters.begin(), d.parameters.end(), is_free),
+                           d.parameters.end());
+        if (!d.parameters.empty()) specs.push_back(std::move(d));
       }
       continue;
     }
