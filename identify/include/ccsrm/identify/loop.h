@@ -46,8 +46,10 @@
 //     And it must explain the residual, not a sliver of it (issue 28): when
 //     the residual after its refit is still above unexplained_noise_ratio
 //     times the noise (weighted mean square above its square), it must
-//     remove at least min_excess_share of the excess mean square over the
-//     noise, (MS_before - MS_after) / (MS_before - 1) in noise units;
+//     remove at least min_excess_share of the current fit's excess mean
+//     square over the noise, (MS_current - MS_after) / (MS_current - 1) in
+//     noise units (from the current fit, not from "before": a refit that
+//     moves the declared parameters far has a poor point without it);
 //     otherwise it is not named as the cause and the residual is reported
 //     as not explained.
 //  5. The winner has the largest ΔBIC. Candidates within tie_delta_bic of
@@ -65,9 +67,8 @@
 // sensitivity the data cannot tell apart (their columns, beyond what the
 // fit's own remove, correlate above 0.99, or their scores differ by less
 // than tie_delta_bic) are reported together as a combination: the best
-// scoring one is refitted and stands for them. A value that earns its place is reported as "the declared X
-// is off by Δ ± σ", and the corrected configuration is written
-// (calibrated.yaml).
+// scoring one is refitted and stands for them. A value that earns its place is reported as "the
+// declared X is off by Δ ± σ", and the corrected configuration is written (calibrated.yaml).
 //
 // At the end, every (experiment, joint, axis) whose RMS residual exceeds
 // unexplained_noise_ratio (1.5) times its noise is reported as
