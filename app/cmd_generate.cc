@@ -157,6 +157,10 @@ std::string TruthYaml(const GenerateArgs& a, const sim::PaperRun& run, const sim
   for (const sim::ParameterInfo& p : sim::Parameters()) {
     out << YAML::Key << p.name << YAML::Value << truth.parameters.*p.field;
   }
+  // Declared-value errors given with --set (declared.<value>), by full name.
+  for (const auto& [name, value] : truth.parameters.declared_deltas) {
+    out << YAML::Key << name << YAML::Value << value;
+  }
   out << YAML::EndMap;
   out << YAML::Key << "effects" << YAML::Comment("effects switched on, true values");
   out << YAML::Value << YAML::BeginMap;

@@ -1,5 +1,6 @@
 // ccsrm loop --data exp1.h5 [exp2.h5 ...] [--holdout exp3.h5 ...] [--candidates a,b,...]
-//            [--free ...] [--params p.yaml] [--set name=value ...] [--threads N] --out loop/
+//            [--free ...] [--params p.yaml] [--set name=value ...] [--config arm.yaml]
+//            [--threads N] --out loop/
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -21,6 +22,7 @@ struct LoopArgs {
   std::optional<std::string> candidates;  // unset: every effect
   std::optional<std::string> free;
   std::string params;
+  std::string config;  // the declared configuration (default: each file's own)
   std::vector<std::string> set;
   int threads = identify::DefaultThreads();
   int max_rounds = identify::LoopOptions().max_rounds;
@@ -42,11 +44,12 @@ int RunLoop(const LoopArgs& a) {
   std::vector<std::string> inputs = a.data;
   inputs.insert(inputs.end(), a.holdout.begin(), a.holdout.end());
   inputs.push_back(a.params);
+  inputs.push_back(a.config);
   CheckOut(a.out, LoopFolderOutput(), inputs);
   const std::vector<identify::Experiment> training =
-      LoadExperiments(a.data, a.noise_deg, "training");
+      LoadExperiments(a.data, a.noise_deg, "training", a.config);
   const std::vector<identify::Experiment> holdout =
-      LoadExperiments(a.holdout, a.noise_deg, "held out");
+      LoadExperiments(a.holdout, a.noise_deg, "held out", a.config);
 
   std::string free_list;
   for (const std::string& n : options.fit.free_parameters)
@@ -92,13 +95,17 @@ void AddLoopCommand(CLI::App& root) {
                   "Held-out experiments: not fitted, each candidate's refit is scored on them")
       ->expected(1, -1);
   cmd->add_option("--candidates", a->candidates,
-                  "Candidate effects, comma-separated (default: every effect of the library "
-                  "that is off; ccsrm generate --list-effects)");
+                  "Candidate effects, comma-separated, and 'declared' for the configuration's "
+                  "declared values (default: every effect of the library that is off, and "
+                  "declared; ccsrm generate --list-effects)");
   cmd->add_option("--free", a->free,
                   "The declared model's free parameters, comma-separated (default: mu,mu_c,T_p)");
   cmd->add_option("--params", a->params,
                   "YAML file: name: value, or name: {value, free, bounds: [lo, hi]}");
   cmd->add_option("--set", a->set, "Value of a parameter, name=value (repeatable)");
+  cmd->add_option("--config", a->config,
+                  "The declared arm configuration, instead of each recording's own config_yaml "
+                  "(same joints and driving cables): what the declared values are checked against");
   cmd->add_option("--threads", a->threads, "Simulations at a time (default: every core)")
       ->check(ValidIn(&identify::IdentificationOptions::threads));
   cmd->add_option("--max-rounds", a->max_rounds, "Effects added at most")

@@ -12,7 +12,9 @@
 #include <sstream>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/sim/declared_values.h"
 #include "ccsrm/sim/effects.h"
+#include "declared_values.h"
 
 namespace ccsrm::identify {
 namespace {
@@ -107,6 +109,12 @@ std::map<std::string, double> ValuesOf(const IdentificationSummary& fit,
   return values;
 }
 
+std::string Join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
 struct HoldoutResult {
   std::vector<Eigen::MatrixXd> angles_rad;
   double rms_deg = 0.0;
@@ -129,12 +137,17 @@ bool LoopOptions::IsValid(std::string* error) const {
   if (!fit.IsValid(&inner)) return fail(inner);
   std::set<std::string> seen;
   for (const std::string& c : candidates) {
+    if (c == internal::kDeclaredCandidates) {
+      if (!seen.insert(c).second) return fail("candidates: '" + c + "' is given twice");
+      continue;
+    }
     bool known = false;
     for (const sim::EffectInfo& e : sim::Effects()) known = known || e.name == c;
     if (!known) {
       std::string names;
       for (const sim::EffectInfo& e : sim::Effects()) names += (names.empty() ? "" : ", ") + e.name;
-      return fail("candidates: unknown effect '" + c + "' (known: " + names + ")");
+      return fail("candidates: unknown effect '" + c + "' (known: " + names +
+                  "; and declared, for the declared values)");
     }
     if (!seen.insert(c).second) return fail("candidates: '" + c + "' is given twice");
     for (const std::string& name : fit.free_parameters) {
@@ -145,6 +158,10 @@ bool LoopOptions::IsValid(std::string* error) const {
   }
   if (max_rounds < 0) return fail("max_rounds must be >= 0");
   if (refits_per_round < 1) return fail("refits_per_round must be >= 1");
+  if (declared_refits_per_round < 0) return fail("declared_refits_per_round must be >= 0");
+  if (!(min_excess_share >= 0.0 && min_excess_share <= 1.0)) {
+    return fail("min_excess_share must be in [0, 1]");
+  }
   if (!(score_significance > 0.0 && score_significance < 1.0)) {
     return fail("score_significance must be in (0, 1)");
   }
@@ -173,12 +190,37 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
 
   // The arm of the experiments: how many per-joint parameters a candidate has.
   const sim::ArmSize arm = training.front().config.parameters.arm;
-  // The candidates: those given, else every effect the declared model has off.
+  // The candidates: those given, else every effect the declared model has
+  // off and the declared values.
   std::vector<std::string> candidates = options.candidates;
   if (candidates.empty()) {
     for (const sim::EffectInfo& e : sim::Effects()) {
       if (!training.front().config.parameters.EffectOn(e.name)) candidates.push_back(e.name);
     }
+    candidates.push_back(internal::kDeclaredCandidates);
+  }
+  using Spec = internal::LoopCandidateSpec;
+  std::vector<Spec> specs;
+  for (const std::string& c : candidates) {
+    if (c == internal::kDeclaredCandidates) {
+      // A declared value the fit already frees is no candidate, nor in its block.
+      const auto is_free = [&](const std::string& name) {
+        return std::find(options.fit.free_parameters.begin(), options.fit.free_parameters.end(),
+                         name) != options.fit.free_parameters.end();
+      };
+      for (Spec& d : internal::DeclaredValueCandidates(training.front().config.arm)) {
+        d.parameters.erase(std::remove_if(d.parameters.begin(), d.parameters.end(), is_free),
+                           d.parameters.end());
+        if (!d.parameters.empty()) specs.push_back(std::move(d));
+      }
+      continue;
+    }
+    Spec e;
+    e.name = c;
+    e.parameters = SizeParameters(c, arm);
+    e.measurement = sim::FindEffect(c, "--candidates").measurement;
+    e.fingerprint = sim::FindEffect(c, "loop").fingerprint;
+    specs.push_back(std::move(e));
   }
 
   LoopSummary summary;
@@ -244,7 +286,8 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
           (holdout.empty() ? std::string()
                            : ", held out " + Format("%.4f", current_holdout.rms_deg) + " deg"));
 
-  std::vector<std::string> effects_on;
+  std::vector<std::string> effects_on;  // effects and declared values, in order
+  std::map<std::string, std::vector<std::string>> winner_indistinguishable;
   const bool declared_ok = summary.declared.termination != IdentificationTermination::kFailed &&
                            summary.declared.jacobian.size() > 0;
   for (int round = 1; declared_ok && round <= options.max_rounds; ++round) {
@@ -257,11 +300,22 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
     for (const ExperimentFit& f : current.experiments) fitted.push_back(f.simulated_rad);
     lr.evidence = DiagnoseResidual(training, fitted);
 
-    std::vector<std::string> remaining;
-    for (const std::string& c : candidates) {
-      if (std::find(effects_on.begin(), effects_on.end(), c) == effects_on.end()) {
-        remaining.push_back(c);
+    // Not yet added; a block keeps the members not yet added.
+    std::vector<Spec> remaining;
+    for (const Spec& c : specs) {
+      const auto added = [&](const std::string& n) {
+        return std::find(effects_on.begin(), effects_on.end(), n) != effects_on.end();
+      };
+      if (added(c.name)) continue;
+      Spec r = c;
+      if (c.kind == Spec::Kind::kDeclaredBlock) {
+        r.parameters.clear();
+        for (const std::string& q : c.parameters) {
+          if (!added(q)) r.parameters.push_back(q);
+        }
+        if (r.parameters.empty()) continue;
       }
+      remaining.push_back(std::move(r));
     }
     if (remaining.empty()) {
       lr.decision = "every candidate is already in the model.";
@@ -273,19 +327,23 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
     progress(round, "scoring", "",
              "round " + std::to_string(round) + ": scoring " + std::to_string(remaining.size()) +
                  " candidates");
+    // One column per size parameter, shared by the candidates that have it
+    // (a block and its members).
     struct Column {
-      std::size_t candidate;
       std::string parameter;
       double step;
       std::vector<Eigen::MatrixXd> angles;  // per experiment
     };
     std::vector<Column> columns;
+    std::map<std::string, std::size_t> column_of;
     std::vector<RunRequest> requests;
     std::vector<std::size_t> request_column;
     for (std::size_t c = 0; c < remaining.size(); ++c) {
-      const bool measurement = sim::FindEffect(remaining[c], "--candidates").measurement;
-      for (const std::string& q : SizeParameters(remaining[c], arm)) {
-        Column col{c, q, ScoreStep(q, arm), {}};
+      const bool measurement = remaining[c].measurement;
+      for (const std::string& q : remaining[c].parameters) {
+        if (column_of.count(q)) continue;
+        column_of[q] = columns.size();
+        Column col{q, ScoreStep(q, arm), {}};
         for (std::size_t e = 0; e < training.size(); ++e) {
           sim::ArmParameters p = current.experiments[e].parameters;
           sim::SetParameter(q, col.step, "loop", &p);
@@ -338,12 +396,29 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
     const double neff_ratio =
         n > 0.0 && current.effective_samples > 0.0 ? current.effective_samples / n : 1.0;
     const double base_reduction = Reduction(r, jb, nullptr);
+    // Each column in the weighted residual's units, per unit of its parameter.
+    std::map<std::string, Eigen::VectorXd> weighted_column;
+    for (const Column& col : columns) {
+      std::vector<const Eigen::MatrixXd*> ca;
+      for (const Eigen::MatrixXd& m : col.angles) ca.push_back(&m);
+      weighted_column[col.parameter] = Weighted(training, ca, true, base_angles) / col.step;
+    }
+    // Bonferroni over the effects and the blocks: a declared value is tested
+    // only inside a significant block (closed testing), at the same level.
+    std::size_t tests = 0;
+    for (const Spec& c : remaining) tests += c.kind != Spec::Kind::kDeclaredValue;
+    tests = std::max<std::size_t>(tests, 1);
+    std::map<std::string, bool> block_significant;
     for (std::size_t c = 0; c < remaining.size(); ++c) {
       CandidateResult cand;
-      cand.name = remaining[c];
+      cand.name = remaining[c].name;
+      cand.kind = remaining[c].kind == Spec::Kind::kEffect          ? "effect"
+                  : remaining[c].kind == Spec::Kind::kDeclaredBlock ? "declared block"
+                                                                    : "declared value";
       std::vector<const Column*> cols;
-      for (const Column& col : columns) {
-        if (col.candidate == c) cols.push_back(&col), cand.parameters.push_back(col.parameter);
+      for (const std::string& q : remaining[c].parameters) {
+        cols.push_back(&columns[column_of.at(q)]);
+        cand.parameters.push_back(q);
       }
       // Active set: a size parameter whose linear estimate leaves its bounds
       // (a negative friction) is dropped and the rest refitted.
@@ -358,10 +433,8 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
         Eigen::MatrixXd a(r.size(), jb.cols() + static_cast<Eigen::Index>(idx.size()));
         a.leftCols(jb.cols()) = jb;
         for (std::size_t k = 0; k < idx.size(); ++k) {
-          std::vector<const Eigen::MatrixXd*> ca;
-          for (const Eigen::MatrixXd& m : cols[idx[k]]->angles) ca.push_back(&m);
           a.col(jb.cols() + static_cast<Eigen::Index>(k)) =
-              Weighted(training, ca, true, base_angles) / cols[idx[k]]->step;
+              weighted_column.at(cols[idx[k]]->parameter);
         }
         reduction = Reduction(r, a, &x) - base_reduction;
         bool changed = false;
@@ -381,9 +454,13 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       cand.score = std::max(reduction, 0.0) * neff_ratio;
       const double dof = static_cast<double>(cols.size());
       cand.p_value = dof > 0 ? gsl_cdf_chisq_Q(cand.score, dof) : 1.0;
-      cand.significant =
-          cand.p_value < options.score_significance / static_cast<double>(remaining.size());
-      for (const std::string& signal : sim::FindEffect(cand.name, "loop").fingerprint) {
+      cand.significant = cand.p_value < options.score_significance / static_cast<double>(tests);
+      if (remaining[c].kind == Spec::Kind::kDeclaredBlock) {
+        block_significant[cand.name] = cand.significant;
+      } else if (remaining[c].kind == Spec::Kind::kDeclaredValue) {
+        cand.significant = cand.significant && block_significant[remaining[c].block];
+      }
+      for (const std::string& signal : remaining[c].fingerprint) {
         if (const SignalEvidence* ev = lr.evidence.Pooled(signal)) cand.evidence.push_back(*ev);
       }
       lr.candidates.push_back(std::move(cand));
@@ -391,14 +468,49 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
     std::stable_sort(
         lr.candidates.begin(), lr.candidates.end(),
         [](const CandidateResult& a, const CandidateResult& b) { return a.score > b.score; });
+    // Declared values the data cannot tell apart: beyond what the fit's own
+    // columns remove, their columns are (anti)parallel. A significant one
+    // stands for the combination.
+    {
+      const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(jb);
+      const Eigen::MatrixXd q = qr.householderQ() * Eigen::MatrixXd::Identity(jb.rows(), qr.rank());
+      std::map<std::string, Eigen::VectorXd> beyond;
+      for (const CandidateResult& c : lr.candidates) {
+        if (c.kind != "declared value") continue;
+        const Eigen::VectorXd& v = weighted_column.at(c.parameters.front());
+        beyond[c.name] = v - q * (q.transpose() * v);
+      }
+      for (CandidateResult& c : lr.candidates) {
+        if (c.kind != "declared value" || !c.significant) continue;
+        const Eigen::VectorXd& a = beyond.at(c.name);
+        for (const auto& [other, b] : beyond) {
+          if (other == c.name || !(a.norm() > 0.0 && b.norm() > 0.0)) continue;
+          // 0.99: the two explain the same residual to within 2 % of its square.
+          const bool parallel = std::abs(a.dot(b)) / (a.norm() * b.norm()) > 0.99;
+          // Or the data prefer neither: each alone removes as much, within
+          // tie_delta_bic (scores are Δχ²_eff of one parameter each, so
+          // their difference is the two models' ΔBIC: "not worth more than
+          // a bare mention"). On a large-S pulley 5 % large, both
+          // segments' large-S wrap angles and pulley radii scored 40.8 to
+          // 41.7: each changes the conduits' friction moment alike.
+          const auto it = std::find_if(lr.candidates.begin(), lr.candidates.end(),
+                                       [&](const CandidateResult& x) { return x.name == other; });
+          const bool tied = it != lr.candidates.end() && it->significant &&
+                            std::abs(it->score - c.score) < options.tie_delta_bic;
+          if (parallel || tied) c.indistinguishable.push_back(other);
+        }
+      }
+    }
     for (const CandidateResult& c : lr.candidates) {
       progress(round, "scoring", c.name,
                "  " + c.name + ": score " + Format("%.1f", c.score) + ", p " +
                    Format("%.2g", c.p_value) + (c.significant ? " (significant)" : ""));
     }
 
-    // Refit the best significant few.
-    int refits = 0;
+    // Refit the best significant few: effects and declared values each on
+    // their own budget; a block is scored only (its members are refitted).
+    int refits = 0, declared_refits = 0;
+    std::set<std::string> covered;  // declared values a refitted one stands for
     std::map<std::string, IdentificationSummary> refit_fits;
     std::map<std::string, HoldoutResult> refit_holdouts;
     for (CandidateResult& cand : lr.candidates) {
@@ -406,12 +518,24 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
         cand.reason = "score test not significant (p " + Format("%.2g", cand.p_value) + ")";
         continue;
       }
-      if (refits >= options.refits_per_round) {
-        cand.reason = "significant, but not among the best " +
-                      std::to_string(options.refits_per_round) + " scores of the round";
+      if (cand.kind == "declared block") {
+        cand.reason = "a block of declared values: scored as one, its members refitted";
         continue;
       }
-      ++refits;
+      const bool declared = cand.kind == "declared value";
+      if (declared && covered.count(cand.name)) {
+        cand.reason = "significant, but indistinguishable from a better-scoring declared value";
+        continue;
+      }
+      int& used = declared ? declared_refits : refits;
+      const int budget = declared ? options.declared_refits_per_round : options.refits_per_round;
+      if (used >= budget) {
+        cand.reason = "significant, but not among the best " + std::to_string(budget) +
+                      (declared ? " declared values" : " effects") + " of the round";
+        continue;
+      }
+      ++used;
+      if (declared) covered.insert(cand.indistinguishable.begin(), cand.indistinguishable.end());
       progress(round, "refit", cand.name, "  refitting with " + cand.name);
       IdentificationOptions o = options.fit;
       o.free_parameters = free;
@@ -509,7 +633,24 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
         cand.holdout_improved = true;  // nothing held out: the criterion alone decides
       }
       const bool bic_ok = cand.delta_bic > options.min_delta_bic;
-      cand.accepted = bic_ok && cand.holdout_improved && cand.size_significant;
+      // The partial-explanation rule: in noise units (weighted mean square,
+      // 1 at the noise), the share of the current residual's excess over
+      // the noise the refit removes, where the residual after it stays
+      // above the unexplained level. From the current fit, not from
+      // cost_without: a refit that moves the declared parameters far to
+      // make room for the candidate has a poor point without it. On a
+      // hole circle 0.5 mm small, joint friction's refit took mu_c from
+      // 0.21 to 0.09: counted from there it removed 58 % of the excess,
+      // of the current residual 3 % (RMS 0.0655 -> 0.0648 deg).
+      const double ms_before = 2.0 * current.final_cost / nres;
+      cand.mean_square_after = 2.0 * refit.final_cost / nres;
+      cand.excess_share =
+          ms_before > 1.0 ? (ms_before - cand.mean_square_after) / (ms_before - 1.0) : 1.0;
+      const double unexplained_ms =
+          options.unexplained_noise_ratio * options.unexplained_noise_ratio;
+      cand.partial =
+          cand.mean_square_after > unexplained_ms && cand.excess_share < options.min_excess_share;
+      cand.accepted = bic_ok && cand.holdout_improved && cand.size_significant && !cand.partial;
       std::string why;
       why += "ΔBIC " + Format("%.1f", cand.delta_bic) + (bic_ok ? " > " : " <= ") +
              Format("%g", options.min_delta_bic);
@@ -520,6 +661,14 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       }
       why += cand.size_significant ? "; its size is distinguishable from 0"
                                    : "; its size is indistinguishable from 0";
+      why += "; it removes " + Format("%.0f", 100.0 * cand.excess_share) +
+             " % of the residual's excess over the noise";
+      if (cand.partial) {
+        why += ", below " + Format("%.0f", 100.0 * options.min_excess_share) +
+               " %, while the residual stays at " +
+               Format("%.1f", std::sqrt(cand.mean_square_after)) +
+               "x the noise: a partial explanation, not the cause";
+      }
       cand.reason = why;
       progress(round, "refit", cand.name,
                "  " + cand.name + ": RMS " + Format("%.4f", cand.rms_deg) + " deg, " + why +
@@ -536,10 +685,21 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
     if (best == nullptr) {
       bool any_significant = false;
       for (const CandidateResult& c : lr.candidates) any_significant |= c.significant;
+      const CandidateResult* partial = nullptr;
+      for (const CandidateResult& c : lr.candidates) {
+        if (c.partial && (partial == nullptr || c.delta_bic > partial->delta_bic)) partial = &c;
+      }
       lr.decision = any_significant
                         ? "no candidate earns its place: the refitted ones fail a criterion."
                         : "no candidate earns its place: none explains a significant part of "
                           "the residual (score test).";
+      if (partial != nullptr) {
+        lr.decision += " The residual is not explained: " + partial->name + " would remove only " +
+                       Format("%.0f", 100.0 * partial->excess_share) +
+                       " % of its excess over the noise and leave it at " +
+                       Format("%.1f", std::sqrt(partial->mean_square_after)) +
+                       "x the noise; it is not named as the cause.";
+      }
       for (CandidateResult& c : lr.candidates) c.accepted = false;
       summary.rounds.push_back(std::move(lr));
       progress(round, "done", "",
@@ -562,8 +722,15 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
         c.reason += "; passes, but " + lr.winner + " explains more";
       }
     }
+    const bool declared_winner = winner->kind == "declared value";
+    if (declared_winner) winner_indistinguishable[lr.winner] = winner->indistinguishable;
     lr.decision =
-        "added " + lr.winner + ": ΔBIC " + Format("%.1f", winner->delta_bic) + ", training RMS " +
+        (declared_winner ? "corrected " : "added ") + lr.winner +
+        (winner->indistinguishable.empty()
+             ? std::string()
+             : " (indistinguishable from " + Join(winner->indistinguishable) +
+                   ": the data see their combination)") +
+        ": ΔBIC " + Format("%.1f", winner->delta_bic) + ", training RMS " +
         Format("%.4f", lr.rms_deg) + " -> " + Format("%.4f", winner->rms_deg) + " deg" +
         (winner->holdout_rms_deg ? ", held-out " + Format("%.4f", *lr.holdout_rms_deg) + " -> " +
                                        Format("%.4f", *winner->holdout_rms_deg) + " deg"
@@ -583,7 +750,36 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
     summary.rounds.push_back(std::move(lr));
   }
 
-  summary.added_effects = effects_on;
+  for (const std::string& name : effects_on) {
+    if (name.rfind("declared.", 0) != 0) {
+      summary.added_effects.push_back(name);
+      continue;
+    }
+    // "The declared X is off by Δ ± σ".
+    DeclaredCorrection d;
+    d.parameter = name;
+    d.config_key = sim::DeclaredValueKey(name);
+    d.label = internal::DeclaredValueLabel(name);
+    d.declared = sim::DeclaredValue(training.front().config.arm, name);
+    if (const ParameterEstimate* est = current.Find(name)) {
+      d.relative = est->value;
+      d.identifiable = est->identifiable;
+      d.relative_std_error = est->std_error;
+      d.relative_ci95_lower = est->ci95_lower;
+      d.relative_ci95_upper = est->ci95_upper;
+    }
+    d.indistinguishable = winner_indistinguishable[name];
+    summary.declared_corrections.push_back(d);
+  }
+  if (!summary.declared_corrections.empty()) {
+    // The corrected configuration, with every value of the final model.
+    sim::Config c = training.front().config;
+    sim::ArmParameters p = ParametersFor(training.front(), ValuesOf(current, fixed));
+    c.arm = sim::CorrectedArm(c.arm, p);
+    p.declared_deltas.clear();
+    c.parameters = p;
+    summary.calibrated = c;
+  }
   summary.final_fit = current;
   summary.after = current.errors;
   summary.rms_after_deg = current.errors.rms_deg_overall;
@@ -631,6 +827,15 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       conclusion << (k ? ", " : "") << summary.added_effects[k];
     }
     conclusion << ".";
+  }
+  for (const DeclaredCorrection& d : summary.declared_corrections) {
+    conclusion << " " << d.Sentence() << ".";
+  }
+  if (!summary.rounds.empty()) {
+    // A partial explanation refused in the last round: say so.
+    const std::string& last = summary.rounds.back().decision;
+    const std::size_t at = last.find("The residual is not explained");
+    if (at != std::string::npos) conclusion << " " << last.substr(at);
   }
   if (declared_ok) {
     if (summary.unexplained.empty()) {

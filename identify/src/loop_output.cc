@@ -57,7 +57,32 @@ nlohmann::json Evidence(const std::vector<SignalEvidence>& evidence) {
   return out;
 }
 
+// A value in SI units with its unit, the wrap angle in degrees.
+std::string WithUnit(double value, const std::string& key) {
+  const bool angle = key.find("_deg") != std::string::npos;
+  const std::string unit = key.substr(key.rfind('_') + 1);
+  return Format("%.4g", angle ? value * kDeg : value) + " " + unit;
+}
+
 }  // namespace
+
+std::string DeclaredCorrection::Sentence() const {
+  std::string out = "the declared " + label + " (" + config_key + " = " +
+                    WithUnit(declared, config_key) + ") is off by " + (delta() >= 0.0 ? "+" : "") +
+                    WithUnit(delta(), config_key);
+  if (identifiable && std::isfinite(relative_std_error)) {
+    out += " ± " + WithUnit(std::abs(declared) * relative_std_error, config_key);
+  } else {
+    out += " (its error not identifiable)";
+  }
+  out += " (" + Format("%+.2f", 100.0 * relative) + " %)";
+  if (!indistinguishable.empty()) {
+    std::string names;
+    for (const std::string& n : indistinguishable) names += (names.empty() ? "" : ", ") + n;
+    out += ", or a combination with " + names + " that the data cannot tell apart";
+  }
+  return out;
+}
 
 nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& training,
                       const std::vector<Experiment>& holdout) {
@@ -78,6 +103,8 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
                    {"refits_per_round", o.refits_per_round},
                    {"max_rounds", o.max_rounds},
                    {"min_delta_bic", o.min_delta_bic},
+                   {"declared_refits_per_round", o.declared_refits_per_round},
+                   {"min_excess_share", o.min_excess_share},
                    {"holdout_z", o.holdout_z},
                    {"tie_delta_bic", o.tie_delta_bic},
                    {"unexplained_noise_ratio", o.unexplained_noise_ratio}};
@@ -87,26 +114,32 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
     for (const CandidateResult& c : r.candidates) {
       json est = json::object();
       for (const auto& [name, e] : c.estimates) est[name] = Estimate(e);
-      cands.push_back({{"name", c.name},
-                       {"score", Number(c.score)},
-                       {"p_value", Number(c.p_value)},
-                       {"significant", c.significant},
-                       {"parameters", c.parameters},
-                       {"linearised", c.linearised},
-                       {"evidence", Evidence(c.evidence)},
-                       {"refitted", c.refitted},
-                       {"cost_without", c.refitted ? Number(c.cost_without) : json(nullptr)},
-                       {"delta_bic", c.refitted ? Number(c.delta_bic) : json(nullptr)},
-                       {"holdout_rms_without_deg", Optional(c.holdout_rms_without_deg)},
-                       {"rms_deg", c.refitted ? Number(c.rms_deg) : json(nullptr)},
-                       {"holdout_rms_deg", Optional(c.holdout_rms_deg)},
-                       {"holdout_improved", c.holdout_improved},
-                       {"size_significant", c.size_significant},
-                       {"termination", c.termination},
-                       {"estimates", est},
-                       {"simulations", c.simulations},
-                       {"accepted", c.accepted},
-                       {"reason", c.reason}});
+      cands.push_back(
+          {{"name", c.name},
+           {"kind", c.kind},
+           {"indistinguishable", c.indistinguishable},
+           {"excess_share", c.refitted ? Number(c.excess_share) : json(nullptr)},
+           {"mean_square_after", c.refitted ? Number(c.mean_square_after) : json(nullptr)},
+           {"partial", c.partial},
+           {"score", Number(c.score)},
+           {"p_value", Number(c.p_value)},
+           {"significant", c.significant},
+           {"parameters", c.parameters},
+           {"linearised", c.linearised},
+           {"evidence", Evidence(c.evidence)},
+           {"refitted", c.refitted},
+           {"cost_without", c.refitted ? Number(c.cost_without) : json(nullptr)},
+           {"delta_bic", c.refitted ? Number(c.delta_bic) : json(nullptr)},
+           {"holdout_rms_without_deg", Optional(c.holdout_rms_without_deg)},
+           {"rms_deg", c.refitted ? Number(c.rms_deg) : json(nullptr)},
+           {"holdout_rms_deg", Optional(c.holdout_rms_deg)},
+           {"holdout_improved", c.holdout_improved},
+           {"size_significant", c.size_significant},
+           {"termination", c.termination},
+           {"estimates", est},
+           {"simulations", c.simulations},
+           {"accepted", c.accepted},
+           {"reason", c.reason}});
     }
     rounds.push_back({{"round", r.index},
                       {"effects_on", r.effects_on},
@@ -120,6 +153,22 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
   }
   j["rounds"] = rounds;
   j["added_effects"] = s.added_effects;
+  json corrections = json::array();
+  for (const DeclaredCorrection& d : s.declared_corrections) {
+    corrections.push_back(
+        {{"parameter", d.parameter},
+         {"config_key", d.config_key},
+         {"declared", Number(d.declared)},
+         {"corrected", Number(d.corrected())},
+         {"delta", Number(d.delta())},
+         {"relative", Number(d.relative)},
+         {"relative_std_error", Number(d.relative_std_error)},
+         {"relative_ci95", {Number(d.relative_ci95_lower), Number(d.relative_ci95_upper)}},
+         {"identifiable", d.identifiable},
+         {"indistinguishable", d.indistinguishable},
+         {"sentence", d.Sentence()}});
+  }
+  j["declared_corrections"] = corrections;
   json params = json::object();
   for (const ParameterEstimate& p : s.final_fit.parameters) {
     if (p.free) params[p.name] = Estimate(p);
@@ -172,10 +221,12 @@ std::string LoopSummary::FullReport() const {
   out << "\n";
   for (const LoopRound& r : rounds) {
     out << "\nRound " << r.index << " (training RMS " << Format("%.4f", r.rms_deg) << " deg)\n";
-    out << "  candidate           score     p        refit  dBIC     RMS      held-out  accepted\n";
+    out << "  candidate                                  score     p        refit  dBIC     RMS    "
+           "  "
+           "held-out  accepted\n";
     for (const CandidateResult& c : r.candidates) {
       char line[256];
-      std::snprintf(line, sizeof(line), "  %-18s %9s %8s  %-5s %8s %8s %9s  %s\n", c.name.c_str(),
+      std::snprintf(line, sizeof(line), "  %-41s %9s %8s  %-5s %8s %8s %9s  %s\n", c.name.c_str(),
                     Format("%.1f", c.score).c_str(), Format("%.2g", c.p_value).c_str(),
                     c.refitted ? "yes" : "no",
                     c.refitted ? Format("%.1f", c.delta_bic).c_str() : "-",
@@ -197,6 +248,10 @@ std::string LoopSummary::FullReport() const {
       out << " " << p.units << "  (not identifiable)";
     }
     out << "\n";
+  }
+  if (!declared_corrections.empty()) {
+    out << "\nDeclared values corrected (calibrated.yaml):\n";
+    for (const DeclaredCorrection& d : declared_corrections) out << "  " << d.Sentence() << "\n";
   }
   out << "\nRMS error [deg]      before    after\n";
   out << "  training          " << Format("%.4f", rms_before_deg) << "   "
@@ -260,6 +315,14 @@ std::vector<std::string> WriteLoopDirectory(const LoopSummary& summary,
       WriteTextFileAtomically((tmp / "holdout" / (name + ".angles.csv")).string(), csv);
       written.push_back((fs::path(directory) / "holdout" / (name + ".angles.csv")).string());
     }
+  }
+  if (summary.calibrated) {
+    WriteTextFileAtomically((tmp / "calibrated.yaml").string(),
+                            "# The declared configuration with the loop's corrections of declared "
+                            "values and the final model's fitted values (loop.json: "
+                            "declared_corrections).\n" +
+                                sim::ToYaml(*summary.calibrated));
+    written.push_back((fs::path(directory) / "calibrated.yaml").string());
   }
   WriteTextFileAtomically((tmp / "loop.json").string(),
                           ToJson(summary, training, holdout).dump(2) + "\n");

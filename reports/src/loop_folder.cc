@@ -248,6 +248,24 @@ LoopFolder ReadLoopFolder(const std::string& folder) {
   for (std::size_t r = 0; r < rounds.size(); ++r)
     loop.rounds.push_back(ReadRound(in, rounds[r], r));
   loop.added_effects = in.Texts(root, "", "added_effects");
+  if (root.contains("declared_corrections")) {
+    const json& corrections = in.List(root, "", "declared_corrections");
+    for (std::size_t k = 0; k < corrections.size(); ++k) {
+      const std::string at = JsonReader::Index("declared_corrections", k);
+      const json& c = corrections[k];
+      LoopDeclaredCorrection d;
+      d.parameter = in.Text(c, at, "parameter");
+      d.config_key = in.Text(c, at, "config_key");
+      d.sentence = in.Text(c, at, "sentence");
+      d.declared = in.NumberAt(c, at, "declared", true);
+      d.corrected = in.NumberAt(c, at, "corrected", true);
+      d.relative = in.NumberAt(c, at, "relative", true);
+      d.relative_std_error = in.NumberAt(c, at, "relative_std_error", true);
+      d.relative_ci95 = in.Pair(in.At(c, at, "relative_ci95"), at + ".relative_ci95", true);
+      d.indistinguishable = in.Texts(c, at, "indistinguishable");
+      loop.declared_corrections.push_back(std::move(d));
+    }
+  }
   loop.parameters = ReadEstimates(in, root, "", "parameters");
   loop.rms_before_deg = in.NumberAt(root, "", "rms_before_deg", true);
   loop.rms_after_deg = in.NumberAt(root, "", "rms_after_deg", true);

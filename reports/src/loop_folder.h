@@ -127,6 +127,16 @@ struct LoopHoldout {
   datasets::Array measured_deg, declared_deg, final_deg;  // T × J × 2
 };
 
+// A declared value the loop corrected (loop.json 'declared_corrections',
+// issue 28; absent in files written before it).
+struct LoopDeclaredCorrection {
+  std::string parameter, config_key, sentence;
+  double declared = kUnknown, corrected = kUnknown, relative = kUnknown;
+  double relative_std_error = kUnknown;
+  std::array<double, 2> relative_ci95 = {kUnknown, kUnknown};
+  std::vector<std::string> indistinguishable;
+};
+
 struct LoopFolder {
   std::string folder;  // as given
   struct Data {
@@ -137,6 +147,7 @@ struct LoopFolder {
   std::vector<std::string> declared_free;
   std::vector<LoopRound> rounds;
   std::vector<std::string> added_effects;
+  std::vector<LoopDeclaredCorrection> declared_corrections;
   std::vector<LoopEstimate> parameters;  // the final model's free parameters
   double rms_before_deg = kUnknown, rms_after_deg = kUnknown;
   double holdout_rms_before_deg = kUnknown, holdout_rms_after_deg = kUnknown;

@@ -26,6 +26,7 @@ using internal::FigureStem;
 using internal::JointGroup;
 using internal::ListNames;
 using internal::LoopCandidate;
+using internal::LoopDeclaredCorrection;
 using internal::LoopDiagnostics;
 using internal::LoopErrors;
 using internal::LoopEstimate;
@@ -94,6 +95,35 @@ Table DataTable(const LoopFolder& loop) {
   return table;
 }
 
+// The declared values the loop corrected: the difference of calibrated.yaml
+// from the declared configuration.
+Table DeclaredCorrectionTable(const LoopFolder& loop) {
+  Table table;
+  table.id = "declared_corrections";
+  table.title = "Declared values corrected (calibrated.yaml)";
+  table.caption =
+      "loop.json 'declared_corrections': values of the configuration the data say are off, "
+      "and the corrected configuration's values (calibrated.yaml in the loop folder). "
+      "Relative error: (corrected - declared) / declared, with its 95 % interval. Values the "
+      "data cannot tell apart from it are listed: it stands for their combination.";
+  // Six digits: a correction of a tenth of a per cent must show.
+  const NumberFormat kConfig = NumberFormat::Significant(6);
+  table.columns = {
+      {"value", "configuration key", "", kCount}, {"declared", "declared", "", kConfig},
+      {"corrected", "corrected", "", kConfig},    {"relative", "relative error", "", kValue},
+      {"ci", "95 % interval", "", kCount},        {"alike", "indistinguishable from", "", kCount}};
+  for (const LoopDeclaredCorrection& d : loop.declared_corrections) {
+    const std::string ci =
+        std::isfinite(d.relative_ci95[0])
+            ? "[" + Show(d.relative_ci95[0], kValue) + ", " + Show(d.relative_ci95[1], kValue) + "]"
+            : "not identifiable";
+    table.AddRow({Cell::Text(d.config_key), Cell::Number(d.declared), Cell::Number(d.corrected),
+                  Cell::Number(d.relative), Cell::Text(ci),
+                  Cell::Text(Names(d.indistinguishable, "-"))});
+  }
+  return table;
+}
+
 Section SummarySection(const LoopFolder& loop) {
   Section section{"summary", "Summary", {}};
   std::vector<std::string> training, holdout;
@@ -126,6 +156,12 @@ Section SummarySection(const LoopFolder& loop) {
           (std::filesystem::path(loop.folder) / "declared").string() + " (or final).",
       false});
   section.blocks.push_back(LoopTable(loop));
+  if (!loop.declared_corrections.empty()) {
+    for (const LoopDeclaredCorrection& d : loop.declared_corrections) {
+      section.blocks.push_back(Paragraph{"Declared value: " + d.sentence + ".", false});
+    }
+    section.blocks.push_back(DeclaredCorrectionTable(loop));
+  }
   section.blocks.push_back(DataTable(loop));
   return section;
 }

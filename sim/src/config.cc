@@ -700,7 +700,8 @@ int ArmConfig::total_links() const {
 }
 
 ArmSize ArmConfig::size() const {
-  return ArmSize{total_links(), static_cast<int>(driving.cables.size())};
+  return ArmSize{total_links(), static_cast<int>(driving.cables.size()),
+                 static_cast<int>(segments.size())};
 }
 
 int ArmConfig::segment_of_link(int link) const {

@@ -10,6 +10,7 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/number_text.h"
 #include "ccsrm/common/yaml_document.h"
+#include "ccsrm/sim/declared_values.h"
 #include "ccsrm/sim/effects.h"
 #include "effects/effect.h"
 #include "effects/effects_yaml.h"
@@ -24,7 +25,8 @@ std::string KnownNames() {
   for (const ParameterInfo& p : Parameters()) names += (names.empty() ? "" : ", ") + p.name;
   std::string effects;
   for (const EffectInfo& e : Effects()) effects += (effects.empty() ? "" : ", ") + e.name;
-  return names + "; effects' parameters as <effect>.<parameter>, effects: " + effects;
+  return names + "; effects' parameters as <effect>.<parameter>, effects: " + effects +
+         "; declared values as declared.<value> (ccsrm generate --list-effects)";
 }
 
 // For "effect.x": that effect's parameters (on `arm`, when known), when the
@@ -52,6 +54,7 @@ const ParameterInfo* LookUp(const std::string& name, const ArmSize* arm,
   for (const ParameterInfo& p : Parameters()) {
     if (p.name == name) return &p;
   }
+  if (name.rfind("declared.", 0) == 0) return internal::FindDeclaredParameter(name, arm, beyond);
   return internal::FindEffectParameter(name, arm, beyond);
 }
 
@@ -87,6 +90,20 @@ bool ArmParameters::IsValid(std::string* error) const {
     if (info == nullptr || !info->is_effect()) {
       *error =
           "unknown effect parameter '" + name + "'" + (beyond.empty() ? "" : " (" + beyond + ")");
+      return false;
+    }
+    const std::string problem = ParameterValueProblem(*info, value);
+    if (!problem.empty()) {
+      *error = problem;
+      return false;
+    }
+  }
+  for (const auto& [name, value] : declared_deltas) {
+    std::string beyond;
+    const ParameterInfo* info = LookUp(name, &arm, &beyond);
+    if (info == nullptr || !info->declared) {
+      *error =
+          "unknown declared value '" + name + "'" + (beyond.empty() ? "" : " (" + beyond + ")");
       return false;
     }
     const std::string problem = ParameterValueProblem(*info, value);
@@ -221,6 +238,10 @@ std::string ParameterValueProblem(const ParameterInfo& info, double value) {
 double GetParameter(const ArmParameters& parameters, const std::string& name) {
   const ParameterInfo& info = FindParameter(name, "GetParameter", parameters.arm);
   if (info.field != nullptr) return parameters.*info.field;
+  if (info.declared) {
+    const auto d = parameters.declared_deltas.find(name);
+    return d != parameters.declared_deltas.end() ? d->second : 0.0;
+  }
   const auto it = parameters.effect_values.find(name);
   return it != parameters.effect_values.end() ? it->second : info.absent_value;
 }
@@ -232,6 +253,10 @@ void SetParameter(const std::string& name, double value, const std::string& wher
   if (!problem.empty()) ThrowInputError(where, "", problem);
   if (info.field != nullptr) {
     parameters->*info.field = value;
+    return;
+  }
+  if (info.declared) {
+    parameters->declared_deltas[name] = value;
     return;
   }
   parameters->effect_values[name] = value;

@@ -1,5 +1,7 @@
 #include "ccsrm/sim/simulator.h"
 
+#include "ccsrm/sim/declared_values.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -409,6 +411,14 @@ SimulationResult Simulate(const ArmModel& model, const ArmParameters& parameters
                         std::to_string(model.num_cables()));
   }
   UseGslErrorCodes();
+  // Declared-value corrections (declared_values.h): the arm built with the
+  // corrected values; with none, the model as given.
+  if (AnyDeclaredCorrection(parameters)) {
+    const ArmModel corrected(CorrectedArm(model.arm(), parameters));
+    ArmParameters rest = parameters;
+    rest.declared_deltas.clear();
+    return Simulate(corrected, rest, inputs, options);
+  }
   // Actuator effects (delay, creep) drive the arm with what the actuators
   // realise from the commanded inputs; with none on, the inputs as given.
   const std::unique_ptr<CableInputs> realised =

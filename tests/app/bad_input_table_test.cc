@@ -294,6 +294,15 @@ const std::vector<BadInput>& Rows() {
       {"overrides",
        "loop --data {d}/processed.h5 --candidates '' --out {d}/loop",
        {"--candidates", "empty"}},  // 3
+      // A declared value of a segment the arm does not have (issue 28).
+      {"overrides",
+       "simulate --config {d}/c.yaml --set declared.segment9.link_length=0.01 --duration 0.1 "
+       "--out {d}/run2.h5",
+       {"--set", "declared.segment9.link_length", "segments"}},
+      {"overrides",
+       "simulate --config {d}/c.yaml --set declared.joint_disk_gap=0.5 --duration 0.1 "
+       "--out {d}/run2.h5",
+       {"--set", "declared.joint_disk_gap", "outside"}},
       {"overrides",
        "derivatives --config {d}/c.yaml --parameters '' --duration 0.1",
        {"--parameters", "empty"}},

@@ -639,6 +639,36 @@ TEST(LoopPage, AFailedDeclaredFitGivesAPageThatSaysSo) {
   EXPECT_FALSE(summary["tables"]["errors_per_joint"]["rows"][0].contains("holdout_x_before_deg"));
 }
 
+TEST(LoopPage, CorrectedDeclaredValuesAreShownWithTheirConfigurationDifference) {
+  // Issue 28: a declared value the loop corrected, as loop.json writes it.
+  json loop = KnownLoopJson();
+  loop["declared_corrections"] = json::array(
+      {{{"parameter", "declared.segment2.hole_circle_radius"},
+        {"config_key", "arm.segments[1].hole_circle_radius_m"},
+        {"declared", 0.016},
+        {"corrected", 0.0152008},
+        {"delta", -0.0007992},
+        {"relative", -0.04995},
+        {"relative_std_error", 0.00035},
+        {"relative_ci95", {-0.05063, -0.04927}},
+        {"identifiable", true},
+        {"indistinguishable", json::array()},
+        {"sentence", "the declared segment 2 hole circle radius (...) is off by -0.0007992 m"}}});
+  const fs::path dir = WriteLoopFolder("declared", loop);
+  const Document document = BuildLoopDocument(dir.string(), ReportOptions());
+  const json summary = ToJson(document);
+  ASSERT_TRUE(summary["tables"].contains("declared_corrections"));
+  const json& rows = summary["tables"]["declared_corrections"]["rows"];
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0]["value"], "arm.segments[1].hole_circle_radius_m");
+  EXPECT_DOUBLE_EQ(rows[0]["declared"].get<double>(), 0.016);
+  EXPECT_DOUBLE_EQ(rows[0]["corrected"].get<double>(), 0.0152008);
+  // A loop.json without the key (written before issue 28) has no such table.
+  const Document before =
+      BuildLoopDocument(WriteLoopFolder("before", KnownLoopJson()).string(), ReportOptions());
+  EXPECT_FALSE(ToJson(before)["tables"].contains("declared_corrections"));
+}
+
 // Renders the loop page in headless Chromium into
 // <build>/report_screenshots/loop.png for a person to look at; checks only
 // that an image of some size came out.

@@ -22,6 +22,11 @@ namespace ccsrm::sim {
 struct ArmSize {
   int joints = 0;
   int cables = 0;
+  // Segments: what sizes the per-segment declared values
+  // (declared_values.h). Not compared: an arm's joints and cables decide
+  // its effects' parameters, and files that record an arm's size
+  // (prediction) give those two only.
+  int segments = 0;
   bool operator==(const ArmSize& other) const {
     return joints == other.joints && cables == other.cables;
   }
@@ -80,6 +85,11 @@ struct ArmParameters {
   std::map<std::string, double> effect_values;
   std::set<std::string> effects_on;
 
+  // Corrections of the configuration's declared values
+  // (ccsrm/sim/declared_values.h), by full name ("declared.segment1.link_length"),
+  // relative to the declared value; a name absent here is 0 (as declared).
+  std::map<std::string, double> declared_deltas;
+
   // The arm these parameters are for (ParseConfig sets it from the arm). It
   // decides which per-joint and per-cable effect parameters exist, so that
   // every door that sets a parameter by name (SetParameter, a
@@ -116,6 +126,9 @@ struct ParameterInfo {
   std::string short_name{};
   double realistic = std::numeric_limits<double>::quiet_NaN();
   bool is_effect() const { return !effect.empty(); }
+  // A declared value's relative correction (declared_values.h): field null,
+  // no effect, `realistic` set, absent_value 0.
+  bool declared = false;
 };
 
 // The model's named parameters: SPEC 6's nine in its order (mu, mu_s, mu_c,
