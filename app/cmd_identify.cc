@@ -37,6 +37,7 @@ struct IdentifyArgs {
   bool central_throughout = false;
   std::string out;
   bool quiet = false;
+  double run_timeout_s = identify::MpiOptions().run_timeout_s;
 };
 
 int RunIdentify(const IdentifyArgs& a) {
@@ -55,6 +56,9 @@ int RunIdentify(const IdentifyArgs& a) {
   CheckOut(a.out, FitFolderOutput(), inputs);
   std::vector<identify::Experiment> experiments =
       LoadExperiments(a.data, a.noise_deg, "experiment");
+  const auto backends = RunBackends({&experiments}, a.threads, a.run_timeout_s);
+  if (backends.empty()) return 0;  // another rank of an MPI job: it served rank 0's runs
+  options.backend = backends.front();
   std::string free_list;
   for (const std::string& n : options.free_parameters)
     free_list += (free_list.empty() ? "" : ", ") + n;
@@ -118,6 +122,7 @@ void AddIdentifyCommand(CLI::App& root) {
       ->check(Above(0.0, "deg"));
   cmd->add_option("--out", a->out, "Output folder")->required();
   cmd->add_flag("--quiet", a->quiet, "No progress lines");
+  AddRunTimeoutOption(cmd, &a->run_timeout_s);
   cmd->callback([a] {
     const int code = RunIdentify(*a);
     if (code != 0) throw CLI::RuntimeError(code);

@@ -28,6 +28,7 @@ struct LoopArgs {
   double noise_deg = 0.0;  // 0: estimated
   std::string out;
   bool quiet = false;
+  double run_timeout_s = identify::MpiOptions().run_timeout_s;
 };
 
 int RunLoop(const LoopArgs& a) {
@@ -47,6 +48,10 @@ int RunLoop(const LoopArgs& a) {
       LoadExperiments(a.data, a.noise_deg, "training");
   const std::vector<identify::Experiment> holdout =
       LoadExperiments(a.holdout, a.noise_deg, "held out");
+  const auto backends = RunBackends({&training, &holdout}, a.threads, a.run_timeout_s);
+  if (backends.empty()) return 0;  // another rank of an MPI job: it served rank 0's runs
+  options.fit.backend = backends[0];
+  options.holdout_backend = backends[1];
 
   std::string free_list;
   for (const std::string& n : options.fit.free_parameters)
@@ -113,6 +118,7 @@ void AddLoopCommand(CLI::App& root) {
       ->check(Above(0.0, "deg"));
   cmd->add_option("--out", a->out, "Output folder")->required();
   cmd->add_flag("--quiet", a->quiet, "No progress lines");
+  AddRunTimeoutOption(cmd, &a->run_timeout_s);
   cmd->callback([a] {
     const int code = RunLoop(*a);
     if (code != 0) throw CLI::RuntimeError(code);

@@ -77,4 +77,28 @@ identify::RunFinishedCallback RunProgress() {
   };
 }
 
+void AddRunTimeoutOption(CLI::App* command, double* run_timeout_s) {
+  command
+      ->add_option("--run-timeout", *run_timeout_s,
+                   "Under mpirun: seconds a rank may take over one run before the job ends "
+                   "with one line and exit status 7 (docs/cluster.md)")
+      ->capture_default_str()
+      ->check(Above(0.0, "s"));
+}
+
+std::vector<std::shared_ptr<identify::SimulationBackend>> RunBackends(
+    const std::vector<const std::vector<identify::Experiment>*>& sets, int threads,
+    double run_timeout_s) {
+  identify::MpiOptions mpi;
+  mpi.threads = threads;
+  mpi.run_timeout_s = run_timeout_s;
+  std::vector<std::shared_ptr<identify::SimulationBackend>> backends =
+      identify::ShareRuns(sets, mpi);
+  if (!backends.empty() && identify::MpiRanks() > 1) {
+    std::printf("runs on %d MPI ranks, %d at a time\n", identify::MpiRanks(),
+                backends.front()->parallelism());
+  }
+  return backends;
+}
+
 }  // namespace ccsrm::app

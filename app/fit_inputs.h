@@ -1,12 +1,15 @@
 #pragma once
 // What `ccsrm identify` and `ccsrm loop` read the same way: the fit's
 // parameter options (--free, --params, --set) and the experiment files.
+#include <CLI/CLI.hpp>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "ccsrm/identify/experiment.h"
 #include "ccsrm/identify/identification.h"
+#include "ccsrm/identify/mpi_backend.h"
 
 namespace ccsrm::app {
 
@@ -29,5 +32,17 @@ void PrintFitProgress(identify::IdentificationOptions* options, const std::strin
 
 // The per-simulation progress line ("simulation 3 / 8"), on stderr.
 identify::RunFinishedCallback RunProgress();
+
+// --run-timeout (MpiOptions::run_timeout_s), for the commands whose runs go
+// to every rank of an MPI job.
+void AddRunTimeoutOption(CLI::App* command, double* run_timeout_s);
+
+// The backends of the experiment sets (identify::ShareRuns): every rank of
+// an MPI job (docs/cluster.md), else `threads` threads. Empty on a rank other
+// than 0 once it has served rank 0's runs: its command is then over. Prints
+// where the runs go on stdout.
+std::vector<std::shared_ptr<identify::SimulationBackend>> RunBackends(
+    const std::vector<const std::vector<identify::Experiment>*>& sets, int threads,
+    double run_timeout_s);
 
 }  // namespace ccsrm::app

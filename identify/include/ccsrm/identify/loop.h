@@ -90,6 +90,9 @@ struct LoopOptions {
     o.free_parameters = LoopDeclaredParameterNames();
     return o;
   }();
+  // The backend of the held-out experiments (null: threads on this machine);
+  // fit.backend is the training experiments'.
+  std::shared_ptr<SimulationBackend> holdout_backend;
   // The candidate effects, by name. Default: every effect of the library
   // (sim::Effects()) that the declared model does not have on.
   std::vector<std::string> candidates;
