@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "ccsrm/common/error.h"
+#include "run_codec.h"
 #include "run_pool.h"
 
 #ifdef CCSRM_HAVE_MPI
@@ -70,6 +71,12 @@ std::vector<std::shared_ptr<SimulationBackend>> ShareRuns(
 
 namespace {
 
+using internal::GetRequest;
+using internal::GetResult;
+using internal::Packer;
+using internal::PutRequest;
+using internal::PutResult;
+using internal::Unpacker;
 using Clock = std::chrono::steady_clock;
 
 // Message tags. Work and stop go from rank 0 to a server; the rest to rank 0.
@@ -83,129 +90,6 @@ bool started = false;
 int rank = 0;
 int ranks = 1;
 bool servers_released = false;  // rank 0: every server was sent kStop
-
-// Bytes of a message: numbers copied as they are, so that values arrive
-// bit for bit.
-class Packer {
- public:
-  template <typename T>
-  void Put(const T& value) {
-    Append(&value, sizeof(T));
-  }
-  void PutString(const std::string& s) {
-    Put<std::uint64_t>(s.size());
-    Append(s.data(), s.size());
-  }
-  void PutMatrix(const Eigen::MatrixXd& m) {
-    Put<std::int64_t>(m.rows());
-    Put<std::int64_t>(m.cols());
-    Append(m.data(), sizeof(double) * static_cast<std::size_t>(m.size()));
-  }
-  void Append(const void* p, std::size_t n) {
-    if (n == 0) return;
-    const std::size_t at = bytes_.size();
-    bytes_.resize(at + n);
-    std::memcpy(bytes_.data() + at, p, n);
-  }
-  std::vector<char>& bytes() { return bytes_; }
-
- private:
-  std::vector<char> bytes_;
-};
-
-class Unpacker {
- public:
-  explicit Unpacker(const std::vector<char>& bytes) : p_(bytes.data()), end_(p_ + bytes.size()) {}
-  template <typename T>
-  T Get() {
-    T value;
-    Take(&value, sizeof(T));
-    return value;
-  }
-  std::string GetString() {
-    std::string s(Get<std::uint64_t>(), '\0');
-    Take(s.data(), s.size());
-    return s;
-  }
-  Eigen::MatrixXd GetMatrix() {
-    const auto rows = Get<std::int64_t>();
-    const auto cols = Get<std::int64_t>();
-    Eigen::MatrixXd m(rows, cols);
-    Take(m.data(), sizeof(double) * static_cast<std::size_t>(m.size()));
-    return m;
-  }
-
- private:
-  void Take(void* out, std::size_t n) {
-    CCSRM_CHECK(static_cast<std::size_t>(end_ - p_) >= n);  // a message of this build
-    std::memcpy(out, p_, n);
-    p_ += n;
-  }
-  const char* p_;
-  const char* end_;
-};
-
-void PutParameters(const sim::ArmParameters& p, Packer* out) {
-  for (const sim::ParameterInfo& info : sim::Parameters()) out->Put<double>(p.*(info.field));
-  out->Put<std::int32_t>(p.arm.joints);
-  out->Put<std::int32_t>(p.arm.cables);
-  out->Put<std::uint64_t>(p.effects_on.size());
-  for (const std::string& e : p.effects_on) out->PutString(e);
-  out->Put<std::uint64_t>(p.effect_values.size());
-  for (const auto& [name, value] : p.effect_values) {
-    out->PutString(name);
-    out->Put<double>(value);
-  }
-}
-
-sim::ArmParameters GetParameters(Unpacker* in) {
-  sim::ArmParameters p;
-  for (const sim::ParameterInfo& info : sim::Parameters()) p.*(info.field) = in->Get<double>();
-  p.arm.joints = in->Get<std::int32_t>();
-  p.arm.cables = in->Get<std::int32_t>();
-  for (auto n = in->Get<std::uint64_t>(); n > 0; --n) p.effects_on.insert(in->GetString());
-  for (auto n = in->Get<std::uint64_t>(); n > 0; --n) {
-    std::string name = in->GetString();
-    p.effect_values[name] = in->Get<double>();
-  }
-  return p;
-}
-
-void PutSummary(const sim::SimulationSummary& s, Packer* out) {
-  out->Put<std::int32_t>(static_cast<std::int32_t>(s.status));
-  out->PutString(s.message);
-  out->Put(s.simulated_s);
-  out->Put(s.wall_time_s);
-  out->Put(s.real_time_factor);
-  out->Put(s.steps);
-  out->Put(s.rejected_steps);
-  out->Put(s.rhs_evaluations);
-  out->Put(s.stick_slip_switches);
-  out->Put(s.failed_releases);
-  out->Put(s.largest_threshold_raise_n);
-  out->Put(s.max_constraint_violation);
-  out->Put<std::uint64_t>(s.slack.size());
-  for (const sim::SlackInterval& i : s.slack) out->Put(i);
-}
-
-sim::SimulationSummary GetSummary(Unpacker* in) {
-  sim::SimulationSummary s;
-  s.status = static_cast<sim::SimulationStatus>(in->Get<std::int32_t>());
-  s.message = in->GetString();
-  s.simulated_s = in->Get<double>();
-  s.wall_time_s = in->Get<double>();
-  s.real_time_factor = in->Get<double>();
-  s.steps = in->Get<std::int64_t>();
-  s.rejected_steps = in->Get<std::int64_t>();
-  s.rhs_evaluations = in->Get<std::int64_t>();
-  s.stick_slip_switches = in->Get<std::int64_t>();
-  s.failed_releases = in->Get<std::int64_t>();
-  s.largest_threshold_raise_n = in->Get<double>();
-  s.max_constraint_violation = in->Get<double>();
-  s.slack.resize(in->Get<std::uint64_t>());
-  for (sim::SlackInterval& i : s.slack) i = in->Get<sim::SlackInterval>();
-  return s;
-}
 
 std::vector<char> Receive(int source, int tag, MPI_Status* status = nullptr) {
   MPI_Status st;
@@ -259,9 +143,21 @@ struct Job {
   MpiOptions options;
   std::vector<int> server_threads;   // per rank; [0] is rank 0's own
   std::int64_t runs_handed_out = 0;  // numbers the runs of the job for messages
+  // For the closing line (the scaling figures of BENCHMARKS.md): from the
+  // backends' creation, the time rank 0 spent in batches and outside them.
+  Clock::time_point created = Clock::now();
+  double batch_s = 0.0;
 
   ~Job() {
-    if (rank != 0 || servers_released) return;
+    if (rank != 0) return;
+    const double total_s = std::chrono::duration<double>(Clock::now() - created).count();
+    std::printf(
+        "MPI: %lld runs on %d rank%s in %.2f s of batches (%.3g runs/s); rank 0 on its "
+        "own %.2f s\n",
+        static_cast<long long>(runs_handed_out), ranks, ranks == 1 ? "" : "s", batch_s,
+        batch_s > 0.0 ? static_cast<double>(runs_handed_out) / batch_s : 0.0, total_s - batch_s);
+    std::fflush(stdout);
+    if (servers_released) return;
     for (int r = 1; r < ranks; ++r) MPI_Send(nullptr, 0, MPI_CHAR, r, kStop, MPI_COMM_WORLD);
     servers_released = true;
   }
@@ -280,6 +176,7 @@ class MpiBackend final : public SimulationBackend {
     const std::vector<Experiment>& experiments = *job_->sets[set_];
     for (const RunRequest& r : requests) CCSRM_CHECK(r.experiment < experiments.size());
     const std::size_t n = requests.size();
+    const Clock::time_point batch_start = Clock::now();
     const std::int64_t first_run = job_->runs_handed_out + 1;
     job_->runs_handed_out += static_cast<std::int64_t>(n);
     std::vector<RunResult> results(n);
@@ -364,12 +261,8 @@ class MpiBackend final : public SimulationBackend {
         packer.Put<std::uint64_t>(set_);
         packer.Put<std::uint64_t>(o.runs.size());
         for (const std::size_t k : o.runs) {
-          const RunRequest& q = requests[k];
           packer.Put<std::uint64_t>(k);
-          packer.Put<std::uint64_t>(q.experiment);
-          PutParameters(q.parameters, &packer);
-          packer.Put<std::uint64_t>(q.measurement_variants.size());
-          for (const sim::ArmParameters& v : q.measurement_variants) PutParameters(v, &packer);
+          PutRequest(requests[k], &packer);
         }
         if (o.runs.empty()) continue;
         busy = true;
@@ -401,11 +294,7 @@ class MpiBackend final : public SimulationBackend {
             failed = true;
             continue;
           }
-          RunResult& result = results[k];
-          result.summary = GetSummary(&in);
-          result.angles_rad = in.GetMatrix();
-          result.variant_angles_rad.resize(in.Get<std::uint64_t>());
-          for (Eigen::MatrixXd& v : result.variant_angles_rad) v = in.GetMatrix();
+          results[k] = GetResult(&in);
           finish(k);
         }
         o.runs.clear();
@@ -434,6 +323,7 @@ class MpiBackend final : public SimulationBackend {
       if (!progressed) std::this_thread::sleep_for(kPollInterval);
     }
     for (std::thread& t : pool) t.join();
+    job_->batch_s += std::chrono::duration<double>(Clock::now() - batch_start).count();
     if (failed) throw std::runtime_error(error);
     return results;
   }
@@ -464,13 +354,8 @@ void Serve(const Job& job) {
     std::vector<RunRequest> requests;
     for (auto count = in.Get<std::uint64_t>(); count > 0; --count) {
       ids.push_back(in.Get<std::uint64_t>());
-      RunRequest q;
-      q.experiment = in.Get<std::uint64_t>();
-      CCSRM_CHECK(q.experiment < experiments.size());
-      q.parameters = GetParameters(&in);
-      q.measurement_variants.resize(in.Get<std::uint64_t>());
-      for (sim::ArmParameters& v : q.measurement_variants) v = GetParameters(&in);
-      requests.push_back(std::move(q));
+      requests.push_back(GetRequest(&in));
+      CCSRM_CHECK(requests.back().experiment < experiments.size());
     }
     if (lose.rank == rank && runs >= lose.runs) {
       if (!lose.hang) _exit(9);
@@ -497,10 +382,7 @@ void Serve(const Job& job) {
         out.PutString(errors[k]);
         continue;
       }
-      PutSummary(results[k].summary, &out);
-      out.PutMatrix(results[k].angles_rad);
-      out.Put<std::uint64_t>(results[k].variant_angles_rad.size());
-      for (const Eigen::MatrixXd& v : results[k].variant_angles_rad) out.PutMatrix(v);
+      PutResult(results[k], &out);
     }
     MPI_Send(out.bytes().data(), static_cast<int>(out.bytes().size()), MPI_CHAR, 0, kResults,
              MPI_COMM_WORLD);
@@ -567,7 +449,9 @@ int MpiRanks() { return ranks; }
 std::vector<std::shared_ptr<SimulationBackend>> ShareRuns(
     const std::vector<const std::vector<Experiment>*>& sets, const MpiOptions& options) {
   CheckOptions(options);
-  if (!started || ranks == 1) return ThreadBackends(sets, options.threads);
+  // Under mpirun even one rank goes through here (the same runs on its
+  // threads), for the closing line's figures.
+  if (!started) return ThreadBackends(sets, options.threads);
   auto job = std::make_shared<Job>();
   job->sets = sets;
   job->options = options;

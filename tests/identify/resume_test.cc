@@ -1,7 +1,7 @@
-// `ccsrm identify --resume` (issue 29): a fit killed with SIGKILL at a random
-// moment after its first checkpoint, then resumed, ends with the fit of an
-// uninterrupted run, to the bit, repeating at most one iteration's runs; a
-// checkpoint of other options or another version is refused with one line.
+// `ccsrm identify --resume` and `ccsrm loop --resume` (issue 29): a fit killed with SIGKILL at a
+// random moment after its first checkpoint, then resumed, ends with the fit of an uninterrupted
+// run, to the bit, repeating at most one iteration's runs; a checkpoint of other options or another
+// version is refused with one line.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -131,6 +132,82 @@ TEST(IdentifyResume, AFitKilledAtARandomMomentResumesToTheSameResult) {
   EXPECT_EQ(ccsrm::ReadTextFile(whole + "/long.angles.csv"),
             ccsrm::ReadTextFile(stopped + "/long.angles.csv"));
   EXPECT_FALSE(fs::exists(stopped + "/checkpoint.json")) << "the resumed fit is done";
+}
+
+// `ccsrm loop --resume`: the loop runs again over the journal of its runs.
+// Killed at a random moment once its first batch is on disk, then resumed:
+// the same loop.json, every recorded run taken from the journal, and no run
+// simulated beyond those the uninterrupted loop ran (the runs lost with the
+// kill are those of the batch in flight, which the journal never held).
+TEST(LoopResume, ALoopKilledAtARandomMomentResumesToTheSameResult) {
+  const fs::path dir = ScratchDirectory("loop_resume");
+  const std::string arm = std::string(CCSRM_SOURCE_DIR) + "/datasets/samples/loop/arm.yaml";
+  std::string paths[3];
+  const char* files[] = {"long.h5", "short.h5", "held.h5"};
+  const char* durations[] = {"1.5", "1", "1"};
+  for (int i = 0; i < 3; ++i) {
+    paths[i] = (dir / files[i]).string();
+    const Outcome g =
+        RunCcsrm("generate --config " + arm + " --case 4 --duration " + durations[i] +
+                 " --set T_p=60 --seed " + std::to_string(7 + i) + " --quiet --out " + paths[i]);
+    ASSERT_EQ(g.status, 0) << g.all();
+  }
+  const std::string loop = "loop --data " + paths[0] + " " + paths[1] + " --holdout " + paths[2] +
+                           " --free T_p --candidates joint_friction --max-rounds 1 "
+                           "--max-iterations 3 --threads 2 --quiet --out ";
+  const std::string whole = (dir / "whole").string();
+  const auto t0 = Clock::now();
+  const Outcome w = RunCcsrm(loop + whole);
+  const double whole_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  ASSERT_EQ(w.status, 0) << w.all();
+  EXPECT_FALSE(fs::exists(whole + "/runs.journal")) << "a finished loop leaves no journal";
+  const auto runs = [](const std::string& out, long long* simulated, long long* replayed) {
+    const std::size_t at = out.find("runs: ");
+    return at != std::string::npos &&
+           std::sscanf(out.c_str() + at, "runs: %lld simulated, %lld taken", simulated, replayed) ==
+               2;
+  };
+  long long whole_simulated = 0, whole_replayed = 0;
+  ASSERT_TRUE(runs(w.out, &whole_simulated, &whole_replayed)) << w.out;
+  EXPECT_EQ(whole_replayed, 0);
+
+  const std::string stopped = (dir / "stopped").string();
+  const unsigned seed = std::random_device{}();
+  std::mt19937 random(seed);
+  const double delay_s = std::uniform_real_distribution<double>(0.0, 0.5 * whole_s)(random);
+  SCOPED_TRACE("seed " + std::to_string(seed) + ", killed " + std::to_string(delay_s) +
+               " s after the first batch was recorded");
+  const pid_t pid = Launch(loop + stopped);
+  const std::string journal = stopped + "/runs.journal";
+  const auto deadline = Clock::now() + std::chrono::seconds(120);  // guards a hung test only
+  while (!(fs::exists(journal) && fs::file_size(journal) > 0) && Clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_TRUE(fs::exists(journal)) << "no journal was written";
+  std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
+  ASSERT_EQ(kill(pid, SIGKILL), 0);
+  int raw = 0;
+  waitpid(pid, &raw, 0);
+  ASSERT_TRUE(WIFSIGNALED(raw)) << "the loop ended before it was killed";
+  EXPECT_FALSE(fs::exists(stopped + "/loop.json"));
+
+  const Outcome refused = RunCcsrm(loop + stopped + " --resume --set mu_c=0.1");
+  EXPECT_EQ(refused.status, 2) << refused.all();
+  EXPECT_EQ(CountLines(refused.err), 1) << refused.err;
+  EXPECT_THAT(refused.err, HasSubstr("other data or options"));
+
+  const Outcome r = RunCcsrm(loop + stopped + " --resume");
+  ASSERT_EQ(r.status, 0) << r.all();
+  long long simulated = 0, replayed = 0;
+  ASSERT_TRUE(runs(r.out, &simulated, &replayed)) << r.out;
+  EXPECT_GT(replayed, 0) << "the recorded runs are taken, not simulated again";
+  EXPECT_EQ(simulated + replayed, whole_simulated) << "no run beyond the uninterrupted loop's";
+  nlohmann::json a = nlohmann::json::parse(ccsrm::ReadTextFile(whole + "/loop.json"));
+  nlohmann::json b = nlohmann::json::parse(ccsrm::ReadTextFile(stopped + "/loop.json"));
+  DropMachineFields(&a);
+  DropMachineFields(&b);
+  EXPECT_EQ(a, b) << nlohmann::json::diff(a, b).dump(1);
+  EXPECT_FALSE(fs::exists(journal)) << "the resumed loop is done";
 }
 
 }  // namespace
