@@ -12,11 +12,13 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "run_ccsrm.h"
+#include "same_result.h"
 
 namespace {
 namespace fs = std::filesystem;
 using ccsrm::testing::CountLines;
 using ccsrm::testing::RunCcsrm;
+using ccsrm::testing::RunCommand;
 using ccsrm::testing::ScratchDirectory;
 using ::testing::HasSubstr;
 using Outcome = ccsrm::testing::CommandOutcome;
@@ -42,32 +44,10 @@ bool MpiMissing(std::string* why) {
   return !why->empty();
 }
 
-// Runs `command` (a whole command line) through the shell, as RunCcsrm runs ccsrm.
-Outcome RunShell(const std::string& command) {
-  std::string err_path = (fs::temp_directory_path() / "ccsrm_mpi_test_XXXXXX").string();
-  const int fd = mkstemp(err_path.data());
-  if (fd >= 0) close(fd);
-  Outcome outcome;
-  FILE* pipe = popen((command + " 2>" + err_path).c_str(), "r");
-  if (pipe == nullptr) return outcome;
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof(buffer), pipe) != nullptr) outcome.out += buffer;
-  const int raw = pclose(pipe);
-  outcome.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  outcome.err = ccsrm::ReadTextFile(err_path);
-  fs::remove(err_path);
-  return outcome;
-}
-
 // What differs between two runs of the same fit by design: clocks, and how
 // many runs went at a time.
 void DropMachineFields(nlohmann::json* j) {
-  if (j->is_object()) {
-    for (const char* key : {"wall_time_s", "real_time_factor", "threads"}) j->erase(key);
-    for (auto& [key, value] : j->items()) DropMachineFields(&value);
-  } else if (j->is_array()) {
-    for (auto& value : *j) DropMachineFields(&value);
-  }
+  ccsrm::testing::DropKeys(j, {"wall_time_s", "real_time_factor", "threads"});
 }
 
 // Two experiments of different lengths (so the ranks get unequal work) of
@@ -103,7 +83,7 @@ TEST(MpiIdentify, ThreeRanksGiveTheThreadBackendsFitToTheBit) {
   const std::string ranks_out = (fit.dir / "ranks").string();
   const Outcome t = RunCcsrm(fit.args + " --out " + threads_out);
   ASSERT_TRUE(t.status == 0 || t.status == 4) << t.all();
-  const Outcome m = RunShell(Mpirun(3) + " " + fit.args + " --out " + ranks_out);
+  const Outcome m = RunCommand(Mpirun(3) + " " + fit.args + " --out " + ranks_out);
   ASSERT_EQ(m.status, t.status) << m.all();
   EXPECT_THAT(m.out, HasSubstr("runs on 3 MPI ranks"));
   // Printed once (rank 0), not once per rank.
@@ -136,7 +116,7 @@ void ExpectLostRankEndsTheJob(const std::string& mode) {
   setenv("CCSRM_MPI_TEST_LOSE_RANK", ("2:3:" + mode).c_str(), 1);
   // `timeout` only guards the test against a job that hangs (its 124 fails it).
   const Outcome m =
-      RunShell("timeout 300 " + Mpirun(3) + " " + fit.args + " --run-timeout 5 --out " + out);
+      RunCommand("timeout 300 " + Mpirun(3) + " " + fit.args + " --run-timeout 5 --out " + out);
   unsetenv("CCSRM_MPI_TEST_LOSE_RANK");
   EXPECT_EQ(m.status, 7) << m.all();
   EXPECT_EQ(CountLines(m.err), 1) << m.err;

@@ -18,6 +18,7 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "run_ccsrm.h"
+#include "same_result.h"
 
 namespace {
 namespace fs = std::filesystem;
@@ -31,14 +32,7 @@ using Clock = std::chrono::steady_clock;
 // What differs between two runs of the same fit by design: clocks, threads,
 // and the runs a resumed fit repeats (counted apart).
 void DropMachineFields(nlohmann::json* j) {
-  if (j->is_object()) {
-    for (const char* key : {"wall_time_s", "real_time_factor", "threads", "simulations"}) {
-      j->erase(key);
-    }
-    for (auto& [key, value] : j->items()) DropMachineFields(&value);
-  } else if (j->is_array()) {
-    for (auto& value : *j) DropMachineFields(&value);
-  }
+  ccsrm::testing::DropKeys(j, {"wall_time_s", "real_time_factor", "threads", "simulations"});
 }
 
 // `ccsrm <args>` in the background, output discarded; its pid.
