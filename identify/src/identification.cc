@@ -954,6 +954,13 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     }
     summary.iterations =
         progress.iterations_before() + static_cast<int>(ceres_summary.iterations.size()) - 1;
+    // Ceres counts only the iterations since the resume in its message.
+    const std::string counted = "Number of iterations: ";
+    if (const std::size_t at = summary.message.find(counted);
+        resume != nullptr && at != std::string::npos) {
+      summary.message =
+          summary.message.substr(0, at) + counted + std::to_string(summary.iterations) + ".";
+    }
     simulations_before = progress.simulations_before();
     summary.initial_cost = ceres_summary.initial_cost;
     summary.final_cost = ceres_summary.final_cost;

@@ -5,6 +5,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -58,29 +60,36 @@ struct SmallFit {
   std::string args;
 };
 
-SmallFit MakeSmallFit(const std::string& name) {
-  SmallFit fit;
-  fit.dir = ScratchDirectory(name);
-  const std::string arm = std::string(CCSRM_SOURCE_DIR) + "/datasets/samples/loop/arm.yaml";
-  std::string data;
-  for (const auto& [file, duration, seed] :
-       {std::tuple{"long.h5", "1.5", "7"}, std::tuple{"short.h5", "1", "8"}}) {
-    const std::string path = (fit.dir / file).string();
-    const Outcome g = RunCcsrm("generate --config " + arm + " --case 4 --duration " + duration +
-                               " --set T_p=60 --seed " + seed + " --quiet --out " + path);
-    EXPECT_EQ(g.status, 0) << g.all();
-    data += " " + path;
-  }
-  fit.args = "identify --data" + data + " --free T_p,c_sc --max-iterations 3 --threads 1 --quiet";
-  return fit;
+// Generated once per test program; each test writes its own output folder.
+const SmallFit& MakeSmallFit() {
+  static const SmallFit made = [] {
+    SmallFit fit;
+    // Per process: CTest may run this program's tests at once.
+    fit.dir = ScratchDirectory("mpi_small_fit_" + std::to_string(getpid()));
+    const std::string arm = std::string(CCSRM_SOURCE_DIR) + "/datasets/samples/loop/arm.yaml";
+    std::string data;
+    for (const auto& [file, duration, seed] :
+         {std::tuple{"long.h5", "1.5", "7"}, std::tuple{"short.h5", "1", "8"}}) {
+      const std::string path = (fit.dir / file).string();
+      const Outcome g = RunCcsrm("generate --config " + arm + " --case 4 --duration " + duration +
+                                 " --set T_p=60 --seed " + seed + " --quiet --out " + path);
+      EXPECT_EQ(g.status, 0) << g.all();
+      data += " " + path;
+    }
+    fit.args = "identify --data" + data + " --free T_p,c_sc --max-iterations 3 --threads 1 --quiet";
+    return fit;
+  }();
+  return made;
 }
 
 TEST(MpiIdentify, ThreeRanksGiveTheThreadBackendsFitToTheBit) {
   std::string why;
   if (MpiMissing(&why)) GTEST_SKIP() << why;
-  const SmallFit fit = MakeSmallFit("mpi_same_fit");
+  const SmallFit& fit = MakeSmallFit();
   const std::string threads_out = (fit.dir / "threads").string();
+  fs::remove_all(threads_out);
   const std::string ranks_out = (fit.dir / "ranks").string();
+  fs::remove_all(ranks_out);
   const Outcome t = RunCcsrm(fit.args + " --out " + threads_out);
   ASSERT_TRUE(t.status == 0 || t.status == 4) << t.all();
   const Outcome m = RunCommand(Mpirun(3) + " " + fit.args + " --out " + ranks_out);
@@ -111,8 +120,8 @@ TEST(MpiIdentify, ThreeRanksGiveTheThreadBackendsFitToTheBit) {
 void ExpectLostRankEndsTheJob(const std::string& mode) {
   std::string why;
   if (MpiMissing(&why)) GTEST_SKIP() << why;
-  const SmallFit fit = MakeSmallFit("mpi_lost_rank_" + mode);
-  const std::string out = (fit.dir / "fit").string();
+  const SmallFit& fit = MakeSmallFit();
+  const std::string out = (fit.dir / ("lost_" + mode)).string();
   setenv("CCSRM_MPI_TEST_LOSE_RANK", ("2:3:" + mode).c_str(), 1);
   // `timeout` only guards the test against a job that hangs (its 124 fails it).
   const Outcome m =

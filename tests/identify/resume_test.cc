@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
@@ -47,6 +48,25 @@ pid_t Launch(const std::string& args) {
   return pid;
 }
 
+// Runs `ccsrm <args>` and kills it with SIGKILL `delay_s` after `ready`
+// holds (polled; 120 s at most, which only guards a hung test). False, with
+// *why, when `ready` never held or the command ended before the kill.
+bool KillWhenReady(const std::string& args, const std::function<bool()>& ready, double delay_s,
+                   std::string* why) {
+  const pid_t pid = Launch(args);
+  const auto deadline = Clock::now() + std::chrono::seconds(120);
+  while (!ready() && Clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (!ready()) *why = "it never got to the point of the kill";
+  std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
+  kill(pid, SIGKILL);
+  int raw = 0;
+  waitpid(pid, &raw, 0);
+  if (why->empty() && !WIFSIGNALED(raw)) *why = "it ended before it was killed";
+  return why->empty();
+}
+
 TEST(IdentifyResume, AFitKilledAtARandomMomentResumesToTheSameResult) {
   const fs::path dir = ScratchDirectory("identify_resume");
   // Two short recordings of the loop sample's arm (its first seconds ramp
@@ -62,7 +82,7 @@ TEST(IdentifyResume, AFitKilledAtARandomMomentResumesToTheSameResult) {
     data += " " + path;
   }
   const std::string fit =
-      "identify --data" + data + " --free T_p,c_sc --max-iterations 4 --threads 2 --quiet --out ";
+      "identify --data" + data + " --free T_p,c_sc --max-iterations 3 --threads 2 --quiet --out ";
   const std::string whole = (dir / "whole").string();
   const auto t0 = Clock::now();
   const Outcome w = RunCcsrm(fit + whole);
@@ -78,17 +98,10 @@ TEST(IdentifyResume, AFitKilledAtARandomMomentResumesToTheSameResult) {
   const double delay_s = std::uniform_real_distribution<double>(0.0, 0.6 * whole_s)(random);
   SCOPED_TRACE("seed " + std::to_string(seed) + ", killed " + std::to_string(delay_s) +
                " s after the first checkpoint");
-  const pid_t pid = Launch(fit + stopped);
-  const auto deadline = Clock::now() + std::chrono::seconds(120);  // guards a hung test only
-  while (!fs::exists(stopped + "/checkpoint.json") && Clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  ASSERT_TRUE(fs::exists(stopped + "/checkpoint.json")) << "no checkpoint was written";
-  std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
-  ASSERT_EQ(kill(pid, SIGKILL), 0);
-  int raw = 0;
-  waitpid(pid, &raw, 0);
-  ASSERT_TRUE(WIFSIGNALED(raw)) << "the fit ended before it was killed";
+  std::string why;
+  ASSERT_TRUE(KillWhenReady(
+      fit + stopped, [&] { return fs::exists(stopped + "/checkpoint.json"); }, delay_s, &why))
+      << why;
   EXPECT_FALSE(fs::exists(stopped + "/fit.json"));
   const nlohmann::json saved =
       nlohmann::json::parse(ccsrm::ReadTextFile(stopped + "/checkpoint.json"));
@@ -171,18 +184,12 @@ TEST(LoopResume, ALoopKilledAtARandomMomentResumesToTheSameResult) {
   const double delay_s = std::uniform_real_distribution<double>(0.0, 0.5 * whole_s)(random);
   SCOPED_TRACE("seed " + std::to_string(seed) + ", killed " + std::to_string(delay_s) +
                " s after the first batch was recorded");
-  const pid_t pid = Launch(loop + stopped);
   const std::string journal = stopped + "/runs.journal";
-  const auto deadline = Clock::now() + std::chrono::seconds(120);  // guards a hung test only
-  while (!(fs::exists(journal) && fs::file_size(journal) > 0) && Clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  ASSERT_TRUE(fs::exists(journal)) << "no journal was written";
-  std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
-  ASSERT_EQ(kill(pid, SIGKILL), 0);
-  int raw = 0;
-  waitpid(pid, &raw, 0);
-  ASSERT_TRUE(WIFSIGNALED(raw)) << "the loop ended before it was killed";
+  std::string why;
+  ASSERT_TRUE(KillWhenReady(
+      loop + stopped, [&] { return fs::exists(journal) && fs::file_size(journal) > 0; }, delay_s,
+      &why))
+      << why;
   EXPECT_FALSE(fs::exists(stopped + "/loop.json"));
 
   const Outcome refused = RunCcsrm(loop + stopped + " --resume --set mu_c=0.1");
