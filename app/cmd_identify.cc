@@ -37,7 +37,22 @@ struct IdentifyArgs {
   bool central_throughout = false;
   std::string out;
   bool quiet = false;
+  double run_timeout_s = identify::MpiOptions().run_timeout_s;
+  bool resume = false;
 };
+
+// What decides the fit's result besides the files' bytes (not --threads,
+// --quiet, --run-timeout or the number of ranks: the result is the same).
+std::string ResultOptions(const IdentifyArgs& a) {
+  std::string text = "free=" + a.free.value_or("(default)") + "\nsets=";
+  for (const std::string& s : a.set) text += s + ",";
+  char numbers[160];
+  std::snprintf(numbers, sizeof(numbers),
+                "\nmax_iterations=%d relative_step=%.17g "
+                "noise_deg=%.17g central=%d",
+                a.max_iterations, a.relative_step, a.noise_deg, a.central_throughout ? 1 : 0);
+  return text + numbers;
+}
 
 int RunIdentify(const IdentifyArgs& a) {
   // Everything is checked before the first simulation: options, output path,
@@ -53,8 +68,19 @@ int RunIdentify(const IdentifyArgs& a) {
   std::vector<std::string> inputs = a.data;
   inputs.push_back(a.params);
   CheckOut(a.out, FitFolderOutput(), inputs);
+  const CheckpointKey key = MakeCheckpointKey("identify", ResultOptions(a), inputs);
+  if (a.resume) {
+    options.resume = std::make_shared<identify::FitCheckpoint>(
+        identify::FitCheckpointFromJson(ReadCheckpoint(a.out, key), CheckpointPath(a.out)));
+  }
+  options.on_checkpoint = [&](const identify::FitCheckpoint& c) {
+    WriteCheckpoint(a.out, key, identify::ToJson(c));
+  };
   std::vector<identify::Experiment> experiments =
       LoadExperiments(a.data, a.noise_deg, "experiment");
+  const auto backends = RunBackends({&experiments}, a.threads, a.run_timeout_s);
+  if (backends.empty()) return 0;  // another rank of an MPI job: it served rank 0's runs
+  options.backend = backends.front();
   std::string free_list;
   for (const std::string& n : options.free_parameters)
     free_list += (free_list.empty() ? "" : ", ") + n;
@@ -65,6 +91,7 @@ int RunIdentify(const IdentifyArgs& a) {
   const identify::IdentificationSummary summary = identify::Identify(experiments, options);
   std::printf("%s", summary.FullReport().c_str());
   const std::vector<std::string> written = identify::WriteFitDirectory(summary, experiments, a.out);
+  RemoveCheckpoint(a.out);  // the fit is there now
   std::printf("  output: %s (%zu files)\n", a.out.c_str(), written.size());
   switch (summary.termination) {
     case identify::IdentificationTermination::kConverged:
@@ -118,6 +145,10 @@ void AddIdentifyCommand(CLI::App& root) {
       ->check(Above(0.0, "deg"));
   cmd->add_option("--out", a->out, "Output folder")->required();
   cmd->add_flag("--quiet", a->quiet, "No progress lines");
+  AddRunTimeoutOption(cmd, &a->run_timeout_s);
+  cmd->add_flag("--resume", a->resume,
+                "Continue the fit stopped in --out from its checkpoint (written after every "
+                "accepted iteration); refused for other data, options or version");
   cmd->callback([a] {
     const int code = RunIdentify(*a);
     if (code != 0) throw CLI::RuntimeError(code);

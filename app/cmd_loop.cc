@@ -2,12 +2,14 @@
 //            [--free ...] [--params p.yaml] [--set name=value ...] [--config arm.yaml]
 //            [--threads N] --out loop/
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/identify/loop.h"
+#include "ccsrm/identify/run_journal.h"
 #include "commands.h"
 #include "fit_inputs.h"
 #include "option_checks.h"
@@ -30,7 +32,27 @@ struct LoopArgs {
   double noise_deg = 0.0;  // 0: estimated
   std::string out;
   bool quiet = false;
+  double run_timeout_s = identify::MpiOptions().run_timeout_s;
+  bool resume = false;
 };
+
+// What decides the loop's result besides the files' bytes (not --threads,
+// --quiet, --run-timeout or the number of ranks).
+std::string ResultOptions(const LoopArgs& a) {
+  std::string text = "data=" + std::to_string(a.data.size()) +
+                     " holdout=" + std::to_string(a.holdout.size()) +
+                     "\ncandidates=" + a.candidates.value_or("(default)") +
+                     "\nfree=" + a.free.value_or("(default)") + "\nsets=";
+  for (const std::string& s : a.set) text += s + ",";
+  char numbers[128];
+  std::snprintf(numbers, sizeof(numbers), "\nmax_rounds=%d max_iterations=%d noise_deg=%.17g",
+                a.max_rounds, a.max_iterations, a.noise_deg);
+  return text + numbers;
+}
+
+std::string JournalPath(const std::string& out) {
+  return (std::filesystem::path(out) / "runs.journal").string();
+}
 
 int RunLoop(const LoopArgs& a) {
   identify::LoopOptions options;
@@ -46,10 +68,23 @@ int RunLoop(const LoopArgs& a) {
   inputs.push_back(a.params);
   inputs.push_back(a.config);
   CheckOut(a.out, LoopFolderOutput(), inputs);
+  // A loop is resumed by running it again over the journal of its runs.
+  const CheckpointKey key = MakeCheckpointKey("loop", ResultOptions(a), inputs);
+  if (a.resume) ReadCheckpoint(a.out, key);  // refuses other data, options or version
   const std::vector<identify::Experiment> training =
       LoadExperiments(a.data, a.noise_deg, "training", a.config);
   const std::vector<identify::Experiment> holdout =
       LoadExperiments(a.holdout, a.noise_deg, "held out", a.config);
+  const auto backends = RunBackends({&training, &holdout}, a.threads, a.run_timeout_s);
+  if (backends.empty()) return 0;  // another rank of an MPI job: it served rank 0's runs
+  WriteCheckpoint(a.out, key, {{"runs_journal", "runs.journal"}});
+  const auto journal = std::make_shared<identify::RunJournal>(JournalPath(a.out), a.resume);
+  if (a.resume) {
+    std::printf("resuming: %lld runs recorded in %s\n", static_cast<long long>(journal->recorded()),
+                journal->path().c_str());
+  }
+  options.fit.backend = identify::WithJournal(backends[0], journal, 0);
+  options.holdout_backend = identify::WithJournal(backends[1], journal, 1);
 
   std::string free_list;
   for (const std::string& n : options.fit.free_parameters)
@@ -71,6 +106,12 @@ int RunLoop(const LoopArgs& a) {
   const std::vector<std::string> written =
       identify::WriteLoopDirectory(summary, training, holdout, a.out);
   std::printf("  output: %s (%zu files)\n", a.out.c_str(), written.size());
+  // The loop is there now: its journal and checkpoint are not needed.
+  std::printf("  runs: %lld simulated, %lld taken from the journal of a stopped run\n",
+              static_cast<long long>(journal->simulated()),
+              static_cast<long long>(journal->replayed()));
+  RemoveCheckpoint(a.out);
+  std::filesystem::remove(JournalPath(a.out));
   if (summary.declared.termination == identify::IdentificationTermination::kFailed) {
     std::fprintf(stderr, "ccsrm: the declared model's fit failed: %s (outputs written)\n",
                  summary.declared.message.c_str());
@@ -120,6 +161,10 @@ void AddLoopCommand(CLI::App& root) {
       ->check(Above(0.0, "deg"));
   cmd->add_option("--out", a->out, "Output folder")->required();
   cmd->add_flag("--quiet", a->quiet, "No progress lines");
+  AddRunTimeoutOption(cmd, &a->run_timeout_s);
+  cmd->add_flag("--resume", a->resume,
+                "Continue the loop stopped in --out: it runs again, taking every run it had done "
+                "from its journal (runs.journal); refused for other data, options or version");
   cmd->callback([a] {
     const int code = RunLoop(*a);
     if (code != 0) throw CLI::RuntimeError(code);

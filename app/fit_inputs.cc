@@ -1,10 +1,13 @@
 #include "fit_inputs.h"
 
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/version.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/parameters.h"
 #include "option_checks.h"
@@ -75,6 +78,113 @@ identify::RunFinishedCallback RunProgress() {
                  r.summary.wall_time_s);
     if (finished == total) std::fprintf(stderr, "\r%-60s\r", "");
   };
+}
+
+void AddRunTimeoutOption(CLI::App* command, double* run_timeout_s) {
+  command
+      ->add_option("--run-timeout", *run_timeout_s,
+                   "Under mpirun: seconds a rank may take over one run before the job ends "
+                   "with one line and exit status 7 (docs/cluster.md)")
+      ->capture_default_str()
+      ->check(Above(0.0, "s"));
+}
+
+std::vector<std::shared_ptr<identify::SimulationBackend>> RunBackends(
+    const std::vector<const std::vector<identify::Experiment>*>& sets, int threads,
+    double run_timeout_s) {
+  identify::MpiOptions mpi;
+  mpi.threads = threads;
+  mpi.run_timeout_s = run_timeout_s;
+  std::vector<std::shared_ptr<identify::SimulationBackend>> backends =
+      identify::ShareRuns(sets, mpi);
+  if (!backends.empty() && identify::MpiRanks() > 1) {
+    std::printf("runs on %d MPI ranks, %d at a time\n", identify::MpiRanks(),
+                backends.front()->parallelism());
+  }
+  return backends;
+}
+
+namespace {
+
+constexpr const char* kCheckpointSchema = "ccsrm-checkpoint/1";
+
+// 64-bit FNV-1a: a change of any byte changes the digest (not a defence
+// against forgery; it tells runs apart).
+void Digest(const char* data, std::size_t n, std::uint64_t* h) {
+  for (std::size_t i = 0; i < n; ++i) {
+    *h ^= static_cast<unsigned char>(data[i]);
+    *h *= 1099511628211ULL;
+  }
+}
+
+}  // namespace
+
+CheckpointKey MakeCheckpointKey(const std::string& command, const std::string& options_text,
+                                const std::vector<std::string>& input_files) {
+  std::uint64_t h = 14695981039346656037ULL;
+  for (const std::string& part : {std::string(kVersion), command, options_text}) {
+    Digest(part.data(), part.size() + 1, &h);  // with its terminator: parts stay apart
+  }
+  for (const std::string& file : input_files) {
+    if (file.empty()) continue;
+    std::ifstream in(file, std::ios::binary);
+    char buffer[1 << 16];
+    while (in.read(buffer, sizeof(buffer)) || in.gcount() > 0) {
+      Digest(buffer, static_cast<std::size_t>(in.gcount()), &h);
+    }
+  }
+  char text[17];
+  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(h));
+  return {command, text};
+}
+
+std::string CheckpointPath(const std::string& out) {
+  return (fs::path(out) / "checkpoint.json").string();
+}
+
+nlohmann::json ReadCheckpoint(const std::string& out, const CheckpointKey& key) {
+  const std::string path = CheckpointPath(out);
+  if (!fs::exists(path)) {
+    ThrowInputError(path, "--resume",
+                    "no checkpoint here: nothing to resume (run without --resume)");
+  }
+  const nlohmann::json json = nlohmann::json::parse(ReadTextFile(path), nullptr, false);
+  if (!json.is_object() || json.value("schema", "") != kCheckpointSchema) {
+    ThrowInputError(path, "schema", std::string("not a ") + kCheckpointSchema + " file");
+  }
+  const std::string refuse = "; refusing to resume (run without --resume to start over)";
+  if (json.value("command", "") != key.command) {
+    ThrowInputError(path, "command",
+                    "the checkpoint is of `ccsrm " + json.value("command", "") + "`" + refuse);
+  }
+  if (json.value("version", "") != kVersion) {
+    ThrowInputError(
+        path, "version",
+        "written by ccsrm " + json.value("version", "") + ", this is " + kVersion + refuse);
+  }
+  if (json.value("inputs_digest", "") != key.digest) {
+    ThrowInputError(path, "inputs_digest",
+                    "the checkpoint is of other data or options (digest " +
+                        json.value("inputs_digest", "") + ", these give " + key.digest + ")" +
+                        refuse);
+  }
+  return json.at("state");
+}
+
+void WriteCheckpoint(const std::string& out, const CheckpointKey& key,
+                     const nlohmann::json& state) {
+  fs::create_directories(out);
+  const nlohmann::json json = {{"schema", kCheckpointSchema},
+                               {"command", key.command},
+                               {"version", kVersion},
+                               {"inputs_digest", key.digest},
+                               {"state", state}};
+  WriteTextFileAtomically(CheckpointPath(out), json.dump() + "\n");
+}
+
+void RemoveCheckpoint(const std::string& out) {
+  std::error_code ignored;
+  fs::remove(CheckpointPath(out), ignored);
 }
 
 }  // namespace ccsrm::app

@@ -5,6 +5,7 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/output_policy.h"
 #include "ccsrm/common/version.h"
+#include "ccsrm/identify/mpi_backend.h"
 #include "commands.h"
 
 namespace {
@@ -27,12 +28,18 @@ int ExitOnParseError(const CLI::App& root, const CLI::ParseError& e) {
   return 2;
 }
 
-}  // namespace
+// The commands whose runs go to every rank of an MPI job (docs/cluster.md).
+bool SharesRuns(const std::string& command) { return command == "identify" || command == "loop"; }
 
-int main(int argc, char** argv) {
-  // Before any thread starts: Ctrl-C or a scheduler's SIGTERM removes the
-  // temporaries of unfinished outputs (docs/conventions.md, "Outputs").
-  ccsrm::RemoveTemporariesOnInterrupt();
+int Run(int argc, char** argv) {
+  const std::string command = argc > 1 ? argv[1] : "";
+  if (ccsrm::identify::MpiRanks() > 1 && !SharesRuns(command)) {
+    // Every rank would run it and write the same outputs: rank 0 alone does.
+    if (ccsrm::identify::MpiRank() > 0) return 0;
+    std::fprintf(stderr,
+                 "ccsrm: note: %s does not spread its runs over MPI ranks; rank 0 runs it alone\n",
+                 command.c_str());
+  }
   CLI::App root{"ccsrm: simulate, measure and identify cable-driven continuum manipulators"};
   root.set_version_flag("--version", ccsrm::kVersion);
   root.require_subcommand(1);
@@ -61,4 +68,16 @@ int main(int argc, char** argv) {
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Before any thread starts: Ctrl-C or a scheduler's SIGTERM removes the
+  // temporaries of unfinished outputs (docs/conventions.md, "Outputs").
+  ccsrm::RemoveTemporariesOnInterrupt();
+  ccsrm::identify::StartMpi(&argc, &argv);
+  const int status = Run(argc, argv);
+  ccsrm::identify::StopMpi(status);
+  return status;
 }

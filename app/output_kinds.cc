@@ -80,13 +80,19 @@ OutputKind DerivativesJsonOutput() {
 }
 
 OutputKind FitFolderOutput() {
-  return {"ccsrm fit folder (fit.json, ccsrm-fit/1)", true,
-          [](const std::string& p) { return FolderJsonHasSchema(p, "fit.json", "ccsrm-fit/1"); }};
+  return {"ccsrm fit folder (fit.json, ccsrm-fit/1)", true, [](const std::string& p) {
+            // Or one a stopped fit left its checkpoint in (--resume).
+            return FolderJsonHasSchema(p, "fit.json", "ccsrm-fit/1") ||
+                   FolderJsonHasSchema(p, "checkpoint.json", "ccsrm-checkpoint/1");
+          }};
 }
 
 OutputKind LoopFolderOutput() {
-  return {"ccsrm loop folder (loop.json, ccsrm-loop/1)", true,
-          [](const std::string& p) { return FolderJsonHasSchema(p, "loop.json", "ccsrm-loop/1"); }};
+  return {"ccsrm loop folder (loop.json, ccsrm-loop/1)", true, [](const std::string& p) {
+            // Or one a stopped loop left its checkpoint in (--resume).
+            return FolderJsonHasSchema(p, "loop.json", "ccsrm-loop/1") ||
+                   FolderJsonHasSchema(p, "checkpoint.json", "ccsrm-checkpoint/1");
+          }};
 }
 
 OutputKind PredictionFolderOutput() {

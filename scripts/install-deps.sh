@@ -5,6 +5,8 @@
 # them headless for the report screenshot test, which skips without it.
 # python3-dev and python3-pybind11 build the Python module (python/), whose
 # tests and examples use python3-pytest, -numpy, -h5py and -matplotlib.
+# libopenmpi-dev and openmpi-bin run identification over MPI (docs/cluster.md);
+# without them everything runs on threads and the MPI tests skip.
 set -euo pipefail
 
 packages=(
@@ -14,6 +16,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-h5py python3-numpy python3-dev python3-pybind11 python3-pytest python3-matplotlib
   chromium
+  libopenmpi-dev openmpi-bin
 )
 
 missing=()

@@ -429,16 +429,30 @@ std::string StepRuleMessage(double fraction) {
 
 class IterationReporter final : public ceres::IterationCallback {
  public:
+  // `checkpoint` holds what a checkpoint keeps besides the minimiser's
+  // state (its start, damping floor, and, when resuming, the iterations and
+  // simulations done before).
   IterationReporter(FitProblem* problem, const double* u, const IdentificationOptions& options,
-                    std::chrono::steady_clock::time_point start, std::vector<double>* costs)
-      : problem_(problem), u_(u), options_(options), start_(start), costs_(costs) {}
+                    std::chrono::steady_clock::time_point start, std::vector<double>* costs,
+                    FitCheckpoint checkpoint)
+      : problem_(problem),
+        u_(u),
+        options_(options),
+        start_(start),
+        costs_(costs),
+        checkpoint_(std::move(checkpoint)),
+        iterations_before_(checkpoint_.iterations),
+        simulations_before_(checkpoint_.simulations) {}
 
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    if (s.step_is_successful || s.iteration == 0) costs_->push_back(s.cost);
+    // A resumed fit's start is the checkpoint's point, whose cost is in the history.
+    const bool resumed_start = s.iteration == 0 && options_.resume;
+    if ((s.step_is_successful || s.iteration == 0) && !resumed_start) costs_->push_back(s.cost);
     Report(s);
     if (s.iteration == 0) previous_.assign(u_, u_ + problem_->num_free());
     if (s.iteration == 0 || !s.step_is_successful) {
       if (s.iteration == 0) previous_cost_ = s.cost;
+      if (s.iteration == 0 && !resumed_start) Save(s);
       return ceres::SOLVER_CONTINUE;
     }
     const bool small = StepWithinStandardErrors(s.cost);
@@ -454,13 +468,31 @@ class IterationReporter final : public ceres::IterationCallback {
                     options_.min_effective_chi2_decrease);
       stop_reason_ = text;
     }
-    return small || insignificant ? ceres::SOLVER_TERMINATE_SUCCESSFULLY : ceres::SOLVER_CONTINUE;
+    if (small || insignificant) return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+    // Only a state the fit goes on from: resumed, a state where a rule
+    // stopped the fit would not stop again (the rules judge a step).
+    Save(s);
+    return ceres::SOLVER_CONTINUE;
   }
 
   // Why the callback stopped the fit; empty when it did not.
   const std::string& stop_reason() const { return stop_reason_; }
+  int iterations_before() const { return iterations_before_; }
+  std::int64_t simulations_before() const { return simulations_before_; }
 
  private:
+  void Save(const ceres::IterationSummary& s) {
+    if (!options_.on_checkpoint) return;
+    checkpoint_.iterations = iterations_before_ + s.iteration;
+    checkpoint_.u.assign(u_, u_ + problem_->num_free());
+    checkpoint_.values = problem_->ValuesAt(u_);
+    // After an accepted step Ceres has already updated the radius for the next.
+    checkpoint_.trust_region_radius = s.trust_region_radius;
+    checkpoint_.simulations = simulations_before_ + problem_->simulations();
+    checkpoint_.cost_history = *costs_;
+    options_.on_checkpoint(checkpoint_);
+  }
+
   // The statistical stopping rule: the last step moved every free parameter
   // by less than options.converged_step_fraction of its standard error, as
   // the summary will report it (Jacobian at the new point, residual variance
@@ -514,13 +546,13 @@ class IterationReporter final : public ceres::IterationCallback {
   void Report(const ceres::IterationSummary& s) {
     if (options_.on_iteration) {
       IterationProgress p;
-      p.iteration = s.iteration;
+      p.iteration = iterations_before_ + s.iteration;
       p.cost = s.cost;
       p.rms_deg = problem_->CachedRmsDeg(u_).value_or(kNaN);
       p.relative_decrease = s.iteration == 0 ? 0.0 : s.relative_decrease;
       p.trust_region_radius = s.trust_region_radius;
       p.step_accepted = s.step_is_successful;
-      p.simulations = problem_->simulations();
+      p.simulations = simulations_before_ + problem_->simulations();
       p.wall_time_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
       const std::vector<double> values = problem_->ValuesAt(u_);
@@ -536,6 +568,9 @@ class IterationReporter final : public ceres::IterationCallback {
   const IdentificationOptions& options_;
   std::chrono::steady_clock::time_point start_;
   std::vector<double>* costs_;
+  FitCheckpoint checkpoint_;
+  int iterations_before_ = 0;
+  std::int64_t simulations_before_ = 0;
   std::vector<double> previous_;
   double previous_cost_ = 0.0;
   std::string stop_reason_;
@@ -816,7 +851,34 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
   for (std::size_t i = 0; i < free.size(); ++i) u[i] = free[i].start / free[i].scale;
 
   // The start point first: a start that does not run is an answer in itself.
-  const Evaluation start_eval = problem.Evaluate(u.data());
+  // A resumed fit has its start's runs in the checkpoint, and goes on from
+  // the checkpoint's point.
+  const FitCheckpoint* resume = options.resume.get();
+  if (resume != nullptr) {
+    if (resume->u.size() != free.size() || resume->start_angles_rad.size() != experiments.size()) {
+      ThrowInputError("identification", "resume",
+                      "the checkpoint is of another fit (free parameters or experiments)");
+    }
+    for (std::size_t e = 0; e < experiments.size(); ++e) {
+      const Eigen::MatrixXd& a = resume->start_angles_rad[e];
+      if (a.rows() != experiments[e].measured_rad.rows() ||
+          a.cols() != experiments[e].measured_rad.cols()) {
+        ThrowInputError("identification", "resume",
+                        "the checkpoint's runs do not match experiment " + experiments[e].name);
+      }
+    }
+  }
+  Evaluation start_eval;
+  if (resume == nullptr) {
+    start_eval = problem.Evaluate(u.data());
+  } else {
+    start_eval.u = u;
+    start_eval.angles_rad = resume->start_angles_rad;
+    start_eval.summaries.resize(experiments.size());
+    start_eval.residuals = problem.Residuals(start_eval.angles_rad);
+    start_eval.ok = true;
+    u = resume->u;
+  }
 
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -830,6 +892,7 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
                                          free[i].upper / free[i].scale);
   }
 
+  std::int64_t simulations_before = 0;  // a resumed fit's, before it was stopped
   if (!start_eval.ok) {
     summary.termination = IdentificationTermination::kFailed;
     summary.message = "the run at the start values did not complete: " + start_eval.failure;
@@ -849,12 +912,26 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     // scaling on, the same norms of unit columns.
     Eigen::MatrixXd start_jacobian;
     std::string ignored;  // a failed run stops the minimiser at iteration 0
-    if (options.min_relative_damping > 0.0 &&
-        problem.Jacobian(u.data(), &start_jacobian, &ignored)) {
+    if (resume != nullptr) {
+      solver.initial_trust_region_radius = resume->trust_region_radius;
+      solver.jacobi_scaling = resume->jacobi_scaling;
+      solver.min_lm_diagonal = resume->min_lm_diagonal;
+      solver.max_num_iterations = std::max(options.max_iterations - resume->iterations, 0);
+    } else if (options.min_relative_damping > 0.0 &&
+               problem.Jacobian(u.data(), &start_jacobian, &ignored)) {
       solver.jacobi_scaling = false;
       solver.min_lm_diagonal =
           std::max(options.min_relative_damping * start_jacobian.colwise().squaredNorm().maxCoeff(),
                    solver.min_lm_diagonal);
+    }
+    FitCheckpoint checkpoint;
+    if (resume != nullptr) {
+      checkpoint = *resume;
+      summary.cost_history = resume->cost_history;
+    } else {
+      checkpoint.start_angles_rad = start_eval.angles_rad;
+      checkpoint.min_lm_diagonal = solver.min_lm_diagonal;
+      checkpoint.jacobi_scaling = solver.jacobi_scaling;
     }
     solver.num_threads = 1;  // the parallelism is in the backend
     solver.logging_type = ceres::SILENT;
@@ -864,7 +941,8 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     // finite-difference Jacobian, and one bound-hugging fit spent 50
     // simulations there for no gain.
     solver.max_num_line_search_step_size_iterations = 0;
-    IterationReporter progress(&problem, u.data(), options, clock_start, &summary.cost_history);
+    IterationReporter progress(&problem, u.data(), options, clock_start, &summary.cost_history,
+                               std::move(checkpoint));
     solver.callbacks.push_back(&progress);
     ceres::Solver::Summary ceres_summary;
     ceres::Solve(solver, &ceres_problem, &ceres_summary);
@@ -874,7 +952,16 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     if (summary.termination == IdentificationTermination::kFailed && !cost.last_failure().empty()) {
       summary.message += " (" + cost.last_failure() + ")";
     }
-    summary.iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
+    summary.iterations =
+        progress.iterations_before() + static_cast<int>(ceres_summary.iterations.size()) - 1;
+    // Ceres counts only the iterations since the resume in its message.
+    const std::string counted = "Number of iterations: ";
+    if (const std::size_t at = summary.message.find(counted);
+        resume != nullptr && at != std::string::npos) {
+      summary.message =
+          summary.message.substr(0, at) + counted + std::to_string(summary.iterations) + ".";
+    }
+    simulations_before = progress.simulations_before();
     summary.initial_cost = ceres_summary.initial_cost;
     summary.final_cost = ceres_summary.final_cost;
     // Ceres leaves u at the best point it accepted.
@@ -1064,7 +1151,7 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
   }
   summary.start_errors = AngleErrors(all, start_angles);
   summary.errors = AngleErrors(all, final_angles);
-  summary.simulations = problem.simulations();
+  summary.simulations = simulations_before + problem.simulations();
   summary.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
   if (!final_eval.ok && summary.termination != IdentificationTermination::kFailed) {

@@ -225,10 +225,10 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
 
   LoopSummary summary;
   summary.options = options;
-  std::unique_ptr<SimulationBackend> training_backend =
-      MakeThreadBackend(&training, options.fit.threads);
-  std::unique_ptr<SimulationBackend> holdout_backend =
-      MakeThreadBackend(&holdout, options.fit.threads);
+  std::shared_ptr<SimulationBackend> training_backend = options.fit.backend;
+  if (!training_backend) training_backend = MakeThreadBackend(&training, options.fit.threads);
+  std::shared_ptr<SimulationBackend> holdout_backend = options.holdout_backend;
+  if (!holdout_backend) holdout_backend = MakeThreadBackend(&holdout, options.fit.threads);
   summary.threads = training_backend->parallelism();
   std::int64_t simulations = 0;
 

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "ccsrm/identify/sensitivity.h"
+#include "ccsrm/identify/simulation_backend.h"
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/parameters.h"
 #include "ccsrm/sim/protocol.h"
@@ -39,5 +40,9 @@ std::vector<RunOutcome> RunAll(const sim::ArmModel& model, const sim::CableInput
                                const sim::SimulationOptions& simulation,
                                const std::vector<RunRequest>& requests, int threads,
                                const ProgressCallback& progress);
+
+// One run of a backend's request on experiment e (every backend's runs go
+// through here, so they agree to the bit whichever backend ran them).
+RunResult RunExperiment(const Experiment& e, const identify::RunRequest& request);
 
 }  // namespace ccsrm::identify::internal

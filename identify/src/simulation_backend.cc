@@ -8,9 +8,9 @@
 #include "run_pool.h"
 
 namespace ccsrm::identify {
-namespace {
+namespace internal {
 
-RunResult RunOne(const Experiment& e, const RunRequest& request) {
+RunResult RunExperiment(const Experiment& e, const identify::RunRequest& request) {
   sim::SimulationOptions options;
   options.duration_s = e.duration_s();
   options.sample_times = e.sample_time_s;
@@ -44,6 +44,10 @@ RunResult RunOne(const Experiment& e, const RunRequest& request) {
   return out;
 }
 
+}  // namespace internal
+
+namespace {
+
 class ThreadBackend final : public SimulationBackend {
  public:
   ThreadBackend(const std::vector<Experiment>* experiments, int threads)
@@ -58,7 +62,8 @@ class ThreadBackend final : public SimulationBackend {
     internal::ForEachInParallel(
         requests.size(), threads_,
         [&](std::size_t k) {
-          results[k] = RunOne((*experiments_)[requests[k].experiment], requests[k]);
+          results[k] =
+              internal::RunExperiment((*experiments_)[requests[k].experiment], requests[k]);
         },
         [&](std::size_t k, std::size_t done) {
           if (on_finished) on_finished(done, requests.size(), results[k]);

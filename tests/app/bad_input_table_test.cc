@@ -292,6 +292,12 @@ const std::vector<BadInput>& Rows() {
        "identify --data {d}/processed.h5 --free mu, --out {d}/fit",
        {"--free", "empty"}},
       {"overrides",
+       "identify --data {d}/processed.h5 --resume --out {d}/nofit",
+       {"{d}/nofit/checkpoint.json", "--resume", "no checkpoint"}},  // issue 29
+      {"overrides",
+       "identify --data {d}/processed.h5 --run-timeout 0 --out {d}/fit",
+       {"--run-timeout"}},  // issue 29
+      {"overrides",
        "loop --data {d}/processed.h5 --candidates '' --out {d}/loop",
        {"--candidates", "empty"}},  // 3
       // A declared value of a segment the arm does not have (issue 28).

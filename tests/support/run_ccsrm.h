@@ -25,14 +25,14 @@ struct CommandOutcome {
   std::string all() const { return out + err; }
 };
 
-// `ccsrm <args>` through the shell (args are not quoted).
-inline CommandOutcome RunCcsrm(const std::string& args) {
+// A whole command line through the shell (e.g. ccsrm under mpirun).
+inline CommandOutcome RunCommand(const std::string& command_line) {
   // Per-call file for stderr: test executables run in parallel under CTest.
   std::string err_path =
       (std::filesystem::temp_directory_path() / "ccsrm_test_stderr_XXXXXX").string();
   const int fd = mkstemp(err_path.data());
   if (fd >= 0) close(fd);
-  const std::string command = std::string(CCSRM_PROGRAM) + " " + args + " 2>" + err_path;
+  const std::string command = command_line + " 2>" + err_path;
   CommandOutcome outcome;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return outcome;
@@ -43,6 +43,11 @@ inline CommandOutcome RunCcsrm(const std::string& args) {
   outcome.err = ReadTextFile(err_path);
   std::filesystem::remove(err_path);
   return outcome;
+}
+
+// `ccsrm <args>` through the shell (args are not quoted).
+inline CommandOutcome RunCcsrm(const std::string& args) {
+  return RunCommand(std::string(CCSRM_PROGRAM) + " " + args);
 }
 
 // An empty scratch directory <tmp>/ccsrm_<name> (whatever was there is removed).

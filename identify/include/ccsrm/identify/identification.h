@@ -77,6 +77,26 @@ struct IterationProgress {
   std::vector<std::pair<std::string, double>> values;  // the free parameters
 };
 
+// The state of a fit after an accepted iteration (and at its start): what
+// resuming it needs (ccsrm identify --resume; docs/cluster.md). Levenberg-
+// Marquardt after an accepted step holds only the point, the trust region
+// radius and the damping floor (Ceres resets its decrease factor on every
+// accepted step), so a fit resumed from here takes the same steps as one
+// never stopped.
+struct FitCheckpoint {
+  int iterations = 0;                // minimiser iterations done, accepted and not
+  std::vector<double> u;             // the free parameters in the scaled space, p / scale
+  std::vector<double> values;        // the same as values (for people; u is what is used)
+  double trust_region_radius = 0.0;  // Ceres' radius for the next step
+  double min_lm_diagonal = 0.0;      // the damping floor set at the start (0: Ceres' own)
+  bool jacobi_scaling = true;        // Ceres' Jacobi scaling (off with the floor)
+  std::int64_t simulations = 0;      // run so far
+  std::vector<double> cost_history;  // per accepted iteration, from the start
+  // The runs at the start values, per experiment, as Evaluation keeps them
+  // (the report's start errors), so that resuming does not run them again.
+  std::vector<Eigen::MatrixXd> start_angles_rad;
+};
+
 struct IdentificationOptions {
   // The parameters to fit, by name. Default: SPEC 6's nine (mu, mu_s, mu_c,
   // mu_c_s, beta, c_sc, c_lc, T_p, T_d0). Each Jacobian then costs 18 runs
@@ -157,6 +177,12 @@ struct IdentificationOptions {
   // Called after every iteration and after every simulation; may be empty.
   std::function<void(const IterationProgress&)> on_iteration;
   RunFinishedCallback on_run;
+  // Called at the start and after every accepted iteration with the fit's
+  // state (to be saved: ccsrm identify writes it atomically); may be empty.
+  std::function<void(const FitCheckpoint&)> on_checkpoint;
+  // Continue from a saved state of the same fit (same experiments and
+  // options) instead of the start values. Null (the default): from the start.
+  std::shared_ptr<const FitCheckpoint> resume;
 
   // False with the reason naming the field: an unknown or repeated
   // parameter name, no free parameter, bounds for a parameter that is not
@@ -326,6 +352,12 @@ void ApplyFitParameters(const std::vector<std::string>* free, const std::string&
 
 // fit.json: every number of the summary, SPEC 6 names.
 nlohmann::json ToJson(const IdentificationSummary& summary);
+
+// A checkpoint's state as JSON (numbers round-trip to the bit; an unmeasured
+// angle, NaN, as null), and back. FromJson throws InputError naming `file`
+// and the field for a state it cannot read.
+nlohmann::json ToJson(const FitCheckpoint& checkpoint);
+FitCheckpoint FitCheckpointFromJson(const nlohmann::json& json, const std::string& file);
 
 // Writes a fit directory (created if missing, files replaced atomically):
 // fit.json; per experiment <name>.fit.h5 (ccsrm-run/1 of the final run at

@@ -113,6 +113,9 @@ struct LoopOptions {
     o.free_parameters = LoopDeclaredParameterNames();
     return o;
   }();
+  // The backend of the held-out experiments (null: threads on this machine);
+  // fit.backend is the training experiments'.
+  std::shared_ptr<SimulationBackend> holdout_backend;
   // The candidate effects, by name, and "declared" for every declared value
   // of the arm. Default: every effect of the library (sim::Effects()) that
   // the declared model does not have on, and the declared values.

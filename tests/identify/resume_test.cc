@@ -1,0 +1,214 @@
+// `ccsrm identify --resume` and `ccsrm loop --resume` (issue 29): a fit killed with SIGKILL at a
+// random moment after its first checkpoint, then resumed, ends with the fit of an uninterrupted
+// run, to the bit, repeating at most one iteration's runs; a checkpoint of other options or another
+// version is refused with one line.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <string>
+#include <thread>
+
+#include "ccsrm/common/atomic_file.h"
+#include "run_ccsrm.h"
+#include "same_result.h"
+
+namespace {
+namespace fs = std::filesystem;
+using ccsrm::testing::CountLines;
+using ccsrm::testing::RunCcsrm;
+using ccsrm::testing::ScratchDirectory;
+using ::testing::HasSubstr;
+using Outcome = ccsrm::testing::CommandOutcome;
+using Clock = std::chrono::steady_clock;
+
+// What differs between two runs of the same fit by design: clocks, threads,
+// and the runs a resumed fit repeats (counted apart).
+void DropMachineFields(nlohmann::json* j) {
+  ccsrm::testing::DropKeys(j, {"wall_time_s", "real_time_factor", "threads", "simulations"});
+}
+
+// `ccsrm <args>` in the background, output discarded; its pid.
+pid_t Launch(const std::string& args) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const std::string command =
+        std::string("exec ") + CCSRM_PROGRAM + " " + args + " >/dev/null 2>&1";
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+// Runs `ccsrm <args>` and kills it with SIGKILL `delay_s` after `ready`
+// holds (polled; 120 s at most, which only guards a hung test). False, with
+// *why, when `ready` never held or the command ended before the kill.
+bool KillWhenReady(const std::string& args, const std::function<bool()>& ready, double delay_s,
+                   std::string* why) {
+  const pid_t pid = Launch(args);
+  const auto deadline = Clock::now() + std::chrono::seconds(120);
+  while (!ready() && Clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (!ready()) *why = "it never got to the point of the kill";
+  std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
+  kill(pid, SIGKILL);
+  int raw = 0;
+  waitpid(pid, &raw, 0);
+  if (why->empty() && !WIFSIGNALED(raw)) *why = "it ended before it was killed";
+  return why->empty();
+}
+
+TEST(IdentifyResume, AFitKilledAtARandomMomentResumesToTheSameResult) {
+  const fs::path dir = ScratchDirectory("identify_resume");
+  // Two short recordings of the loop sample's arm (its first seconds ramp
+  // every joint), two free parameters: a fit of a few accepted iterations.
+  const std::string arm = std::string(CCSRM_SOURCE_DIR) + "/datasets/samples/loop/arm.yaml";
+  std::string data;
+  for (const auto& [file, duration, seed] :
+       {std::tuple{"long.h5", "1.5", "7"}, std::tuple{"short.h5", "1", "8"}}) {
+    const std::string path = (dir / file).string();
+    const Outcome g = RunCcsrm("generate --config " + arm + " --case 4 --duration " + duration +
+                               " --set T_p=60 --seed " + seed + " --quiet --out " + path);
+    ASSERT_EQ(g.status, 0) << g.all();
+    data += " " + path;
+  }
+  const std::string fit =
+      "identify --data" + data + " --free T_p,c_sc --max-iterations 3 --threads 2 --quiet --out ";
+  const std::string whole = (dir / "whole").string();
+  const auto t0 = Clock::now();
+  const Outcome w = RunCcsrm(fit + whole);
+  const double whole_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  ASSERT_TRUE(w.status == 0 || w.status == 4) << w.all();
+  EXPECT_FALSE(fs::exists(whole + "/checkpoint.json")) << "a finished fit leaves no checkpoint";
+
+  // Killed once its first checkpoint is there, at a random moment of the
+  // rest of the fit (the seed is printed, to replay a failure).
+  const std::string stopped = (dir / "stopped").string();
+  const unsigned seed = std::random_device{}();
+  std::mt19937 random(seed);
+  const double delay_s = std::uniform_real_distribution<double>(0.0, 0.6 * whole_s)(random);
+  SCOPED_TRACE("seed " + std::to_string(seed) + ", killed " + std::to_string(delay_s) +
+               " s after the first checkpoint");
+  std::string why;
+  ASSERT_TRUE(KillWhenReady(
+      fit + stopped, [&] { return fs::exists(stopped + "/checkpoint.json"); }, delay_s, &why))
+      << why;
+  EXPECT_FALSE(fs::exists(stopped + "/fit.json"));
+  const nlohmann::json saved =
+      nlohmann::json::parse(ccsrm::ReadTextFile(stopped + "/checkpoint.json"));
+
+  // Another option, or another version, is refused with one line.
+  Outcome refused = RunCcsrm(fit + stopped + " --resume --set c_sc=0.06");
+  EXPECT_EQ(refused.status, 2) << refused.all();
+  EXPECT_EQ(CountLines(refused.err), 1) << refused.err;
+  EXPECT_THAT(refused.err, HasSubstr("checkpoint.json: inputs_digest: the checkpoint is of other "
+                                     "data or options"));
+  nlohmann::json other_version = saved;
+  other_version["version"] = "0.0.1";
+  const std::string elsewhere = (dir / "elsewhere").string();
+  fs::create_directories(elsewhere);
+  ccsrm::WriteTextFileAtomically(elsewhere + "/checkpoint.json", other_version.dump());
+  refused = RunCcsrm(fit + elsewhere + " --resume");
+  EXPECT_EQ(refused.status, 2) << refused.all();
+  EXPECT_EQ(CountLines(refused.err), 1) << refused.err;
+  EXPECT_THAT(refused.err, HasSubstr("written by ccsrm 0.0.1"));
+
+  const Outcome r = RunCcsrm(fit + stopped + " --resume");
+  EXPECT_EQ(r.status, w.status) << r.all();
+  nlohmann::json a = nlohmann::json::parse(ccsrm::ReadTextFile(whole + "/fit.json"));
+  nlohmann::json b = nlohmann::json::parse(ccsrm::ReadTextFile(stopped + "/fit.json"));
+  // Runs repeated: those at the checkpoint's point, its base run and its
+  // forward-difference Jacobian, one per experiment and per free parameter
+  // and experiment (2 + 2 × 2): one iteration's runs, the issue's bound.
+  const std::int64_t repeated =
+      b["simulations"].get<std::int64_t>() - a["simulations"].get<std::int64_t>();
+  EXPECT_GE(repeated, 0);
+  EXPECT_LE(repeated, 2 * (1 + 2)) << "checkpoint at iteration " << saved["state"]["iterations"];
+  DropMachineFields(&a);
+  DropMachineFields(&b);
+  EXPECT_EQ(a, b) << nlohmann::json::diff(a, b).dump(1);
+  EXPECT_EQ(ccsrm::ReadTextFile(whole + "/long.angles.csv"),
+            ccsrm::ReadTextFile(stopped + "/long.angles.csv"));
+  EXPECT_FALSE(fs::exists(stopped + "/checkpoint.json")) << "the resumed fit is done";
+}
+
+// `ccsrm loop --resume`: the loop runs again over the journal of its runs.
+// Killed at a random moment once its first batch is on disk, then resumed:
+// the same loop.json, every recorded run taken from the journal, and no run
+// simulated beyond those the uninterrupted loop ran (the runs lost with the
+// kill are those of the batch in flight, which the journal never held).
+TEST(LoopResume, ALoopKilledAtARandomMomentResumesToTheSameResult) {
+  const fs::path dir = ScratchDirectory("loop_resume");
+  const std::string arm = std::string(CCSRM_SOURCE_DIR) + "/datasets/samples/loop/arm.yaml";
+  std::string paths[3];
+  const char* files[] = {"long.h5", "short.h5", "held.h5"};
+  const char* durations[] = {"1.5", "1", "1"};
+  for (int i = 0; i < 3; ++i) {
+    paths[i] = (dir / files[i]).string();
+    const Outcome g =
+        RunCcsrm("generate --config " + arm + " --case 4 --duration " + durations[i] +
+                 " --set T_p=60 --seed " + std::to_string(7 + i) + " --quiet --out " + paths[i]);
+    ASSERT_EQ(g.status, 0) << g.all();
+  }
+  const std::string loop = "loop --data " + paths[0] + " " + paths[1] + " --holdout " + paths[2] +
+                           " --free T_p --candidates joint_friction --max-rounds 1 "
+                           "--max-iterations 3 --threads 2 --quiet --out ";
+  const std::string whole = (dir / "whole").string();
+  const auto t0 = Clock::now();
+  const Outcome w = RunCcsrm(loop + whole);
+  const double whole_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  ASSERT_EQ(w.status, 0) << w.all();
+  EXPECT_FALSE(fs::exists(whole + "/runs.journal")) << "a finished loop leaves no journal";
+  const auto runs = [](const std::string& out, long long* simulated, long long* replayed) {
+    const std::size_t at = out.find("runs: ");
+    return at != std::string::npos &&
+           std::sscanf(out.c_str() + at, "runs: %lld simulated, %lld taken", simulated, replayed) ==
+               2;
+  };
+  long long whole_simulated = 0, whole_replayed = 0;
+  ASSERT_TRUE(runs(w.out, &whole_simulated, &whole_replayed)) << w.out;
+  EXPECT_EQ(whole_replayed, 0);
+
+  const std::string stopped = (dir / "stopped").string();
+  const unsigned seed = std::random_device{}();
+  std::mt19937 random(seed);
+  const double delay_s = std::uniform_real_distribution<double>(0.0, 0.5 * whole_s)(random);
+  SCOPED_TRACE("seed " + std::to_string(seed) + ", killed " + std::to_string(delay_s) +
+               " s after the first batch was recorded");
+  const std::string journal = stopped + "/runs.journal";
+  std::string why;
+  ASSERT_TRUE(KillWhenReady(
+      loop + stopped, [&] { return fs::exists(journal) && fs::file_size(journal) > 0; }, delay_s,
+      &why))
+      << why;
+  EXPECT_FALSE(fs::exists(stopped + "/loop.json"));
+
+  const Outcome refused = RunCcsrm(loop + stopped + " --resume --set mu_c=0.1");
+  EXPECT_EQ(refused.status, 2) << refused.all();
+  EXPECT_EQ(CountLines(refused.err), 1) << refused.err;
+  EXPECT_THAT(refused.err, HasSubstr("other data or options"));
+
+  const Outcome r = RunCcsrm(loop + stopped + " --resume");
+  ASSERT_EQ(r.status, 0) << r.all();
+  long long simulated = 0, replayed = 0;
+  ASSERT_TRUE(runs(r.out, &simulated, &replayed)) << r.out;
+  EXPECT_GT(replayed, 0) << "the recorded runs are taken, not simulated again";
+  EXPECT_EQ(simulated + replayed, whole_simulated) << "no run beyond the uninterrupted loop's";
+  nlohmann::json a = nlohmann::json::parse(ccsrm::ReadTextFile(whole + "/loop.json"));
+  nlohmann::json b = nlohmann::json::parse(ccsrm::ReadTextFile(stopped + "/loop.json"));
+  DropMachineFields(&a);
+  DropMachineFields(&b);
+  EXPECT_EQ(a, b) << nlohmann::json::diff(a, b).dump(1);
+  EXPECT_FALSE(fs::exists(journal)) << "the resumed loop is done";
+}
+
+}  // namespace
