@@ -227,9 +227,9 @@ TEST(ReportCli, BadInputGetsOneLineAndExitStatus2) {
                      "missing.h5: no such file");
   ExpectOneLineError(
       RunCcsrm("report --in " + dir.string() + " --out " + out),
-      "not a fit, loop or prediction folder (no fit.json, loop.json or pred.json); expected a "
-      "ccsrm-run/1 or ccsrm-dataset/1 file, or a folder written by ccsrm identify, ccsrm loop or "
-      "ccsrm predict");
+      "not a fit, loop, prediction or design folder (no fit.json, loop.json, pred.json or "
+      "design.json); expected a ccsrm-run/1 or ccsrm-dataset/1 file, or a folder written by ccsrm "
+      "identify, ccsrm loop, ccsrm predict or ccsrm design");
   fs::create_directories(dir / "fit");
   ccsrm::WriteTextFileAtomically((dir / "fit" / "fit.json").string(),
                                  "{\"schema\": \"ccsrm-run/1\"}");
