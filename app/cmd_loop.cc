@@ -136,9 +136,10 @@ void AddLoopCommand(CLI::App& root) {
                   "Held-out experiments: not fitted, each candidate's refit is scored on them")
       ->expected(1, -1);
   cmd->add_option("--candidates", a->candidates,
-                  "Candidate effects, comma-separated, and 'declared' for the configuration's "
-                  "declared values (default: every effect of the library that is off, and "
-                  "declared; ccsrm generate --list-effects)");
+                  "Candidate effects, comma-separated, 'declared' for the configuration's "
+                  "declared values and 'terms' for terms found in the data (a joint moment, "
+                  "docs/loop.md) (default: every effect of the library that is off, declared "
+                  "and terms; ccsrm generate --list-effects)");
   cmd->add_option("--free", a->free,
                   "The declared model's free parameters, comma-separated (default: mu,mu_c,T_p)");
   cmd->add_option("--params", a->params,

@@ -114,6 +114,12 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
     for (const CandidateResult& c : r.candidates) {
       json est = json::object();
       for (const auto& [name, e] : c.estimates) est[name] = Estimate(e);
+      json path = json::array();
+      for (const CandidateResult::TermSupport& t : c.term_path) {
+        path.push_back({{"parameters", t.parameters},
+                        {"delta_chi2_eff", Number(t.delta_chi2_eff)},
+                        {"delta_bic", Number(t.delta_bic)}});
+      }
       cands.push_back(
           {{"name", c.name},
            {"kind", c.kind},
@@ -140,6 +146,7 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
            {"simulations", c.simulations},
            {"accepted", c.accepted},
            {"reason", c.reason}});
+      if (!c.term_path.empty()) cands.back()["term_path"] = path;
     }
     rounds.push_back({{"round", r.index},
                       {"effects_on", r.effects_on},
@@ -150,6 +157,7 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
                       {"winner", r.winner.empty() ? json(nullptr) : json(r.winner)},
                       {"tie", r.tie},
                       {"decision", r.decision}});
+    if (!r.discovery.empty()) rounds.back()["discovery"] = r.discovery;
   }
   j["rounds"] = rounds;
   j["added_effects"] = s.added_effects;
@@ -169,6 +177,23 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
          {"sentence", d.Sentence()}});
   }
   j["declared_corrections"] = corrections;
+  json discovered = json::array();
+  for (const DiscoveredMoment& m : s.discovered_terms) {
+    json terms = json::array();
+    for (const DiscoveredMoment::Term& t : m.terms) {
+      terms.push_back({{"term", t.name},
+                       {"formula", t.formula},
+                       {"parameter", t.estimate.name},
+                       {"units", t.units},
+                       {"estimate", Estimate(t.estimate)}});
+    }
+    discovered.push_back({{"segment", m.segment},
+                          {"joints", {m.first_joint, m.last_joint}},
+                          {"axis", m.axis == 0 ? "x" : "y"},
+                          {"terms", terms},
+                          {"formula", m.Formula()}});
+  }
+  j["discovered_terms"] = discovered;
   json params = json::object();
   for (const ParameterEstimate& p : s.final_fit.parameters) {
     if (p.free) params[p.name] = Estimate(p);
@@ -252,6 +277,10 @@ std::string LoopSummary::FullReport() const {
   if (!declared_corrections.empty()) {
     out << "\nDeclared values corrected (calibrated.yaml):\n";
     for (const DeclaredCorrection& d : declared_corrections) out << "  " << d.Sentence() << "\n";
+  }
+  if (!discovered_terms.empty()) {
+    out << "\nTerms found in the data (joint_moment):\n";
+    for (const DiscoveredMoment& m : discovered_terms) out << "  " << m.Formula() << "\n";
   }
   out << "\nRMS error [deg]      before    after\n";
   out << "  training          " << Format("%.4f", rms_before_deg) << "   "

@@ -90,24 +90,29 @@ LoopDiagnostics ReadDiagnostics(const JsonReader& in, const json& object, const 
   return d;
 }
 
-// Estimates by name ({name: {value, std_error, ci95, identifiable, free, units}}).
+// One estimate ({value, std_error, ci95, identifiable, free, units}).
+LoopEstimate ReadEstimate(const JsonReader& in, const json& entry, const std::string& at,
+                          const std::string& name) {
+  LoopEstimate e;
+  e.name = name;
+  e.value = in.NumberAt(entry, at, "value", true);
+  e.std_error = in.NumberAt(entry, at, "std_error", true);
+  const std::array<double, 2> ci = in.Pair(in.At(entry, at, "ci95"), at + ".ci95", true);
+  e.ci95_lower = ci[0];
+  e.ci95_upper = ci[1];
+  e.identifiable = in.Flag(entry, at, "identifiable");
+  e.free = in.Flag(entry, at, "free");
+  e.units = in.Text(entry, at, "units");
+  return e;
+}
+
+// Estimates by name.
 std::vector<LoopEstimate> ReadEstimates(const JsonReader& in, const json& parent,
                                         const std::string& parent_key, const std::string& key) {
   std::vector<LoopEstimate> out;
   const std::string path = JsonReader::Join(parent_key, key);
   for (const auto& [name, entry] : in.Object(parent, parent_key, key).items()) {
-    const std::string at = path + "." + name;
-    LoopEstimate e;
-    e.name = name;
-    e.value = in.NumberAt(entry, at, "value", true);
-    e.std_error = in.NumberAt(entry, at, "std_error", true);
-    const std::array<double, 2> ci = in.Pair(in.At(entry, at, "ci95"), at + ".ci95", true);
-    e.ci95_lower = ci[0];
-    e.ci95_upper = ci[1];
-    e.identifiable = in.Flag(entry, at, "identifiable");
-    e.free = in.Flag(entry, at, "free");
-    e.units = in.Text(entry, at, "units");
-    out.push_back(std::move(e));
+    out.push_back(ReadEstimate(in, entry, path + "." + name, name));
   }
   return out;
 }
@@ -264,6 +269,30 @@ LoopFolder ReadLoopFolder(const std::string& folder) {
       d.relative_ci95 = in.Pair(in.At(c, at, "relative_ci95"), at + ".relative_ci95", true);
       d.indistinguishable = in.Texts(c, at, "indistinguishable");
       loop.declared_corrections.push_back(std::move(d));
+    }
+  }
+  if (root.contains("discovered_terms")) {
+    const json& moments = in.List(root, "", "discovered_terms");
+    for (std::size_t k = 0; k < moments.size(); ++k) {
+      const std::string at = JsonReader::Index("discovered_terms", k);
+      const json& m = moments[k];
+      LoopDiscoveredMoment d;
+      d.segment = static_cast<int>(in.NumberAt(m, at, "segment", false));
+      d.joints = in.Pair(in.At(m, at, "joints"), at + ".joints", false);
+      d.axis = in.Text(m, at, "axis");
+      d.formula = in.Text(m, at, "formula");
+      const json& terms = in.List(m, at, "terms");
+      for (std::size_t t = 0; t < terms.size(); ++t) {
+        const std::string tat = JsonReader::Index(at + ".terms", t);
+        LoopDiscoveredMoment::Term term;
+        term.term = in.Text(terms[t], tat, "term");
+        term.formula = in.Text(terms[t], tat, "formula");
+        term.units = in.Text(terms[t], tat, "units");
+        term.estimate = ReadEstimate(in, in.At(terms[t], tat, "estimate"), tat + ".estimate",
+                                     in.Text(terms[t], tat, "parameter"));
+        d.terms.push_back(std::move(term));
+      }
+      loop.discovered_terms.push_back(std::move(d));
     }
   }
   loop.parameters = ReadEstimates(in, root, "", "parameters");

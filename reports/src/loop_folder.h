@@ -137,6 +137,19 @@ struct LoopDeclaredCorrection {
   std::vector<std::string> indistinguishable;
 };
 
+// A moment the loop found in the data (loop.json 'discovered_terms').
+struct LoopDiscoveredMoment {
+  int segment = 0;
+  std::array<double, 2> joints = {kUnknown, kUnknown};
+  std::string axis;     // "x" or "y"
+  std::string formula;  // "joints 1-6 (segment 1) θx: M = ..."
+  struct Term {
+    std::string term, formula, units;
+    LoopEstimate estimate;
+  };
+  std::vector<Term> terms;
+};
+
 struct LoopFolder {
   std::string folder;  // as given
   struct Data {
@@ -148,6 +161,7 @@ struct LoopFolder {
   std::vector<LoopRound> rounds;
   std::vector<std::string> added_effects;
   std::vector<LoopDeclaredCorrection> declared_corrections;
+  std::vector<LoopDiscoveredMoment> discovered_terms;
   std::vector<LoopEstimate> parameters;  // the final model's free parameters
   double rms_before_deg = kUnknown, rms_after_deg = kUnknown;
   double holdout_rms_before_deg = kUnknown, holdout_rms_after_deg = kUnknown;

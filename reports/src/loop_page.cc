@@ -28,6 +28,7 @@ using internal::ListNames;
 using internal::LoopCandidate;
 using internal::LoopDeclaredCorrection;
 using internal::LoopDiagnostics;
+using internal::LoopDiscoveredMoment;
 using internal::LoopErrors;
 using internal::LoopEstimate;
 using internal::LoopFolder;
@@ -124,6 +125,34 @@ Table DeclaredCorrectionTable(const LoopFolder& loop) {
   return table;
 }
 
+// The terms the loop found in the data: one row per term of each moment.
+Table DiscoveredTermsTable(const LoopFolder& loop) {
+  Table table;
+  table.id = "discovered_terms";
+  table.title = "Terms found in the data (joint_moment)";
+  table.caption =
+      "loop.json 'discovered_terms': the moment the final model adds at every joint of a "
+      "segment about one axis, M = sum of coefficient x term, in the joint's own angle θ [rad], "
+      "rate θ̇ [rad/s] and time t [s]; chosen by sparse regression on the residual and refitted "
+      "in the simulator (docs/loop.md). Coefficients with their 95 % intervals.";
+  table.columns = {{"joints", "joints", "", kCount},    {"axis", "axis", "", kCount},
+                   {"term", "term", "", kCount},        {"value", "coefficient", "", kValue},
+                   {"ci", "95 % interval", "", kCount}, {"units", "units", "", kCount}};
+  for (const LoopDiscoveredMoment& m : loop.discovered_terms) {
+    const std::string joints = Show(m.joints[0], kCount) + "-" + Show(m.joints[1], kCount) +
+                               " (segment " + std::to_string(m.segment) + ")";
+    for (const LoopDiscoveredMoment::Term& t : m.terms) {
+      const LoopEstimate& e = t.estimate;
+      const std::string ci = std::isfinite(e.ci95_lower) ? "[" + Show(e.ci95_lower, kValue) + ", " +
+                                                               Show(e.ci95_upper, kValue) + "]"
+                                                         : "not identifiable";
+      table.AddRow({Cell::Text(joints), Cell::Text("θ" + m.axis), Cell::Text(t.formula),
+                    Cell::Number(e.value), Cell::Text(ci), Cell::Text(t.units)});
+    }
+  }
+  return table;
+}
+
 Section SummarySection(const LoopFolder& loop) {
   Section section{"summary", "Summary", {}};
   std::vector<std::string> training, holdout;
@@ -161,6 +190,12 @@ Section SummarySection(const LoopFolder& loop) {
       section.blocks.push_back(Paragraph{"Declared value: " + d.sentence + ".", false});
     }
     section.blocks.push_back(DeclaredCorrectionTable(loop));
+  }
+  if (!loop.discovered_terms.empty()) {
+    for (const LoopDiscoveredMoment& m : loop.discovered_terms) {
+      section.blocks.push_back(Paragraph{"Term found in the data: " + m.formula + ".", false});
+    }
+    section.blocks.push_back(DiscoveredTermsTable(loop));
   }
   section.blocks.push_back(DataTable(loop));
   return section;

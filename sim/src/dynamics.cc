@@ -43,7 +43,10 @@ class ArmDynamics::EffectLoadsView final : public EffectLoads {
   double time() const override { return t_; }
   int num_links() const override { return d_->model_.num_links(); }
   int num_joints() const override { return d_->model_.num_joints(); }
+  const Eigen::Vector2d& joint_angle(int joint) const override { return d_->theta_[joint - 1]; }
   const Eigen::Vector2d& joint_rate(int joint) const override { return d_->theta_dot_[joint - 1]; }
+  // Joint j turns link j on link j - 1: it belongs to link j's segment.
+  int joint_segment(int joint) const override { return d_->model_.link(joint).segment + 1; }
   Vector3 link_velocity(int link) const override {
     return Position(qd_, d_->model_.link_offset(link));
   }

@@ -121,6 +121,14 @@ TEST(LoopOptions, RefusesUnknownAndDeclaredCandidates) {
   EXPECT_THAT(error, HasSubstr("'table_tilt' already has a free parameter"));
   o = Options({"backlash", "backlash"});
   EXPECT_FALSE(o.IsValid(&error));
+  // The discovered terms' carrier is no candidate effect: 'terms' asks for it.
+  o = Options({"joint_moment"});
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_THAT(error, HasSubstr("terms, for terms found in the data, which joint_moment carries"));
+  o = Options({"terms"});
+  o.fit.free_parameters = {"T_p", "joint_moment.segment1_x_angle"};
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_THAT(error, HasSubstr("joint_moment, which already has a free parameter"));
 }
 
 TEST(Loop, FindsAnUndeclaredMocapOffsetAndReachesTheNoise) {
@@ -164,9 +172,11 @@ TEST(Loop, AddsNothingWhenTheDeclaredModelIsRight) {
   truth.T_p = 55.0;  // a declared parameter away from its start: the fit finds it
   const std::vector<Experiment> training = Recordings(truth, {1, 2});
   const std::vector<Experiment> holdout = Recordings(truth, {3});
+  // Terms too: null data must not make the discovery add anything.
   const LoopSummary s =
-      CloseLoop(training, holdout, Options({"table_tilt", "mocap_offset", "backlash"}));
+      CloseLoop(training, holdout, Options({"table_tilt", "mocap_offset", "backlash", "terms"}));
   EXPECT_TRUE(s.added_effects.empty());
+  EXPECT_TRUE(s.discovered_terms.empty());
   ASSERT_EQ(s.rounds.size(), 1u);
   for (const CandidateResult& c : s.rounds[0].candidates) EXPECT_FALSE(c.accepted) << c.name;
   EXPECT_THAT(s.rounds[0].decision, HasSubstr("no candidate earns its place"));

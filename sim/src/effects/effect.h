@@ -35,9 +35,11 @@ class EffectLoads {
   virtual double time() const = 0;  // [s]
   virtual int num_links() const = 0;
   virtual int num_joints() const = 0;
-  virtual const Eigen::Vector2d& joint_rate(int joint) const = 0;  // [rad/s]
-  virtual Eigen::Vector3d link_velocity(int link) const = 0;       // mass centre, world [m/s]
-  virtual double link_mass(int link) const = 0;                    // [kg]
+  virtual const Eigen::Vector2d& joint_angle(int joint) const = 0;  // [rad]
+  virtual const Eigen::Vector2d& joint_rate(int joint) const = 0;   // [rad/s]
+  virtual int joint_segment(int joint) const = 0;                   // 1-based
+  virtual Eigen::Vector3d link_velocity(int link) const = 0;        // mass centre, world [m/s]
+  virtual double link_mass(int link) const = 0;                     // [kg]
   // A force on link `link`'s mass centre, world frame [N].
   virtual void AddLinkForce(int link, const Eigen::Vector3d& f_W) = 0;
   // A joint-space moment [N m] on joint `joint`'s angle `axis`, and its
@@ -90,11 +92,11 @@ class Effect {
   virtual void Record(std::vector<Eigen::Vector2d>* /*joint_angles*/) const {}
 };
 
-// Parameters that come one set per joint, or per driving cable, of the arm
-// (mocap_offset: an offset per joint and axis). How many there are is the
+// Parameters that come one set per joint, per driving cable, or per
+// segment of the arm (mocap_offset: an offset per joint and axis). How many there are is the
 // arm's (ArmParameters::arm), never a constant of the effect.
 struct IndexedParameters {
-  enum class Per { kJoint, kCable };
+  enum class Per { kJoint, kCable, kSegment };
   Per per = Per::kJoint;
   // Their short names with "<k>" for the 1-based index ("joint<k>_x_rad"),
   // in the order `make` returns them.
@@ -109,6 +111,7 @@ struct EffectDefinition {
   std::string name;
   std::string description;
   bool measurement = false;
+  bool library = true;  // EffectInfo::library
   // The residual signals it leaves (EffectInfo::fingerprint).
   std::vector<std::string> fingerprint;
   // Its fixed parameters with short names ("coulomb_nm") and `field` null;
@@ -166,5 +169,7 @@ EffectDefinition BacklashEffect();
 EffectDefinition PretensionCreepEffect();
 EffectDefinition AirDragEffect();
 EffectDefinition MocapOffsetEffect();
+// Not of the library: the discovered terms' carrier (joint_moment.cc).
+EffectDefinition JointMomentEffect();
 
 }  // namespace ccsrm::sim::internal

@@ -22,11 +22,27 @@ void Complete(const std::string& effect, ParameterInfo* p) {
 }
 
 int CountOf(const IndexedParameters& indexed, const ArmSize& arm) {
-  return indexed.per == IndexedParameters::Per::kJoint ? arm.joints : arm.cables;
+  switch (indexed.per) {
+    case IndexedParameters::Per::kJoint:
+      return arm.joints;
+    case IndexedParameters::Per::kCable:
+      return arm.cables;
+    case IndexedParameters::Per::kSegment:
+      return arm.segments;
+  }
+  return 0;
 }
 
 const char* UnitOf(const IndexedParameters& indexed) {
-  return indexed.per == IndexedParameters::Per::kJoint ? "joint" : "driving cable";
+  switch (indexed.per) {
+    case IndexedParameters::Per::kJoint:
+      return "joint";
+    case IndexedParameters::Per::kCable:
+      return "driving cable";
+    case IndexedParameters::Per::kSegment:
+      return "segment";
+  }
+  return "";
 }
 
 // The index k of `short_name` in `pattern` ("joint12_x_rad" in
@@ -92,7 +108,7 @@ const std::vector<EffectDefinition>& EffectDefinitions() {
     // One line per effect: its order here is the order of Effects().
     std::vector<EffectDefinition> list = {
         JointFrictionEffect(),   TableTiltEffect(), ActuatorDelayEffect(), BacklashEffect(),
-        PretensionCreepEffect(), AirDragEffect(),   MocapOffsetEffect(),
+        PretensionCreepEffect(), AirDragEffect(),   MocapOffsetEffect(),   JointMomentEffect(),
     };
     for (EffectDefinition& d : list) {
       for (ParameterInfo& p : d.parameters) Complete(d.name, &p);
@@ -202,7 +218,7 @@ const std::vector<EffectInfo>& Effects() {
   static const std::vector<EffectInfo> effects = [] {
     std::vector<EffectInfo> list;
     for (const internal::EffectDefinition& d : internal::EffectDefinitions()) {
-      list.push_back(EffectInfo{d.name, d.description, d.measurement, d.fingerprint});
+      list.push_back(EffectInfo{d.name, d.description, d.measurement, d.fingerprint, d.library});
     }
     return list;
   }();

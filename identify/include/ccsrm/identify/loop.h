@@ -70,6 +70,21 @@
 // scoring one is refitted and stands for them. A value that earns its place is reported as "the
 // declared X is off by Δ ± σ", and the corrected configuration is written (calibrated.yaml).
 //
+// Terms found in the data (issue 28, "terms"): when no effect of the
+// library earns its place in a round (a declared value may: the terms then
+// compete with it by ΔBIC) and the residual is still structured (its weighted mean
+// square above unexplained_noise_ratio², or correlated with one of the
+// effects' signals), a moment at every joint axis is sought as a sparse
+// combination of joint_moment's terms in the joint's own angle, rate and
+// time (sim::JointMomentTerms(); one coefficient per segment, axis and
+// term). Each term's column is one simulation per training experiment;
+// sequentially thresholded least squares on them (term_discovery.h) picks
+// the combination with the best linear ΔBIC, simpler terms winning ties;
+// if that ΔBIC passes min_delta_bic the combination is refitted and judged
+// by every criterion above, held-out error and the partial-explanation
+// rule included. Reported as a formula per segment's joints and axis
+// (LoopSummary::discovered_terms).
+//
 // At the end, every (experiment, joint, axis) whose RMS residual exceeds
 // unexplained_noise_ratio (1.5) times its noise is reported as
 // unexplained, with the phase of the protocol where it is largest.
@@ -116,9 +131,10 @@ struct LoopOptions {
   // The backend of the held-out experiments (null: threads on this machine);
   // fit.backend is the training experiments'.
   std::shared_ptr<SimulationBackend> holdout_backend;
-  // The candidate effects, by name, and "declared" for every declared value
-  // of the arm. Default: every effect of the library (sim::Effects()) that
-  // the declared model does not have on, and the declared values.
+  // The candidate effects, by name, "declared" for every declared value of
+  // the arm, and "terms" for terms found in the data. Default: every effect
+  // of the library (sim::Effects() with `library`) that the declared model
+  // does not have on, the declared values, and terms.
   std::vector<std::string> candidates;
   // At most this many rounds (effects added). Default 3.
   int max_rounds = 3;
@@ -143,6 +159,10 @@ struct LoopOptions {
   // (validation: table tilt with a delay, 48 %); the issue's joint friction
   // on an arm of wrong geometry removed about a quarter.
   double min_excess_share = 1.0 / 3.0;
+  // Terms found in the data: a smaller combination of terms that removes
+  // all but this share of the best combination's linear Δχ²_eff ties with
+  // it (the sensitivity columns are secants: first order). Default 0.05.
+  double term_share = 0.05;
   std::function<void(const LoopProgress&)> on_progress;
 
   bool IsValid(std::string* error) const;
@@ -150,7 +170,8 @@ struct LoopOptions {
 
 struct CandidateResult {
   std::string name;
-  // "effect", "declared block" (scored only) or "declared value".
+  // "effect", "declared block" (scored only), "declared value" or
+  // "discovered terms".
   std::string kind = "effect";
   // Declared values whose sensitivity the data cannot tell apart from this
   // one's: it stands for their combination.
@@ -181,6 +202,14 @@ struct CandidateResult {
   double mean_square_after = 0.0;
   bool partial = false;
   std::string termination;
+  // Discovered terms: the sparse regression's elimination path, every
+  // support from all terms down to one, with its linear Δχ²_eff and ΔBIC.
+  struct TermSupport {
+    std::vector<std::string> parameters;
+    double delta_chi2_eff = 0.0;
+    double delta_bic = 0.0;
+  };
+  std::vector<TermSupport> term_path;
   std::map<std::string, ParameterEstimate> estimates;  // its size parameters
   std::int64_t simulations = 0;
   bool accepted = false;
@@ -197,6 +226,24 @@ struct LoopRound {
   std::string winner;                       // empty: none
   std::vector<std::string> tie;             // candidates tied with the winner
   std::string decision;                     // one or two sentences
+  // Why no terms were sought when none of the others earned its place.
+  std::string discovery;
+};
+
+// A discovered term's moment on one axis of a segment's joints (issue 28):
+// "joints 1-6 θx: M = (-196 ± 12) θ³ N m".
+struct DiscoveredMoment {
+  int segment = 0;  // 1-based
+  int first_joint = 0, last_joint = 0;
+  int axis = 0;  // 0 θx, 1 θy
+  struct Term {
+    std::string name;            // sim::JointMomentTerm::name
+    std::string formula;         // "θ³"
+    std::string units;           // of the coefficient
+    ParameterEstimate estimate;  // the coefficient (joint_moment.segment<k>_<a>_<name>)
+  };
+  std::vector<Term> terms;
+  std::string Formula() const;
 };
 
 struct UnexplainedChannel {
@@ -231,6 +278,9 @@ struct LoopSummary {
   std::vector<LoopRound> rounds;
   std::vector<std::string> added_effects;  // effects and declared values, in order
   std::vector<DeclaredCorrection> declared_corrections;
+  // The terms found in the data, when the discovered terms were added
+  // (joint_moment among added_effects).
+  std::vector<DiscoveredMoment> discovered_terms;
   // The configuration with the corrections and the final fit's values
   // (calibrated.yaml); set when a declared value was corrected.
   std::optional<sim::Config> calibrated;

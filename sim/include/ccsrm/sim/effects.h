@@ -14,6 +14,12 @@
 //   mocap_offset      constant zero offsets of the measured joint angles
 //                     (a measurement effect: what is recorded, not the dynamics)
 //
+// And one that is not of the library: `joint_moment`, the carrier of the
+// terms the loop discovers in data (issue 28): a moment at every joint axis,
+// a combination of JointMomentTerms() of the joint's own state with one
+// coefficient per segment, axis and term. EffectInfo::library is false for
+// it: the loop never tries it as an effect, only through its discovery step.
+//
 // An effect is switched on by a configuration's `effects:` section, by
 // ArmParameters::EnableEffect, or by setting any of its parameters
 // (SetParameter, `--set`, `--params`). Each effect lives in its own file
@@ -41,8 +47,38 @@ struct EffectInfo {
   // "constant", "hold_drift", "hysteresis", "lag". Evidence that points to
   // the effect, reported beside its score; the ranking itself is by score.
   std::vector<std::string> fingerprint;
+  // False for joint_moment, the discovered terms' carrier: not a candidate
+  // effect of the loop.
+  bool library = true;
   // Its parameters are a function of the arm: EffectParameterNames.
 };
+
+// One term of joint_moment's library: a function of a joint axis's own
+// angle θ [rad] and rate θ̇ [rad/s], or of time t [s], whose coefficient is
+// the parameter "joint_moment.segment<k>_<x|y>_<name>" (the moment on every
+// joint of segment k about that axis, in N m per unit of the term).
+struct JointMomentTerm {
+  std::string name;     // "angle3"
+  std::string formula;  // "θ³"
+  std::string units;    // of its coefficient: "N m/rad^3"
+  // The coefficient's realistic value (its score step in the loop): a
+  // moment of 0.01 N m (joint friction's realistic Coulomb moment) at
+  // θ = 0.1 rad, θ̇ = 0.01 rad/s, t = 10 s; negative where the physical
+  // direction is: a restoring spring (θ, θ³), a friction (θ̇, sign θ̇,
+  // |θ| sign θ̇), whose step then damps the motion rather than drive it.
+  double realistic = 0.0;
+  // The simpler wins a tie in the discovery: powers count their degree.
+  int complexity = 1;
+};
+
+// const (1), angle (θ), angle2 (θ²), angle3 (θ³), rate (θ̇), sign_rate
+// (sign θ̇, smoothed as joint friction's: tanh(θ̇ / 1e-3 rad/s)),
+// abs_angle_sign_rate (|θ| sign θ̇: friction that grows with the angle) and
+// time (t), in that order.
+const std::vector<JointMomentTerm>& JointMomentTerms();
+
+// "joint_moment.segment2_x_angle3" (segment 1-based, axis 0 = θx, 1 = θy).
+std::string JointMomentParameter(int segment, int axis, const std::string& term);
 
 // Every effect, in a fixed order (the order above).
 const std::vector<EffectInfo>& Effects();
