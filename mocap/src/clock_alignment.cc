@@ -241,8 +241,17 @@ double Misfit(const AlignmentData& d, double offset_s, double drift, Eigen::Inde
   const Eigen::Index frames = d.measured.rows();
   double total = 0.0;
   std::vector<double> r(static_cast<std::size_t>(frames));
+  // The reference sample before the first frame, by bisection: walking
+  // there from the start cost most of a long log's search.
+  const double first = offset_s + (1.0 + drift) * d.times.front();
+  const Eigen::Index start = std::max<Eigen::Index>(
+      0, static_cast<Eigen::Index>(
+             std::upper_bound(d.reference_time.data(),
+                              d.reference_time.data() + d.reference_time.size(), first) -
+             d.reference_time.data()) -
+             1);
   for (Eigen::Index c = 0; c < d.measured.cols(); ++c) {
-    Eigen::Index hint = 0;
+    Eigen::Index hint = start;
     double sl = 0, sq = 0, sll = 0, slq = 0, sqq = 0, n = 0;
     for (Eigen::Index f = 0; f < frames; f += stride) {
       const double l = Interpolate(d.reference_time, d.reference, c,
