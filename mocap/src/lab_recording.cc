@@ -270,7 +270,9 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
           (out.misaligned
                ? ", more than the " + Format("%.3g", limit * 1e3) +
                      " ms a quasi-static arm allows: check the trigger or the offset (or the "
-                     "arm lags its inputs: friction, elasticity)"
+                     "arm lags its inputs: friction, elasticity; --sync estimate, which simulates "
+                     "the "
+                     "arm, tells them apart)"
                : ": consistent");
     } catch (const InputError& e) {
       out.kinematic_check = std::string("kinematic check not possible: ") + e.what();
