@@ -209,6 +209,19 @@ ClockFit AlignByTrigger(const std::vector<double>& mocap_edges_s,
 
 namespace {
 
+// One log column per driving cable, angles F × J × 2.
+void CheckLogAgainstArm(const sim::ArmModel& model, const std::vector<double>& mocap_time_s,
+                        const std::vector<double>& angles,
+                        const Eigen::MatrixXd& log_length_change_m, const std::string& source) {
+  if (log_length_change_m.cols() != model.num_cables()) {
+    ThrowInputError(source, "cables",
+                    "the log has " + std::to_string(log_length_change_m.cols()) +
+                        " cable column(s), the arm " + std::to_string(model.num_cables()));
+  }
+  CCSRM_CHECK(angles.size() ==
+              mocap_time_s.size() * static_cast<std::size_t>(model.num_joints()) * 2);
+}
+
 // Frames with every joint angle measured: at least 10 to align on.
 void CheckFramesToAlign(Eigen::Index frames, const std::string& source) {
   if (frames < 10) {
@@ -477,12 +490,7 @@ ClockFit AlignByKinematics(const sim::ArmModel& model, const std::vector<double>
                            const KinematicAlignmentOptions& options, const std::string& source) {
   const int joints = model.num_joints();
   const int cables = model.num_cables();
-  if (log_length_change_m.cols() != cables) {
-    ThrowInputError(source, "cables",
-                    "the log has " + std::to_string(log_length_change_m.cols()) +
-                        " cable column(s), the arm " + std::to_string(cables));
-  }
-  CCSRM_CHECK(angles.size() == mocap_time_s.size() * static_cast<std::size_t>(joints) * 2);
+  CheckLogAgainstArm(model, mocap_time_s, angles, log_length_change_m, source);
   // Kinematic pulled-in lengths of the frames with every angle measured.
   const std::vector<sim::LinkPose> straight =
       sim::ForwardKinematics(model, sim::JointAngles(joints, Eigen::Vector2d::Zero()));
@@ -534,14 +542,8 @@ ClockFit AlignBySimulation(const sim::ArmModel& model, const sim::ArmParameters&
                            const std::vector<double>& angles, const Eigen::VectorXd& log_time_s,
                            const Eigen::MatrixXd& log_length_change_m,
                            const KinematicAlignmentOptions& options, const std::string& source) {
+  CheckLogAgainstArm(model, mocap_time_s, angles, log_length_change_m, source);
   const int joints = model.num_joints();
-  const int cables = model.num_cables();
-  if (log_length_change_m.cols() != cables) {
-    ThrowInputError(source, "cables",
-                    "the log has " + std::to_string(log_length_change_m.cols()) +
-                        " cable column(s), the arm " + std::to_string(cables));
-  }
-  CCSRM_CHECK(angles.size() == mocap_time_s.size() * static_cast<std::size_t>(joints) * 2);
   AlignmentData d;
   std::vector<double> rows;
   for (std::size_t f = 0; f < mocap_time_s.size(); ++f) {
@@ -568,6 +570,7 @@ ClockFit AlignBySimulation(const sim::ArmModel& model, const sim::ArmParameters&
   // time-invariant, so the response to the inputs shifted by δ is this one
   // shifted by δ: one run serves every offset.
   const double t0 = log_time_s[0];
+  const int cables = model.num_cables();
   sim::RecordedInputs record;
   record.source_name = source;
   record.time_name = "time";
