@@ -1,7 +1,7 @@
 // ccsrm dataset inspect FILE [--json]
 // ccsrm dataset assemble --markers rec.c3d --actuators log.csv --actuator-map map.yaml
 //   --config arm.yaml [--rigid-bodies rb.yaml] [--static-trial FILE]
-//   [--sync trigger|estimate|offset=S] --out exp.h5
+//   [--sync trigger|estimate|estimate-kinematic|offset=S] [--params prior.yaml] --out exp.h5
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -29,13 +29,15 @@ struct AssembleArgs {
   bool quiet = false;
 };
 
-// --sync trigger | estimate | offset=S (S in seconds, the log's time at
+// --sync trigger | estimate | estimate-kinematic | offset=S (S in seconds, the log's time at
 // mocap time 0).
 void ParseSync(const std::string& sync, mocap::LabRecordingRequest* request) {
   if (sync == "trigger") {
     request->sync = mocap::ClockSync::kTrigger;
   } else if (sync == "estimate") {
     request->sync = mocap::ClockSync::kEstimate;
+  } else if (sync == "estimate-kinematic") {
+    request->sync = mocap::ClockSync::kEstimateKinematic;
   } else if (sync.rfind("offset=", 0) == 0) {
     request->sync = mocap::ClockSync::kOffset;
     const std::string problem = ParseNumberText(sync.substr(7), &request->clock_offset_s);
@@ -43,8 +45,9 @@ void ParseSync(const std::string& sync, mocap::LabRecordingRequest* request) {
       ThrowInputError("dataset assemble", "--sync", "offset '" + sync.substr(7) + "' " + problem);
     }
   } else {
-    ThrowInputError("dataset assemble", "--sync",
-                    "expected trigger, estimate or offset=S, found '" + sync + "'");
+    ThrowInputError(
+        "dataset assemble", "--sync",
+        "expected trigger, estimate, estimate-kinematic or offset=S, found '" + sync + "'");
   }
 }
 
@@ -56,7 +59,7 @@ void RunAssemble(AssembleArgs a) {
   request.mocap_edges.rising = a.trigger_polarity == "rising";
   CheckOut(a.out, ExperimentFileOutput(),
            {request.markers, request.actuators, request.actuator_map, request.config,
-            request.rigid_bodies, request.static_trial});
+            request.rigid_bodies, request.static_trial, request.params});
   const mocap::AssembledRecording assembled = mocap::AssembleLabRecording(request);
   const datasets::ExperimentFile& experiment = assembled.processed.experiment;
   sim_io::CheckExperimentAgainstConfig(experiment, request.markers);
@@ -126,7 +129,9 @@ void AddDatasetCommands(CLI::App& root) {
   assemble
       ->add_option("--sync", a->sync,
                    "How the clocks are aligned: trigger (a C3D analog pulse against the log's "
-                   "trigger column), estimate (from the joint angles through the kinematics) "
+                   "trigger column), estimate (the joint angles against one simulation of the "
+                   "arm driven by the log), estimate-kinematic (the joint angles through the "
+                   "kinematics of a quasi-static arm: no simulation, biased by the arm's lag) "
                    "or offset=S (the log's time at mocap time 0, s)")
       ->default_val("trigger");
   assemble
@@ -142,8 +147,12 @@ void AddDatasetCommands(CLI::App& root) {
   assemble->add_option("--trigger-polarity", a->trigger_polarity, "rising or falling edges")
       ->default_val("rising")
       ->check(CLI::IsMember({"rising", "falling"}));
+  assemble->add_option("--params", r.params,
+                       "With --sync estimate: YAML file of prior parameter values (name: value) "
+                       "for its simulation (default: the configuration's)");
   assemble->add_flag("--estimate-drift", r.estimate.estimate_drift,
-                     "With --sync estimate: also estimate the clocks' rate difference (for long "
+                     "With --sync estimate or estimate-kinematic: also estimate the clocks' rate "
+                     "difference (for long "
                      "recordings; default: drift 0)");
   assemble->add_option("--name", r.name, "Experiment name (default: the marker file's stem)");
   assemble->add_option("--out", a->out, "Output experiment (.h5)")->required();

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Runs both marker-file fuzzers for a bounded time with the vendor files of
+# Runs the three fuzzers (C3D, marker text files, actuator map and log) for a bounded time with the vendor files of
 # ../shared/data/mocap (and seeds/) as the seed corpus, copied to a fresh
 # temporary directory so the shared files are never modified.
 #
@@ -13,13 +13,14 @@ seconds=${2:-60}
 here=$(cd "$(dirname "$0")" && pwd)
 shared=${CCSRM_SHARED_DIR:-$here/../../../shared}
 work=$(mktemp -d "${TMPDIR:-/tmp}/ccsrm_fuzz.XXXXXX")
-mkdir -p "$work/c3d" "$work/text" "$work/crashes"
+mkdir -p "$work/c3d" "$work/text" "$work/actuators" "$work/crashes"
 cp "$shared"/data/mocap/c3d/*.c3d "$work/c3d/"
 # The first 20 kB of each text file hold its header and first rows.
 for f in "$shared"/data/mocap/text/*; do
   head -c 20000 "$f" > "$work/text/$(basename "$f")"
 done
 cp "$here"/seeds/* "$work/text/"
+cp "$here"/actuator_seeds/* "$work/actuators/"
 chmod -R u+w "$work"
 echo "work directory: $work"
 
@@ -28,5 +29,8 @@ status=0
   -rss_limit_mb=4096 -artifact_prefix="$work/crashes/c3d-" -print_final_stats=1 || status=1
 "$build/mocap/fuzz/ccsrm_text_fuzzer" "$work/text" -max_total_time="$seconds" -max_len=20000 \
   -rss_limit_mb=4096 -artifact_prefix="$work/crashes/text-" -print_final_stats=1 || status=1
+"$build/mocap/fuzz/ccsrm_actuator_fuzzer" "$work/actuators" -max_total_time="$seconds" \
+  -max_len=4096 -rss_limit_mb=4096 -artifact_prefix="$work/crashes/actuator-" \
+  -print_final_stats=1 || status=1
 ls -l "$work/crashes"
 exit $status

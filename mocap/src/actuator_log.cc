@@ -213,7 +213,10 @@ ActuatorLog ParseActuatorLog(const std::string& text, const std::string& source_
   // The header: the first line that is neither blank nor a '#' comment.
   std::size_t header_at = 0;
   std::string header_line;
-  for (std::size_t begin = 0; begin < text.size();) {
+  // A UTF-8 byte order mark is not part of the first line (SplitRows drops
+  // it too): "<BOM># comment" is a comment, not the header.
+  const std::size_t bom = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
+  for (std::size_t begin = bom; begin < text.size();) {
     std::size_t end = text.find('\n', begin);
     if (end == std::string::npos) end = text.size();
     std::string line = text.substr(begin, end - begin);
@@ -235,7 +238,9 @@ ActuatorLog ParseActuatorLog(const std::string& text, const std::string& source_
     return row.blank() || (!row.cells.empty() && !row.cells[0].empty() && row.cells[0][0] == '#');
   };
   while (r < rows.size() && skipped(rows[r])) ++r;
-  CCSRM_CHECK(r < rows.size());
+  if (r == rows.size()) {
+    ThrowInputError(source_name, "", "empty: expected a header line and samples");
+  }
   const internal::TextRow& header = rows[r];
   auto column_of = [&](const std::string& name, const std::string& key) {
     for (std::size_t c = 0; c < header.cells.size(); ++c) {

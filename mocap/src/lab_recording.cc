@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/mocap/actuator_log.h"
 #include "ccsrm/mocap/c3d.h"
@@ -86,6 +87,9 @@ bool LabRecordingRequest::IsValid(std::string* error) const {
   if (!std::isfinite(clock_drift_ppm) || std::abs(clock_drift_ppm) >= 1e5) {
     return fail("--clock-drift-ppm: expected a finite rate difference below 1e5 ppm");
   }
+  if (!params.empty() && sync != ClockSync::kEstimate) {
+    return fail("--params: only with --sync estimate (the prior of its simulation)");
+  }
   if (clock_drift_ppm != 0.0 && sync != ClockSync::kOffset) {
     return fail("--clock-drift-ppm: only with --sync offset=S (the other methods find it)");
   }
@@ -98,9 +102,10 @@ bool LabRecordingRequest::IsValid(std::string* error) const {
   if (!(trigger.max_drift > 0.0)) return fail("trigger: max_drift must be > 0");
   if (!(estimate.grid_step_s >= 0.0) || !(estimate.ambiguity_separation_s >= 0.0) ||
       !(estimate.ambiguity_chi2 > 0.0) || !(estimate.max_drift > 0.0) ||
-      !(estimate.drift_step > 0.0) || !(estimate.max_drift / estimate.drift_step <= 1e4)) {
+      !(estimate.drift_step > 0.0) || !(estimate.max_drift / estimate.drift_step <= 1e4) ||
+      !(estimate.coarse_step_s >= 0.0)) {
     return fail(
-        "estimate: grid step and separation must be >= 0, chi2, max drift and drift step > 0, "
+        "estimate: grid steps and separation must be >= 0, chi2, max drift and drift step > 0, "
         "at most 1e4 drift steps each way");
   }
   return processing.IsValid(error);
@@ -130,7 +135,11 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
   // processing.
   const ActuatorMap map = ReadActuatorMap(request.actuator_map);
   const ActuatorLog log = ReadActuatorLog(request.actuators, map, request.actuator_map);
-  const sim::ArmModel model(sim::LoadConfig(request.config).arm);
+  sim::Config config = sim::LoadConfig(request.config);
+  if (!request.params.empty()) {
+    sim::ApplyParameterYaml(ReadTextFile(request.params), request.params, &config.parameters);
+  }
+  const sim::ArmModel model(config.arm);
   if (log.length_change_m.cols() != model.num_cables()) {
     ThrowInputError(request.actuator_map, "cables",
                     "maps " + std::to_string(log.length_change_m.cols()) + " cable(s), the arm (" +
@@ -215,19 +224,27 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
       out.clock.note = "channel '" + analog.labels[channel] + "': " + out.clock.note;
       break;
     }
-    case ClockSync::kEstimate: {
+    case ClockSync::kEstimate:
+    case ClockSync::kEstimateKinematic: {
       if (!experiment.measured_joint_angles) {
         ThrowInputError(request.markers, "/measured/joint_angles",
                         "none: --sync estimate needs the joint angles");
       }
-      out.clock = AlignByKinematics(model, mocap_time, experiment.measured_joint_angles->values,
-                                    log.time_s, log.length_change_m, request.estimate,
-                                    request.markers + " + " + request.actuators);
+      const std::string source = request.markers + " + " + request.actuators;
+      out.clock =
+          request.sync == ClockSync::kEstimate
+              ? AlignBySimulation(model, config.parameters, config.solver, mocap_time,
+                                  experiment.measured_joint_angles->values, log.time_s,
+                                  log.length_change_m, request.estimate, source)
+              : AlignByKinematics(model, mocap_time, experiment.measured_joint_angles->values,
+                                  log.time_s, log.length_change_m, request.estimate, source);
       break;
     }
   }
 
-  if (request.sync != ClockSync::kEstimate && experiment.measured_joint_angles) {
+  const bool estimated =
+      request.sync == ClockSync::kEstimate || request.sync == ClockSync::kEstimateKinematic;
+  if (!estimated && experiment.measured_joint_angles) {
     // The joint angles as a second witness: where they put the log, at the
     // middle of the recording, against the alignment used.
     const double t_mid = 0.5 * (mocap_time.front() + mocap_time.back());
@@ -253,7 +270,9 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
           (out.misaligned
                ? ", more than the " + Format("%.3g", limit * 1e3) +
                      " ms a quasi-static arm allows: check the trigger or the offset (or the "
-                     "arm lags its inputs: friction, elasticity)"
+                     "arm lags its inputs: friction, elasticity; --sync estimate, which simulates "
+                     "the "
+                     "arm, tells them apart)"
                : ": consistent");
     } catch (const InputError& e) {
       out.kinematic_check = std::string("kinematic check not possible: ") + e.what();

@@ -99,17 +99,19 @@ struct LabFiles {
   std::string config;  // the experiment's own nominal configuration, as the lab's arm.yaml
 };
 
-// Generates a 20 s experiment of paper case `paper_case` in `dir`, then
-// records it "in the lab" (the C3D file, the log and its map).
-inline LabFiles MakeLabFiles(const fs::path& dir, int paper_case) {
+// Generates an experiment of paper case `paper_case` in `dir` (the first
+// `duration_s` of the protocol, 20 s: all of it), then records it "in the
+// lab" (the C3D file, the log and its map).
+inline LabFiles MakeLabFiles(const fs::path& dir, int paper_case, double duration_s = 20.0) {
   LabFiles f;
   f.dir = dir;
   const fs::path protocol = f.dir / "protocol.yaml";
   std::ofstream(protocol) << kProtocol;
   const std::string exp = (f.dir / "exp.h5").string();
-  const Outcome o = RunCcsrm("generate --config " + Paper() + " --case " +
-                             std::to_string(paper_case) + " --protocol " + protocol.string() +
-                             " --duration 20 --quiet --seed 11 --out " + exp);
+  const Outcome o =
+      RunCcsrm("generate --config " + Paper() + " --case " + std::to_string(paper_case) +
+               " --protocol " + protocol.string() + " --duration " + std::to_string(duration_s) +
+               " --quiet --seed 11 --out " + exp);
   EXPECT_EQ(o.status, 0) << o.err;
   f.original = ccsrm::datasets::ReadExperimentFile(exp);
   const ccsrm::datasets::ExperimentFile& e = f.original;

@@ -97,6 +97,9 @@ TEST(ActuatorLog, BadLogsAreOneLineNamingLineAndColumn) {
       {"text", header + "0,0,abc,0,0\n", "log.csv: line 2, column 'motor2': expected a number"},
       {"one sample", header + "0,0,0,0,0\n", "at least 2 are needed"},
       {"empty", "# nothing\n", "log.csv: empty"},
+      // Found by the fuzzer: a byte order mark before a comment made the
+      // comment the header line, then no row was left (an internal check).
+      {"BOM and a comment", "\xEF\xBB\xBF# controller log", "log.csv: empty"},
   };
   for (const BadCase& c : cases) {
     SCOPED_TRACE(c.what);

@@ -2,9 +2,11 @@
 // Putting an actuator log on the mocap clock. The two clocks start at
 // different moments and tick at slightly different rates; the model is
 //   t_log = offset_s + (1 + drift) × t_mocap,
-// drift a fraction (80 ppm = 8e-5). Three ways to find it: edges of a trigger
-// pulse seen by both (AlignByTrigger), the offset that best explains the
-// measured joint angles from the logged inputs through the arm's kinematics
+// drift a fraction (80 ppm = 8e-5). Four ways to find it: edges of a trigger
+// pulse seen by both (AlignByTrigger), the offset that best maps the
+// measured joint angles onto those of one simulation driven by the log
+// (AlignBySimulation), the offset at which the logged lengths best explain
+// the measured angles through the kinematics of a quasi-static arm
 // (AlignByKinematics), or a value given by the user.
 #include <Eigen/Core>
 
@@ -12,12 +14,14 @@
 #include <string>
 #include <vector>
 
+#include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
+#include "ccsrm/sim/parameters.h"
 
 namespace ccsrm::mocap {
 
 struct ClockFit {
-  std::string method;  // "trigger", "estimate", "offset"
+  std::string method;  // "trigger", "estimate" (either estimate; the note says which), "offset"
   double offset_s = 0.0;
   double offset_sigma_s = 0.0;  // one standard deviation
   double drift = 0.0;           // fraction (1e-6 = 1 ppm)
@@ -78,12 +82,18 @@ ClockFit AlignByTrigger(const std::vector<double>& mocap_edges_s,
                         const std::vector<double>& log_edges_s,
                         const TriggerAlignmentOptions& options, const std::string& source);
 
-// ---- Alignment by kinematics -------------------------------------------------
+// ---- Alignment by estimation (simulation or kinematics) ----------------------
 
+// The search of AlignBySimulation and AlignByKinematics.
 struct KinematicAlignmentOptions {
   // Offsets searched [s]: every log time that puts the whole mocap recording
-  // inside the log, on a grid of `grid_step_s` (0: one mocap frame), then
-  // refined between grid points.
+  // inside the log. Coarse to fine: a grid of `coarse_step_s` with the
+  // misfit on every k-th frame (k frames ≈ one coarse step), then its five
+  // lowest local minima on a grid of `grid_step_s` (0: one mocap frame)
+  // within one coarse step, with every frame, refined between grid points.
+  // 0.05 s is well below the time over which the misfit of a motion slow
+  // enough to measure (below the arm's first mode, ~1 Hz) changes.
+  double coarse_step_s = 0.05;
   double grid_step_s = 0.0;
   // Search only offsets within search_half_width_s of search_center_s
   // (NaN, the default: every offset the log allows). A check of a known
@@ -92,7 +102,8 @@ struct KinematicAlignmentOptions {
   double search_half_width_s = std::numeric_limits<double>::quiet_NaN();
   // Two minima of the misfit further apart than `ambiguity_separation_s`
   // whose misfits differ by less than `ambiguity_chi2` (in units of the
-  // residual variance, 9 = three standard deviations) make the alignment
+  // residual variance times N / N_eff, the effective sample correction of
+  // correlated residuals; 9 = three standard deviations) make the alignment
   // ambiguous.
   double ambiguity_separation_s = 0.05;
   double ambiguity_chi2 = 9.0;
@@ -111,10 +122,31 @@ struct KinematicAlignmentOptions {
 // (what a quasi-static arm pulls in), compared per cable through an affine
 // fit q_k ≈ a_k + b_k · l_k(t_log) (cable stretch and the log's own zero
 // absorbed). `angles` is F × J × 2 row-major as in /measured/joint_angles.
-// Throws InputError (labelled `source`) when the log cannot cover the
-// recording, the motion is too small to align on, or the misfit has two
-// equally good minima.
+// Assumes a quasi-static arm: an arm that lags its inputs (friction: about
+// 50 ms on the generated case-2 arm) biases it by its lag. The offset's
+// uncertainty is the misfit's curvature with the residual variance scaled by
+// N / N_eff (identification's correction for correlated residuals). Method
+// "estimate". Throws InputError (labelled `source`) when the log
+// cannot cover the recording, the motion is too small to align on, or the
+// misfit has two equally good minima.
 ClockFit AlignByKinematics(const sim::ArmModel& model, const std::vector<double>& mocap_time_s,
+                           const std::vector<double>& angles, const Eigen::VectorXd& log_time_s,
+                           const Eigen::MatrixXd& log_length_change_m,
+                           const KinematicAlignmentOptions& options, const std::string& source);
+
+// The offset (and with options.estimate_drift the drift) that best maps the
+// measured joint angles onto the simulated ones: the arm (model, prior
+// `parameters`, `solver`) is simulated once from rest, driven by the log on
+// its own clock from its first sample (the log's zero: the arm straight and
+// at rest), sampled every half mocap frame; being time-invariant, the arm
+// answers inputs shifted by δ with this response shifted by δ, so the misfit
+// of every offset is the measured angles (minus a per-channel constant, a
+// marker calibration's bias) against the simulated ones interpolated at
+// t_log. Uncertainty and ambiguity as AlignByKinematics. Method "estimate".
+// Throws InputError as AlignByKinematics, and when the simulation does not
+// complete.
+ClockFit AlignBySimulation(const sim::ArmModel& model, const sim::ArmParameters& parameters,
+                           const sim::SolverConfig& solver, const std::vector<double>& mocap_time_s,
                            const std::vector<double>& angles, const Eigen::VectorXd& log_time_s,
                            const Eigen::MatrixXd& log_length_change_m,
                            const KinematicAlignmentOptions& options, const std::string& source);

@@ -13,9 +13,16 @@
 namespace ccsrm::mocap {
 
 enum class ClockSync {
-  kTrigger,   // edges of a C3D analog channel against the log's trigger column
-  kEstimate,  // the offset that best explains the measured joint angles
-  kOffset,    // given: clock_offset_s and clock_drift_ppm
+  kTrigger,  // edges of a C3D analog channel against the log's trigger column
+  // The offset that best maps the measured joint angles onto those of one
+  // simulation of the arm driven by the log (AlignBySimulation): right for
+  // an arm that lags its inputs (friction).
+  kEstimate,
+  // The offset at which the logged lengths best explain the measured angles
+  // through the kinematics (AlignByKinematics): no simulation, but biased by
+  // the arm's lag (about 50 ms on the generated case-2 arm).
+  kEstimateKinematic,
+  kOffset,  // given: clock_offset_s and clock_drift_ppm
 };
 
 struct LabRecordingRequest {
@@ -26,6 +33,9 @@ struct LabRecordingRequest {
   std::string rigid_bodies;  // optional: default "", the config's default layout
   std::string static_trial;  // optional: default "", no refinement
   std::string name;          // the experiment's name; default "": the marker file's stem
+  // kEstimate: YAML of prior parameter values (name: value) over the
+  // configuration's, for the simulation; default "": the configuration's.
+  std::string params;
 
   ClockSync sync = ClockSync::kTrigger;
   // kOffset: the log's time at mocap time 0 [s], and its rate difference.
@@ -58,7 +68,7 @@ struct AssembledRecording {
   // For a trigger or a given offset: the kinematic estimate as a check (one
   // line), and whether it disagrees with the alignment used by more than
   // 4 standard deviations and two mocap frames (a wrong offset, a pulse
-  // paired with the wrong tick). Empty / false for --sync estimate. The
+  // paired with the wrong tick). Empty / false for the estimates. The
   // estimate assumes a quasi-static arm: an arm that lags its inputs
   // (friction: about 50 ms on the generated case-2 arm) shows as a
   // disagreement too, so this is a warning, not a refusal.
