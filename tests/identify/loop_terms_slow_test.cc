@@ -16,6 +16,7 @@
 
 #include "ccsrm/identify/loop.h"
 #include "ccsrm/sim/effects.h"
+#include "loop_recordings.h"
 #include "synthetic_experiment.h"
 
 namespace ccsrm::identify {
@@ -23,29 +24,12 @@ namespace {
 
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
+using testing_support::LoopRecordings;
+using testing_support::LoopTestOptions;
 using testing_support::Nominal;
 using testing_support::Record;
 
-constexpr double kNoiseDeg = 0.03;
-
-std::vector<Experiment> Recordings(const sim::ArmParameters& truth, std::vector<unsigned> seeds) {
-  std::vector<Experiment> out;
-  for (unsigned seed : seeds) {
-    out.push_back(MakeExperiment(Record(truth, kNoiseDeg, seed),
-                                 "synthetic" + std::to_string(seed) + ".h5", {}));
-    out.back().name = "synthetic" + std::to_string(seed);
-  }
-  return out;
-}
-
-LoopOptions Options(std::vector<std::string> candidates) {
-  LoopOptions o;
-  o.fit.free_parameters = {"T_p"};
-  o.fit.values = {{"T_p", 45.0}};
-  o.fit.threads = 2;
-  o.candidates = std::move(candidates);
-  return o;
-}
+constexpr double kNoiseDeg = testing_support::kLoopNoiseDeg;
 
 TEST(Loop, FindsAJointMomentOutsideTheLibraryAsTermsInTheJointsAngle) {
   // Physics no effect of the library has: a hardening spring in every
@@ -56,9 +40,9 @@ TEST(Loop, FindsAJointMomentOutsideTheLibraryAsTermsInTheJointsAngle) {
   for (int segment = 1; segment <= 2; ++segment) {
     sim::SetParameter(sim::JointMomentParameter(segment, 0, "angle3"), -200.0, "test", &truth);
   }
-  const std::vector<Experiment> training = Recordings(truth, {1, 2});
-  const std::vector<Experiment> holdout = Recordings(truth, {3});
-  LoopOptions options = Options({"terms"});
+  const std::vector<Experiment> training = LoopRecordings(truth, {1, 2});
+  const std::vector<Experiment> holdout = LoopRecordings(truth, {3});
+  LoopOptions options = LoopTestOptions({"terms"});
   options.on_progress = [](const LoopProgress& p) { std::printf("%s\n", p.message.c_str()); };
   const LoopSummary s = CloseLoop(training, holdout, options);
   ASSERT_THAT(s.added_effects, ElementsAre("joint_moment"));

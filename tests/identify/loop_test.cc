@@ -15,6 +15,7 @@
 #include "ccsrm/identify/diagnostics.h"
 #include "ccsrm/identify/loop.h"
 #include "ccsrm/sim/effects.h"
+#include "loop_recordings.h"
 #include "synthetic_experiment.h"
 
 namespace ccsrm::identify {
@@ -22,29 +23,12 @@ namespace {
 
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
+using testing_support::LoopRecordings;
+using testing_support::LoopTestOptions;
 using testing_support::Nominal;
 using testing_support::Record;
 
-constexpr double kNoiseDeg = 0.03;
-
-std::vector<Experiment> Recordings(const sim::ArmParameters& truth, std::vector<unsigned> seeds) {
-  std::vector<Experiment> out;
-  for (unsigned seed : seeds) {
-    out.push_back(MakeExperiment(Record(truth, kNoiseDeg, seed),
-                                 "synthetic" + std::to_string(seed) + ".h5", {}));
-    out.back().name = "synthetic" + std::to_string(seed);
-  }
-  return out;
-}
-
-LoopOptions Options(std::vector<std::string> candidates) {
-  LoopOptions o;
-  o.fit.free_parameters = {"T_p"};
-  o.fit.values = {{"T_p", 45.0}};  // nominal 50: the declared fit has work to do
-  o.fit.threads = 2;
-  o.candidates = std::move(candidates);
-  return o;
-}
+constexpr double kNoiseDeg = testing_support::kLoopNoiseDeg;
 
 // The experiment's own angles shifted back by `frames`, plus a pattern.
 Eigen::MatrixXd Shifted(const Experiment& e, int frames) {
@@ -57,7 +41,7 @@ Eigen::MatrixXd Shifted(const Experiment& e, int frames) {
 }
 
 TEST(ResidualDiagnostics, WhiteNoiseIsWhiteAndAConstantOffsetIsNamed) {
-  const std::vector<Experiment> x = Recordings(Nominal().parameters, {3});
+  const std::vector<Experiment> x = LoopRecordings(Nominal().parameters, {3});
   // The "simulation" is the recording plus fresh white noise of 0.03 deg,
   // except on joint 4 θy, which it misses by a constant 0.05 deg.
   Eigen::MatrixXd simulated = x[0].measured_rad;
@@ -85,7 +69,7 @@ TEST(ResidualDiagnostics, WhiteNoiseIsWhiteAndAConstantOffsetIsNamed) {
 }
 
 TEST(ResidualDiagnostics, FindsTheLagOfALateArm) {
-  const std::vector<Experiment> x = Recordings(Nominal().parameters, {4});
+  const std::vector<Experiment> x = LoopRecordings(Nominal().parameters, {4});
   // The measured arm lags the simulation by 10 frames (0.1 s): the simulated
   // motion is the measured one 10 frames earlier.
   const ResidualDiagnostics d = DiagnoseResidual(x, {Shifted(x[0], 10)});
@@ -99,7 +83,7 @@ TEST(ResidualDiagnostics, FindsTheLagOfALateArm) {
 }
 
 TEST(ResidualDiagnostics, SplitsTheProtocolIntoMotionAndHold) {
-  const std::vector<Experiment> x = Recordings(Nominal().parameters, {5});
+  const std::vector<Experiment> x = LoopRecordings(Nominal().parameters, {5});
   const std::vector<ProtocolPhase> phases = ProtocolPhases(x[0]);
   // The compressed protocol's 2 s ramp, then its 1 s hold. The quintic
   // ramp's rate, 30 s²(1 - s)² of its mean, falls below 2 % of its peak
@@ -112,20 +96,20 @@ TEST(ResidualDiagnostics, SplitsTheProtocolIntoMotionAndHold) {
 
 TEST(LoopOptions, RefusesUnknownAndDeclaredCandidates) {
   std::string error;
-  LoopOptions o = Options({"joint_friction", "friction_of_the_table"});
+  LoopOptions o = LoopTestOptions({"joint_friction", "friction_of_the_table"});
   EXPECT_FALSE(o.IsValid(&error));
   EXPECT_THAT(error, HasSubstr("unknown effect 'friction_of_the_table'"));
-  o = Options({"table_tilt"});
+  o = LoopTestOptions({"table_tilt"});
   o.fit.free_parameters = {"T_p", "table_tilt.lateral_rad"};
   EXPECT_FALSE(o.IsValid(&error));
   EXPECT_THAT(error, HasSubstr("'table_tilt' already has a free parameter"));
-  o = Options({"backlash", "backlash"});
+  o = LoopTestOptions({"backlash", "backlash"});
   EXPECT_FALSE(o.IsValid(&error));
   // The discovered terms' carrier is no candidate effect: 'terms' asks for it.
-  o = Options({"joint_moment"});
+  o = LoopTestOptions({"joint_moment"});
   EXPECT_FALSE(o.IsValid(&error));
   EXPECT_THAT(error, HasSubstr("terms, for terms found in the data, which joint_moment carries"));
-  o = Options({"terms"});
+  o = LoopTestOptions({"terms"});
   o.fit.free_parameters = {"T_p", "joint_moment.segment1_x_angle"};
   EXPECT_FALSE(o.IsValid(&error));
   EXPECT_THAT(error, HasSubstr("joint_moment, which already has a free parameter"));
@@ -134,10 +118,10 @@ TEST(LoopOptions, RefusesUnknownAndDeclaredCandidates) {
 TEST(Loop, FindsAnUndeclaredMocapOffsetAndReachesTheNoise) {
   sim::ArmParameters truth = Nominal().parameters;
   sim::EnableEffectAtRealisticMagnitude("mocap_offset", "test", &truth);
-  const std::vector<Experiment> training = Recordings(truth, {1, 2});
-  const std::vector<Experiment> holdout = Recordings(truth, {3});
-  const LoopSummary s =
-      CloseLoop(training, holdout, Options({"table_tilt", "mocap_offset", "actuator_delay"}));
+  const std::vector<Experiment> training = LoopRecordings(truth, {1, 2});
+  const std::vector<Experiment> holdout = LoopRecordings(truth, {3});
+  const LoopSummary s = CloseLoop(
+      training, holdout, LoopTestOptions({"table_tilt", "mocap_offset", "actuator_delay"}));
   ASSERT_FALSE(s.rounds.empty());
   EXPECT_EQ(s.rounds[0].candidates.front().name, "mocap_offset");  // ranked first
   EXPECT_THAT(s.added_effects, ElementsAre("mocap_offset"));
@@ -170,11 +154,11 @@ TEST(Loop, FindsAnUndeclaredMocapOffsetAndReachesTheNoise) {
 TEST(Loop, AddsNothingWhenTheDeclaredModelIsRight) {
   sim::ArmParameters truth = Nominal().parameters;
   truth.T_p = 55.0;  // a declared parameter away from its start: the fit finds it
-  const std::vector<Experiment> training = Recordings(truth, {1, 2});
-  const std::vector<Experiment> holdout = Recordings(truth, {3});
+  const std::vector<Experiment> training = LoopRecordings(truth, {1, 2});
+  const std::vector<Experiment> holdout = LoopRecordings(truth, {3});
   // Terms too: null data must not make the discovery add anything.
-  const LoopSummary s =
-      CloseLoop(training, holdout, Options({"table_tilt", "mocap_offset", "backlash", "terms"}));
+  const LoopSummary s = CloseLoop(
+      training, holdout, LoopTestOptions({"table_tilt", "mocap_offset", "backlash", "terms"}));
   EXPECT_TRUE(s.added_effects.empty());
   EXPECT_TRUE(s.discovered_terms.empty());
   ASSERT_EQ(s.rounds.size(), 1u);
