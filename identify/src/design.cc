@@ -90,11 +90,42 @@ bool DesignOptions::IsValid(std::string* error) const {
   return true;
 }
 
+std::vector<Experiment> DesignExperiments(const std::vector<DesignCandidate>& candidates,
+                                          const DesignOptions& options) {
+  std::vector<Experiment> experiments;
+  for (const DesignCandidate& candidate : candidates) {
+    for (const PlannedExperiment& planned : candidate.experiments) {
+      experiments.push_back(AsExperiment(planned, options));
+    }
+  }
+  return experiments;
+}
+
 namespace {
 
-// One candidate with the parameters of its experiments' configurations.
+// DesignOptions::backend as one candidate's: its experiment k is the
+// backend's first + k.
+class CandidateBackend final : public SimulationBackend {
+ public:
+  CandidateBackend(std::shared_ptr<SimulationBackend> all, std::size_t first)
+      : all_(std::move(all)), first_(first) {}
+  std::vector<RunResult> RunBatch(const std::vector<RunRequest>& requests,
+                                  const RunFinishedCallback& on_finished) override {
+    std::vector<RunRequest> shifted = requests;
+    for (RunRequest& r : shifted) r.experiment += first_;
+    return all_->RunBatch(shifted, on_finished);
+  }
+  int parallelism() const override { return all_->parallelism(); }
+
+ private:
+  std::shared_ptr<SimulationBackend> all_;
+  std::size_t first_;
+};
+
+// One candidate with the parameters of its experiments' configurations;
+// `first_experiment`: the index of its first experiment in DesignExperiments.
 CandidateInformation EvaluateCandidate(const DesignCandidate& candidate,
-                                       const DesignOptions& options) {
+                                       const DesignOptions& options, std::size_t first_experiment) {
   CandidateInformation info;
   info.name = candidate.name;
   info.protocol_yaml = candidate.protocol_yaml;
@@ -124,13 +155,13 @@ CandidateInformation EvaluateCandidate(const DesignCandidate& candidate,
   }
   fit.relative_step = options.relative_step;
   fit.threads = options.threads;
-  fit.backend = options.backend;
+  if (options.backend) fit.backend = std::make_shared<CandidateBackend>(options.backend, first_experiment);
   fit.on_run = options.on_run;
 
   // The prior's own angles as the measurement: one run per experiment.
   {
     std::unique_ptr<SimulationBackend> own;
-    SimulationBackend* backend = options.backend.get();
+    SimulationBackend* backend = fit.backend.get();
     if (backend == nullptr) {
       own = MakeThreadBackend(&experiments, options.threads);
       backend = own.get();
@@ -257,8 +288,12 @@ DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
       }
     }
   }
-  for (const DesignCandidate& candidate : candidates) {
-    summary.candidates.push_back(EvaluateCandidate(candidate, options));
+  std::vector<std::size_t> first(candidates.size(), 0);  // index in DesignExperiments
+  for (std::size_t k = 1; k < candidates.size(); ++k) {
+    first[k] = first[k - 1] + candidates[k - 1].experiments.size();
+  }
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    summary.candidates.push_back(EvaluateCandidate(candidates[k], options, first[k]));
     summary.simulations += summary.candidates.back().simulations;
   }
   const auto by_worst = [&](std::size_t a, std::size_t b) {
@@ -289,7 +324,7 @@ DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
             sim::SetParameter(name, value, "--prior-box", &e.config.parameters);
           }
         }
-        const CandidateInformation there = EvaluateCandidate(at_corner, options);
+        const CandidateInformation there = EvaluateCandidate(at_corner, options, first[k]);
         info.simulations += there.simulations;
         summary.simulations += there.simulations;
         corner.completed = there.completed;
@@ -443,6 +478,13 @@ PlannedExperiment PlanExperiment(const sim::Config& prior, const sim::Protocol& 
 DesignSummary ProposeDesign(const sim::Config& prior, const ProposalSpace& space,
                             const std::vector<DesignCandidate>& given, const DesignOptions& options,
                             std::vector<std::string>* skipped) {
+  return EvaluateDesigns(ProposalCandidates(prior, space, given, skipped), options);
+}
+
+std::vector<DesignCandidate> ProposalCandidates(const sim::Config& prior,
+                                                const ProposalSpace& space,
+                                                const std::vector<DesignCandidate>& given,
+                                                std::vector<std::string>* skipped) {
   std::string error;
   if (!space.IsValid(&error)) ThrowInputError("design proposal space", "", error);
   std::vector<DesignCandidate> candidates = given;
@@ -495,7 +537,7 @@ DesignSummary ProposeDesign(const sim::Config& prior, const ProposalSpace& space
       if (skipped != nullptr) skipped->push_back(e.what());
     }
   }
-  return EvaluateDesigns(candidates, options);
+  return candidates;
 }
 
 std::string PlannedMotionCsv(const sim::Config& prior, const std::string& protocol_yaml,
