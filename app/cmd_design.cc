@@ -71,14 +71,14 @@ std::string ResultOptions(const DesignArgs& a) {
   for (const std::string& b : a.prior_box) text += b + ",";
   text += "\nchirps=";
   for (const std::string& c : a.chirps) text += c + ",";
-  text += "\npropose=" + std::to_string(a.propose) + " amplitudes=" +
-          numbers(a.space.amplitudes_deg) + " move_times=" + numbers(a.space.move_times_s) +
-          " sines=" + numbers(a.space.sine_frequencies_hz) + " planes=" +
-          numbers(a.space.planes_deg) + " figures=" +
-          numbers({a.space.budget_s, a.space.hold_s, a.noise_deg, a.effective_fraction,
-                   a.frame_rate_hz, static_cast<double>(a.case_number),
-                   static_cast<double>(a.robust_candidates),
-                   static_cast<double>(a.space.opposed_segments)});
+  text +=
+      "\npropose=" + std::to_string(a.propose) + " amplitudes=" + numbers(a.space.amplitudes_deg) +
+      " move_times=" + numbers(a.space.move_times_s) +
+      " sines=" + numbers(a.space.sine_frequencies_hz) + " planes=" + numbers(a.space.planes_deg) +
+      " figures=" +
+      numbers({a.space.budget_s, a.space.hold_s, a.noise_deg, a.effective_fraction, a.frame_rate_hz,
+               static_cast<double>(a.case_number), static_cast<double>(a.robust_candidates),
+               static_cast<double>(a.space.opposed_segments)});
   return text;
 }
 

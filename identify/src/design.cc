@@ -155,7 +155,8 @@ CandidateInformation EvaluateCandidate(const DesignCandidate& candidate,
   }
   fit.relative_step = options.relative_step;
   fit.threads = options.threads;
-  if (options.backend) fit.backend = std::make_shared<CandidateBackend>(options.backend, first_experiment);
+  if (options.backend)
+    fit.backend = std::make_shared<CandidateBackend>(options.backend, first_experiment);
   fit.on_run = options.on_run;
 
   // The prior's own angles as the measurement: one run per experiment.
