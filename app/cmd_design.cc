@@ -231,6 +231,7 @@ int RunDesign(const DesignArgs& a) {
   // request then stays an experiment index and parameter values, as for
   // identify and loop. ShareRuns checks that every rank built the same.
   if (a.propose) candidates = identify::ProposalCandidates(prior, space, candidates, &skipped);
+  identify::CheckDesign(candidates, options);  // before the checkpoint is written
   const std::vector<identify::Experiment> experiments =
       identify::DesignExperiments(candidates, options);
   const auto backends = RunBackends({&experiments}, options.threads, a.run_timeout_s);

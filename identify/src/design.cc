@@ -103,6 +103,25 @@ std::vector<Experiment> DesignExperiments(const std::vector<DesignCandidate>& ca
 
 namespace {
 
+// The prior values of the free parameters in a candidate's first experiment.
+// Throws InputError for an unknown name or a prior of 0.
+std::vector<double> FreePriors(const DesignCandidate& candidate, const DesignOptions& options) {
+  const sim::Config& first = candidate.experiments.front().config;
+  std::vector<double> priors;
+  for (const std::string& name : options.free_parameters) {
+    sim::FindParameter(name, "--free", first.arm.size());  // throws for an unknown name
+    const double prior = sim::GetParameter(first.parameters, name);
+    if (prior == 0.0 || !std::isfinite(prior)) {
+      ThrowInputError("--free", name,
+                      "its prior value is 0, where a relative standard error means nothing: "
+                      "give a prior (--set " +
+                          name + "=..., --params)");
+    }
+    priors.push_back(prior);
+  }
+  return priors;
+}
+
 // DesignOptions::backend as one candidate's: its experiment k is the
 // backend's first + k.
 class CandidateBackend final : public SimulationBackend {
@@ -136,22 +155,12 @@ CandidateInformation EvaluateCandidate(const DesignCandidate& candidate,
     info.experiments.push_back(planned.name);
     info.duration_s += planned.duration_s;
   }
-  const sim::Config& first = candidate.experiments.front().config;
-  const sim::ArmSize arm = first.arm.size();
   IdentificationOptions fit;
   fit.free_parameters = options.free_parameters;
-  for (const std::string& name : options.free_parameters) {
-    sim::FindParameter(name, "--free", arm);  // throws for an unknown name
-    const double prior = sim::GetParameter(first.parameters, name);
-    if (prior == 0.0 || !std::isfinite(prior)) {
-      ThrowInputError("--free", name,
-                      "its prior value is 0, where a relative standard error means nothing: "
-                      "give a prior (--set " +
-                          name + "=..., --params)");
-    }
-    info.prior.push_back(prior);
+  info.prior = FreePriors(candidate, options);
+  for (std::size_t i = 0; i < info.prior.size(); ++i) {
     // The scaled space is relative to the prior: u = p / |prior|.
-    fit.scales[name] = std::abs(prior);
+    fit.scales[options.free_parameters[i]] = std::abs(info.prior[i]);
   }
   fit.relative_step = options.relative_step;
   fit.threads = options.threads;
@@ -259,18 +268,14 @@ std::vector<std::pair<std::string, double>> Corner(const std::vector<PriorRange>
 
 }  // namespace
 
-DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
-                              const DesignOptions& options) {
+void CheckDesign(const std::vector<DesignCandidate>& candidates, const DesignOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError("design options", "", error);
-  const auto clock_start = std::chrono::steady_clock::now();
-  DesignSummary summary;
-  summary.options = options;
-  summary.threads = options.backend ? options.backend->parallelism() : options.threads;
   for (const DesignCandidate& candidate : candidates) {
     if (candidate.experiments.empty()) {
       ThrowInputError("design candidate '" + candidate.name + "'", "", "has no experiments");
     }
+    FreePriors(candidate, options);
   }
   // The box's values are checked against the arm's parameter table before
   // any run.
@@ -289,6 +294,15 @@ DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
       }
     }
   }
+}
+
+DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
+                              const DesignOptions& options) {
+  CheckDesign(candidates, options);
+  const auto clock_start = std::chrono::steady_clock::now();
+  DesignSummary summary;
+  summary.options = options;
+  summary.threads = options.backend ? options.backend->parallelism() : options.threads;
   std::vector<std::size_t> first(candidates.size(), 0);  // index in DesignExperiments
   for (std::size_t k = 1; k < candidates.size(); ++k) {
     first[k] = first[k - 1] + candidates[k - 1].experiments.size();

@@ -225,6 +225,9 @@ PlannedExperiment PlanExperiment(const sim::Config& prior, const sim::Protocol& 
 // thrown.
 DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
                               const DesignOptions& options);
+// The checks EvaluateDesigns makes before any run, each throwing its
+// InputError: for a command to refuse bad input before it writes anything.
+void CheckDesign(const std::vector<DesignCandidate>& candidates, const DesignOptions& options);
 
 // Evaluates every point of `space` as a plan of one experiment on the arm of
 // `prior`, after `given` (plans to compare with). A point whose protocol the
