@@ -15,6 +15,7 @@
 #include "ccsrm/common/atomic_file.h"
 #include "run_ccsrm.h"
 #include "same_result.h"
+#include "small_design.h"
 
 namespace {
 namespace fs = std::filesystem;
@@ -144,17 +145,8 @@ TEST(MpiDesign, ThreeRanksGiveTheThreadRunsDesignToTheBit) {
   std::string why;
   if (MpiMissing(&why)) GTEST_SKIP() << why;
   const fs::path dir = ScratchDirectory("mpi_design_" + std::to_string(getpid()));
-  const std::string protocol = (dir / "move.yaml").string();
-  ccsrm::WriteTextFileAtomically(
-      protocol,
-      "schema: ccsrm-protocol/1\nparameters: {amplitude_deg: 2}\nsegments:\n  all:\n"
-      "    - move: {to: {theta_x_deg: amplitude_deg}, duration_s: 0.5}\n");
-  // Two plans of unequal length (one of two experiments) on the loop
-  // sample's arm.
-  const std::string design = "design --config " + std::string(CCSRM_SOURCE_DIR) +
-                             "/datasets/samples/loop/arm.yaml --case 4 --free mu_c,T_p --plans " +
-                             protocol + "@amplitude_deg=4 " + protocol + "@amplitude_deg=-3+" +
-                             protocol + "@amplitude_deg=5 --quiet --out ";
+  // Two plans of unequal length (one of two experiments).
+  const std::string design = ccsrm::testing::SmallDesign(dir) + "--quiet --out ";
   const std::string threads_out = (dir / "threads").string();
   const std::string ranks_out = (dir / "ranks").string();
   const Outcome t = RunCcsrm(design + threads_out + " --threads 3");

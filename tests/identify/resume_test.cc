@@ -21,6 +21,7 @@
 #include "ccsrm/common/atomic_file.h"
 #include "run_ccsrm.h"
 #include "same_result.h"
+#include "small_design.h"
 
 namespace {
 namespace fs = std::filesystem;
@@ -143,6 +144,23 @@ TEST(IdentifyResume, AFitKilledAtARandomMomentResumesToTheSameResult) {
   EXPECT_FALSE(fs::exists(stopped + "/checkpoint.json")) << "the resumed fit is done";
 }
 
+// Kills `ccsrm <args><stopped>` at a random moment of the first half of
+// `whole_s` after its journal holds a first batch; *trace says when (with
+// the seed, to replay a failure).
+bool KillAfterFirstBatch(const std::string& args, const std::string& stopped, double whole_s,
+                         std::string* trace, std::string* why,
+                         const std::string& err = "/dev/null") {
+  const unsigned seed = std::random_device{}();
+  std::mt19937 random(seed);
+  const double delay_s = std::uniform_real_distribution<double>(0.0, 0.5 * whole_s)(random);
+  *trace = "seed " + std::to_string(seed) + ", killed " + std::to_string(delay_s) +
+           " s after the first batch was recorded";
+  const std::string journal = stopped + "/runs.journal";
+  return KillWhenReady(
+      args + stopped, [&] { return fs::exists(journal) && fs::file_size(journal) > 0; }, delay_s,
+      why, err);
+}
+
 // Runs simulated and taken from the journal, from the closing line of a
 // loop or design.
 bool JournalRuns(const std::string& out, long long* simulated, long long* replayed) {
@@ -184,17 +202,11 @@ TEST(LoopResume, ALoopKilledAtARandomMomentResumesToTheSameResult) {
   EXPECT_EQ(whole_replayed, 0);
 
   const std::string stopped = (dir / "stopped").string();
-  const unsigned seed = std::random_device{}();
-  std::mt19937 random(seed);
-  const double delay_s = std::uniform_real_distribution<double>(0.0, 0.5 * whole_s)(random);
-  SCOPED_TRACE("seed " + std::to_string(seed) + ", killed " + std::to_string(delay_s) +
-               " s after the first batch was recorded");
   const std::string journal = stopped + "/runs.journal";
-  std::string why;
-  ASSERT_TRUE(KillWhenReady(
-      loop + stopped, [&] { return fs::exists(journal) && fs::file_size(journal) > 0; }, delay_s,
-      &why))
-      << why;
+  std::string trace, why;
+  const bool killed = KillAfterFirstBatch(loop, stopped, whole_s, &trace, &why);
+  SCOPED_TRACE(trace);
+  ASSERT_TRUE(killed) << why;
   EXPECT_FALSE(fs::exists(stopped + "/loop.json"));
 
   const Outcome refused = RunCcsrm(loop + stopped + " --resume --set mu_c=0.1");
@@ -223,18 +235,9 @@ TEST(LoopResume, ALoopKilledAtARandomMomentResumesToTheSameResult) {
 // candidate's are simulated again (the batch in flight at the kill).
 TEST(DesignResume, ADesignKilledAtARandomMomentResumesToTheSameResult) {
   const fs::path dir = ScratchDirectory("design_resume");
-  const std::string protocol = (dir / "move.yaml").string();
-  ccsrm::WriteTextFileAtomically(
-      protocol,
-      "schema: ccsrm-protocol/1\nparameters: {amplitude_deg: 2}\nsegments:\n  all:\n"
-      "    - move: {to: {theta_x_deg: amplitude_deg}, duration_s: 0.5}\n");
-  // Three plans of the loop sample's arm, one of two experiments: a few
-  // seconds of runs, in batches of a few runs each.
-  const std::string design = "design --config " + std::string(CCSRM_SOURCE_DIR) +
-                             "/datasets/samples/loop/arm.yaml --case 4 --free mu_c,T_p --plans " +
-                             protocol + "@amplitude_deg=4 " + protocol + "@amplitude_deg=-3+" +
-                             protocol + "@amplitude_deg=5 " + protocol +
-                             "@amplitude_deg=6 --threads 2 --out ";
+  // Three plans, one of two experiments: a few seconds of runs, in batches
+  // of a few runs each.
+  const std::string design = ccsrm::testing::SmallDesign(dir, "6") + "--threads 2 --out ";
   const std::string whole = (dir / "whole").string();
   const auto t0 = Clock::now();
   const Outcome w = RunCcsrm(design + whole + " --quiet");
@@ -253,17 +256,11 @@ TEST(DesignResume, ADesignKilledAtARandomMomentResumesToTheSameResult) {
 
   const std::string stopped = (dir / "stopped").string();
   const std::string progress = (dir / "killed.err").string();
-  const unsigned seed = std::random_device{}();
-  std::mt19937 random(seed);
-  const double delay_s = std::uniform_real_distribution<double>(0.0, 0.5 * whole_s)(random);
-  SCOPED_TRACE("seed " + std::to_string(seed) + ", killed " + std::to_string(delay_s) +
-               " s after the first batch was recorded");
   const std::string journal = stopped + "/runs.journal";
-  std::string why;
-  ASSERT_TRUE(KillWhenReady(
-      design + stopped, [&] { return fs::exists(journal) && fs::file_size(journal) > 0; }, delay_s,
-      &why, progress))
-      << why;
+  std::string trace, why;
+  const bool killed = KillAfterFirstBatch(design, stopped, whole_s, &trace, &why, progress);
+  SCOPED_TRACE(trace);
+  ASSERT_TRUE(killed) << why;
   EXPECT_FALSE(fs::exists(stopped + "/design.json"));
   // One "simulation k / n" line per run finished before the kill.
   const std::string lines = ccsrm::ReadTextFile(progress);
