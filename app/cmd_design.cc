@@ -16,6 +16,8 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/number_text.h"
 #include "ccsrm/identify/design.h"
+#include "ccsrm/identify/mpi_backend.h"
+#include "ccsrm/identify/run_journal.h"
 #include "ccsrm/sim/paper_run.h"
 #include "commands.h"
 #include "fit_inputs.h"
@@ -45,7 +47,40 @@ struct DesignArgs {
   int robust_candidates = identify::DesignOptions().robust_candidates;
   std::string out;
   bool quiet = false;
+  double run_timeout_s = identify::MpiOptions().run_timeout_s;
+  bool resume = false;
 };
+
+// What decides the design besides the input files' bytes (not --threads,
+// --quiet, --run-timeout or the number of ranks), for the checkpoint's digest.
+std::string ResultOptions(const DesignArgs& a) {
+  const auto numbers = [](const std::vector<double>& values) {
+    std::string text;
+    char number[32];
+    for (const double v : values) {
+      std::snprintf(number, sizeof(number), "%.17g,", v);
+      text += number;
+    }
+    return text;
+  };
+  std::string text = "free=" + a.free + "\nplans=";
+  for (const std::string& p : a.plans) text += p + "\n";
+  text += "sets=";
+  for (const std::string& s : a.set) text += s + ",";
+  text += "\nprior_box=";
+  for (const std::string& b : a.prior_box) text += b + ",";
+  text += "\nchirps=";
+  for (const std::string& c : a.chirps) text += c + ",";
+  text +=
+      "\npropose=" + std::to_string(a.propose) + " amplitudes=" + numbers(a.space.amplitudes_deg) +
+      " move_times=" + numbers(a.space.move_times_s) +
+      " sines=" + numbers(a.space.sine_frequencies_hz) + " planes=" + numbers(a.space.planes_deg) +
+      " figures=" +
+      numbers({a.space.budget_s, a.space.hold_s, a.noise_deg, a.effective_fraction, a.frame_rate_hz,
+               static_cast<double>(a.case_number), static_cast<double>(a.robust_candidates),
+               static_cast<double>(a.space.opposed_segments)});
+  return text;
+}
 
 std::vector<std::string> Split(const std::string& text, char separator) {
   std::vector<std::string> parts;
@@ -178,13 +213,11 @@ int RunDesign(const DesignArgs& a) {
     candidates.push_back(std::move(candidate));
   }
   CheckOut(a.out, DesignFolderOutput(), inputs);
-  std::printf("design: %zu plan%s, free %s, on %d thread%s\n", candidates.size(),
-              candidates.size() == 1 ? "" : "s", a.free.c_str(), options.threads,
-              options.threads == 1 ? "" : "s");
-  std::fflush(stdout);
-  if (!a.quiet) options.on_run = RunProgress();
+  // A design is resumed by running it again over the journal of its runs
+  // (as a loop is): it asks for the same runs in the same order.
+  const CheckpointKey key = MakeCheckpointKey("design", ResultOptions(a), inputs);
+  if (a.resume) ReadCheckpoint(a.out, key);  // refuses other data, options or version
   std::vector<std::string> skipped;
-  identify::DesignSummary summary;
   // The prior: the arm with the case, --params and --set, as a plan's.
   sim::PaperRunOptions prior_run;
   prior_run.config_path = a.config;
@@ -192,11 +225,31 @@ int RunDesign(const DesignArgs& a) {
   prior_run.params_path = a.params;
   prior_run.sets = a.set;
   const sim::Config prior = sim::PreparePaperRun(prior_run).config;
-  if (a.propose) {
-    summary = identify::ProposeDesign(prior, space, candidates, options, &skipped);
-  } else {
-    summary = identify::EvaluateDesigns(candidates, options);
+  // Under mpirun every rank builds the candidates itself from the same
+  // command line and files rather than receiving them from rank 0: building
+  // them is a function of those alone and takes milliseconds, and a run
+  // request then stays an experiment index and parameter values, as for
+  // identify and loop. ShareRuns checks that every rank built the same.
+  if (a.propose) candidates = identify::ProposalCandidates(prior, space, candidates, &skipped);
+  identify::CheckDesign(candidates, options);  // before the checkpoint is written
+  const std::vector<identify::Experiment> experiments =
+      identify::DesignExperiments(candidates, options);
+  const auto backends = RunBackends({&experiments}, options.threads, a.run_timeout_s);
+  if (backends.empty()) return 0;  // another rank of an MPI job: it served rank 0's runs
+  WriteCheckpoint(a.out, key, {{"runs_journal", "runs.journal"}});
+  const auto journal = std::make_shared<identify::RunJournal>(
+      (std::filesystem::path(a.out) / "runs.journal").string(), a.resume);
+  if (a.resume) {
+    std::printf("resuming: %lld runs recorded in %s\n", static_cast<long long>(journal->recorded()),
+                journal->path().c_str());
   }
+  options.backend = identify::WithJournal(backends[0], journal, 0);
+  std::printf("design: %zu plan%s, free %s, on %d thread%s\n", candidates.size(),
+              candidates.size() == 1 ? "" : "s", a.free.c_str(), options.threads,
+              options.threads == 1 ? "" : "s");
+  std::fflush(stdout);
+  if (!a.quiet) options.on_run = RunProgress();
+  const identify::DesignSummary summary = identify::EvaluateDesigns(candidates, options);
   std::printf("%s", summary.FullReport().c_str());
   for (const std::string& why : skipped) std::printf("  left out: %s\n", why.c_str());
   AtomicOutputDirectory out(a.out);
@@ -219,8 +272,12 @@ int RunDesign(const DesignArgs& a) {
         (tmp / "proposed.inputs.csv").string(),
         identify::PlannedMotionCsv(prior, best->protocol_yaml, best->name, options.frame_rate_hz));
   }
-  out.Commit();
+  out.Commit();  // the folder replaced as a whole: the checkpoint and journal go with it
+  RemoveCheckpoint(a.out);
   std::printf("  output: %s/design.json\n", a.out.c_str());
+  std::printf("  runs: %lld simulated, %lld taken from the journal of a stopped run\n",
+              static_cast<long long>(journal->simulated()),
+              static_cast<long long>(journal->replayed()));
   if (best != nullptr) {
     std::printf(
         "  proposed: %s/proposed.yaml (%s), planned inputs and angles in %s/"
@@ -326,6 +383,11 @@ void AddDesignCommand(CLI::App& root) {
       ->check(ValidIn(&identify::DesignOptions::threads, Checkable()));
   cmd->add_option("--out", a->out, "Output folder")->required();
   cmd->add_flag("--quiet", a->quiet, "No progress lines");
+  AddRunTimeoutOption(cmd, &a->run_timeout_s);
+  cmd->add_flag("--resume", a->resume,
+                "Continue the design stopped in --out: it runs again, taking every run it had "
+                "done from its journal (runs.journal); refused for other plans, data, options or "
+                "version");
   cmd->callback([a] {
     const int code = RunDesign(*a);
     if (code != 0) throw CLI::RuntimeError(code);

@@ -29,7 +29,9 @@ int ExitOnParseError(const CLI::App& root, const CLI::ParseError& e) {
 }
 
 // The commands whose runs go to every rank of an MPI job (docs/cluster.md).
-bool SharesRuns(const std::string& command) { return command == "identify" || command == "loop"; }
+bool SharesRuns(const std::string& command) {
+  return command == "identify" || command == "loop" || command == "design";
+}
 
 int Run(int argc, char** argv) {
   const std::string command = argc > 1 ? argv[1] : "";

@@ -104,7 +104,9 @@ OutputKind PredictionFolderOutput() {
 
 OutputKind DesignFolderOutput() {
   return {"ccsrm design folder (design.json, ccsrm-design/1)", true, [](const std::string& p) {
-            return FolderJsonHasSchema(p, "design.json", "ccsrm-design/1");
+            // Or one a stopped design left its checkpoint in (--resume).
+            return FolderJsonHasSchema(p, "design.json", "ccsrm-design/1") ||
+                   FolderJsonHasSchema(p, "checkpoint.json", "ccsrm-checkpoint/1");
           }};
 }
 

@@ -90,11 +90,61 @@ bool DesignOptions::IsValid(std::string* error) const {
   return true;
 }
 
+std::vector<Experiment> DesignExperiments(const std::vector<DesignCandidate>& candidates,
+                                          const DesignOptions& options) {
+  std::vector<Experiment> experiments;
+  for (const DesignCandidate& candidate : candidates) {
+    for (const PlannedExperiment& planned : candidate.experiments) {
+      experiments.push_back(AsExperiment(planned, options));
+    }
+  }
+  return experiments;
+}
+
 namespace {
 
-// One candidate with the parameters of its experiments' configurations.
+// The prior values of the free parameters in a candidate's first experiment.
+// Throws InputError for an unknown name or a prior of 0.
+std::vector<double> FreePriors(const DesignCandidate& candidate, const DesignOptions& options) {
+  const sim::Config& first = candidate.experiments.front().config;
+  std::vector<double> priors;
+  for (const std::string& name : options.free_parameters) {
+    sim::FindParameter(name, "--free", first.arm.size());  // throws for an unknown name
+    const double prior = sim::GetParameter(first.parameters, name);
+    if (prior == 0.0 || !std::isfinite(prior)) {
+      ThrowInputError("--free", name,
+                      "its prior value is 0, where a relative standard error means nothing: "
+                      "give a prior (--set " +
+                          name + "=..., --params)");
+    }
+    priors.push_back(prior);
+  }
+  return priors;
+}
+
+// DesignOptions::backend as one candidate's: its experiment k is the
+// backend's first + k.
+class CandidateBackend final : public SimulationBackend {
+ public:
+  CandidateBackend(std::shared_ptr<SimulationBackend> all, std::size_t first)
+      : all_(std::move(all)), first_(first) {}
+  std::vector<RunResult> RunBatch(const std::vector<RunRequest>& requests,
+                                  const RunFinishedCallback& on_finished) override {
+    std::vector<RunRequest> shifted = requests;
+    for (RunRequest& r : shifted) r.experiment += first_;
+    return all_->RunBatch(shifted, on_finished);
+  }
+  int parallelism() const override { return all_->parallelism(); }
+
+ private:
+  std::shared_ptr<SimulationBackend> all_;
+  std::size_t first_;
+};
+
+// One candidate with the parameters of its experiments' configurations;
+// `first_experiment`: the index of its first experiment in DesignExperiments.
 CandidateInformation EvaluateCandidate(const DesignCandidate& candidate,
-                                       const DesignOptions& options) {
+                                       const DesignOptions& options, std::size_t first_experiment) {
   CandidateInformation info;
   info.name = candidate.name;
   info.protocol_yaml = candidate.protocol_yaml;
@@ -105,32 +155,23 @@ CandidateInformation EvaluateCandidate(const DesignCandidate& candidate,
     info.experiments.push_back(planned.name);
     info.duration_s += planned.duration_s;
   }
-  const sim::Config& first = candidate.experiments.front().config;
-  const sim::ArmSize arm = first.arm.size();
   IdentificationOptions fit;
   fit.free_parameters = options.free_parameters;
-  for (const std::string& name : options.free_parameters) {
-    sim::FindParameter(name, "--free", arm);  // throws for an unknown name
-    const double prior = sim::GetParameter(first.parameters, name);
-    if (prior == 0.0 || !std::isfinite(prior)) {
-      ThrowInputError("--free", name,
-                      "its prior value is 0, where a relative standard error means nothing: "
-                      "give a prior (--set " +
-                          name + "=..., --params)");
-    }
-    info.prior.push_back(prior);
+  info.prior = FreePriors(candidate, options);
+  for (std::size_t i = 0; i < info.prior.size(); ++i) {
     // The scaled space is relative to the prior: u = p / |prior|.
-    fit.scales[name] = std::abs(prior);
+    fit.scales[options.free_parameters[i]] = std::abs(info.prior[i]);
   }
   fit.relative_step = options.relative_step;
   fit.threads = options.threads;
-  fit.backend = options.backend;
+  if (options.backend)
+    fit.backend = std::make_shared<CandidateBackend>(options.backend, first_experiment);
   fit.on_run = options.on_run;
 
   // The prior's own angles as the measurement: one run per experiment.
   {
     std::unique_ptr<SimulationBackend> own;
-    SimulationBackend* backend = options.backend.get();
+    SimulationBackend* backend = fit.backend.get();
     if (backend == nullptr) {
       own = MakeThreadBackend(&experiments, options.threads);
       backend = own.get();
@@ -227,18 +268,14 @@ std::vector<std::pair<std::string, double>> Corner(const std::vector<PriorRange>
 
 }  // namespace
 
-DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
-                              const DesignOptions& options) {
+void CheckDesign(const std::vector<DesignCandidate>& candidates, const DesignOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError("design options", "", error);
-  const auto clock_start = std::chrono::steady_clock::now();
-  DesignSummary summary;
-  summary.options = options;
-  summary.threads = options.backend ? options.backend->parallelism() : options.threads;
   for (const DesignCandidate& candidate : candidates) {
     if (candidate.experiments.empty()) {
       ThrowInputError("design candidate '" + candidate.name + "'", "", "has no experiments");
     }
+    FreePriors(candidate, options);
   }
   // The box's values are checked against the arm's parameter table before
   // any run.
@@ -257,8 +294,21 @@ DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
       }
     }
   }
-  for (const DesignCandidate& candidate : candidates) {
-    summary.candidates.push_back(EvaluateCandidate(candidate, options));
+}
+
+DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
+                              const DesignOptions& options) {
+  CheckDesign(candidates, options);
+  const auto clock_start = std::chrono::steady_clock::now();
+  DesignSummary summary;
+  summary.options = options;
+  summary.threads = options.backend ? options.backend->parallelism() : options.threads;
+  std::vector<std::size_t> first(candidates.size(), 0);  // index in DesignExperiments
+  for (std::size_t k = 1; k < candidates.size(); ++k) {
+    first[k] = first[k - 1] + candidates[k - 1].experiments.size();
+  }
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    summary.candidates.push_back(EvaluateCandidate(candidates[k], options, first[k]));
     summary.simulations += summary.candidates.back().simulations;
   }
   const auto by_worst = [&](std::size_t a, std::size_t b) {
@@ -289,7 +339,7 @@ DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
             sim::SetParameter(name, value, "--prior-box", &e.config.parameters);
           }
         }
-        const CandidateInformation there = EvaluateCandidate(at_corner, options);
+        const CandidateInformation there = EvaluateCandidate(at_corner, options, first[k]);
         info.simulations += there.simulations;
         summary.simulations += there.simulations;
         corner.completed = there.completed;
@@ -443,6 +493,13 @@ PlannedExperiment PlanExperiment(const sim::Config& prior, const sim::Protocol& 
 DesignSummary ProposeDesign(const sim::Config& prior, const ProposalSpace& space,
                             const std::vector<DesignCandidate>& given, const DesignOptions& options,
                             std::vector<std::string>* skipped) {
+  return EvaluateDesigns(ProposalCandidates(prior, space, given, skipped), options);
+}
+
+std::vector<DesignCandidate> ProposalCandidates(const sim::Config& prior,
+                                                const ProposalSpace& space,
+                                                const std::vector<DesignCandidate>& given,
+                                                std::vector<std::string>* skipped) {
   std::string error;
   if (!space.IsValid(&error)) ThrowInputError("design proposal space", "", error);
   std::vector<DesignCandidate> candidates = given;
@@ -495,7 +552,7 @@ DesignSummary ProposeDesign(const sim::Config& prior, const ProposalSpace& space
       if (skipped != nullptr) skipped->push_back(e.what());
     }
   }
-  return EvaluateDesigns(candidates, options);
+  return candidates;
 }
 
 std::string PlannedMotionCsv(const sim::Config& prior, const std::string& protocol_yaml,

@@ -349,6 +349,9 @@ const std::vector<BadInput>& Rows() {
        "design --free mu,,T_p --plans {d}/proto.yaml --out {d}/design",
        {"--free", "empty name"}},
       {"overrides",
+       "design --free mu --plans {d}/proto.yaml --resume --out {d}/nodesign",
+       {"{d}/nodesign/checkpoint.json", "--resume", "no checkpoint"}},  // issue 29
+      {"overrides",
        "design --free mu --plans {d}/proto.yaml@amplitude --out {d}/design",
        {"--plans", "expected name=value after '@'"}},
       {"overrides",

@@ -15,6 +15,7 @@
 #include "ccsrm/common/atomic_file.h"
 #include "run_ccsrm.h"
 #include "same_result.h"
+#include "small_design.h"
 
 namespace {
 namespace fs = std::filesystem;
@@ -136,5 +137,32 @@ void ExpectLostRankEndsTheJob(const std::string& mode) {
 
 TEST(MpiIdentify, ARankThatDiesEndsTheJobWithOneLine) { ExpectLostRankEndsTheJob("exit"); }
 TEST(MpiIdentify, ARankThatHangsEndsTheJobWithOneLine) { ExpectLostRankEndsTheJob("hang"); }
+
+// `mpirun -n 3 ccsrm design`: every rank builds the plans from the command
+// line, rank 0 ranks them, every rank simulates; design.json is the thread
+// run's on as many threads (3), to the bit, but for the clock.
+TEST(MpiDesign, ThreeRanksGiveTheThreadRunsDesignToTheBit) {
+  std::string why;
+  if (MpiMissing(&why)) GTEST_SKIP() << why;
+  const fs::path dir = ScratchDirectory("mpi_design_" + std::to_string(getpid()));
+  // Two plans of unequal length (one of two experiments).
+  const std::string design = ccsrm::testing::SmallDesign(dir) + "--quiet --out ";
+  const std::string threads_out = (dir / "threads").string();
+  const std::string ranks_out = (dir / "ranks").string();
+  const Outcome t = RunCcsrm(design + threads_out + " --threads 3");
+  ASSERT_EQ(t.status, 0) << t.all();
+  const Outcome m = RunCommand(Mpirun(3) + " " + design + ranks_out + " --threads 1");
+  ASSERT_EQ(m.status, 0) << m.all();
+  EXPECT_THAT(m.out, HasSubstr("runs on 3 MPI ranks"));
+  nlohmann::json a = nlohmann::json::parse(ccsrm::ReadTextFile(threads_out + "/design.json"));
+  nlohmann::json b = nlohmann::json::parse(ccsrm::ReadTextFile(ranks_out + "/design.json"));
+  EXPECT_TRUE(a["candidates"][0]["completed"].get<bool>()) << "a real evaluation is compared";
+  // Every run went through the ranks (rank 0's closing line).
+  EXPECT_THAT(m.out, HasSubstr("MPI: " + std::to_string(a["simulations"].get<long long>()) +
+                               " runs on 3 ranks"));
+  ccsrm::testing::DropKeys(&a, {"wall_time_s"});
+  ccsrm::testing::DropKeys(&b, {"wall_time_s"});
+  EXPECT_EQ(a, b) << nlohmann::json::diff(a, b).dump(1);
+}
 
 }  // namespace

@@ -1,13 +1,14 @@
-// `ccsrm identify --resume` and `ccsrm loop --resume` (issue 29): a fit killed with SIGKILL at a
-// random moment after its first checkpoint, then resumed, ends with the fit of an uninterrupted
-// run, to the bit, repeating at most one iteration's runs; a checkpoint of other options or another
-// version is refused with one line.
+// `ccsrm identify --resume`, `ccsrm loop --resume` and `ccsrm design --resume` (issue 29): a fit
+// killed with SIGKILL at a random moment after its first checkpoint, then resumed, ends with the
+// fit of an uninterrupted run, to the bit, repeating at most one iteration's runs; a checkpoint of
+// other options or another version is refused with one line.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -20,6 +21,7 @@
 #include "ccsrm/common/atomic_file.h"
 #include "run_ccsrm.h"
 #include "same_result.h"
+#include "small_design.h"
 
 namespace {
 namespace fs = std::filesystem;
@@ -36,12 +38,13 @@ void DropMachineFields(nlohmann::json* j) {
   ccsrm::testing::DropKeys(j, {"wall_time_s", "real_time_factor", "threads", "simulations"});
 }
 
-// `ccsrm <args>` in the background, output discarded; its pid.
-pid_t Launch(const std::string& args) {
+// `ccsrm <args>` in the background, stdout discarded, stderr to `err`; its
+// pid.
+pid_t Launch(const std::string& args, const std::string& err) {
   const pid_t pid = fork();
   if (pid == 0) {
     const std::string command =
-        std::string("exec ") + CCSRM_PROGRAM + " " + args + " >/dev/null 2>&1";
+        std::string("exec ") + CCSRM_PROGRAM + " " + args + " >/dev/null 2>" + err;
     execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }
@@ -52,8 +55,8 @@ pid_t Launch(const std::string& args) {
 // holds (polled; 120 s at most, which only guards a hung test). False, with
 // *why, when `ready` never held or the command ended before the kill.
 bool KillWhenReady(const std::string& args, const std::function<bool()>& ready, double delay_s,
-                   std::string* why) {
-  const pid_t pid = Launch(args);
+                   std::string* why, const std::string& err = "/dev/null") {
+  const pid_t pid = Launch(args, err);
   const auto deadline = Clock::now() + std::chrono::seconds(120);
   while (!ready() && Clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -141,6 +144,32 @@ TEST(IdentifyResume, AFitKilledAtARandomMomentResumesToTheSameResult) {
   EXPECT_FALSE(fs::exists(stopped + "/checkpoint.json")) << "the resumed fit is done";
 }
 
+// Kills `ccsrm <args><stopped>` at a random moment of the first half of
+// `whole_s` after its journal holds a first batch; *trace says when (with
+// the seed, to replay a failure).
+bool KillAfterFirstBatch(const std::string& args, const std::string& stopped, double whole_s,
+                         std::string* trace, std::string* why,
+                         const std::string& err = "/dev/null") {
+  const unsigned seed = std::random_device{}();
+  std::mt19937 random(seed);
+  const double delay_s = std::uniform_real_distribution<double>(0.0, 0.5 * whole_s)(random);
+  *trace = "seed " + std::to_string(seed) + ", killed " + std::to_string(delay_s) +
+           " s after the first batch was recorded";
+  const std::string journal = stopped + "/runs.journal";
+  return KillWhenReady(
+      args + stopped, [&] { return fs::exists(journal) && fs::file_size(journal) > 0; }, delay_s,
+      why, err);
+}
+
+// Runs simulated and taken from the journal, from the closing line of a
+// loop or design.
+bool JournalRuns(const std::string& out, long long* simulated, long long* replayed) {
+  const std::size_t at = out.find("runs: ");
+  return at != std::string::npos &&
+         std::sscanf(out.c_str() + at, "runs: %lld simulated, %lld taken", simulated, replayed) ==
+             2;
+}
+
 // `ccsrm loop --resume`: the loop runs again over the journal of its runs.
 // Killed at a random moment once its first batch is on disk, then resumed:
 // the same loop.json, every recorded run taken from the journal, and no run
@@ -168,28 +197,16 @@ TEST(LoopResume, ALoopKilledAtARandomMomentResumesToTheSameResult) {
   const double whole_s = std::chrono::duration<double>(Clock::now() - t0).count();
   ASSERT_EQ(w.status, 0) << w.all();
   EXPECT_FALSE(fs::exists(whole + "/runs.journal")) << "a finished loop leaves no journal";
-  const auto runs = [](const std::string& out, long long* simulated, long long* replayed) {
-    const std::size_t at = out.find("runs: ");
-    return at != std::string::npos &&
-           std::sscanf(out.c_str() + at, "runs: %lld simulated, %lld taken", simulated, replayed) ==
-               2;
-  };
   long long whole_simulated = 0, whole_replayed = 0;
-  ASSERT_TRUE(runs(w.out, &whole_simulated, &whole_replayed)) << w.out;
+  ASSERT_TRUE(JournalRuns(w.out, &whole_simulated, &whole_replayed)) << w.out;
   EXPECT_EQ(whole_replayed, 0);
 
   const std::string stopped = (dir / "stopped").string();
-  const unsigned seed = std::random_device{}();
-  std::mt19937 random(seed);
-  const double delay_s = std::uniform_real_distribution<double>(0.0, 0.5 * whole_s)(random);
-  SCOPED_TRACE("seed " + std::to_string(seed) + ", killed " + std::to_string(delay_s) +
-               " s after the first batch was recorded");
   const std::string journal = stopped + "/runs.journal";
-  std::string why;
-  ASSERT_TRUE(KillWhenReady(
-      loop + stopped, [&] { return fs::exists(journal) && fs::file_size(journal) > 0; }, delay_s,
-      &why))
-      << why;
+  std::string trace, why;
+  const bool killed = KillAfterFirstBatch(loop, stopped, whole_s, &trace, &why);
+  SCOPED_TRACE(trace);
+  ASSERT_TRUE(killed) << why;
   EXPECT_FALSE(fs::exists(stopped + "/loop.json"));
 
   const Outcome refused = RunCcsrm(loop + stopped + " --resume --set mu_c=0.1");
@@ -200,7 +217,7 @@ TEST(LoopResume, ALoopKilledAtARandomMomentResumesToTheSameResult) {
   const Outcome r = RunCcsrm(loop + stopped + " --resume");
   ASSERT_EQ(r.status, 0) << r.all();
   long long simulated = 0, replayed = 0;
-  ASSERT_TRUE(runs(r.out, &simulated, &replayed)) << r.out;
+  ASSERT_TRUE(JournalRuns(r.out, &simulated, &replayed)) << r.out;
   EXPECT_GT(replayed, 0) << "the recorded runs are taken, not simulated again";
   EXPECT_EQ(simulated + replayed, whole_simulated) << "no run beyond the uninterrupted loop's";
   nlohmann::json a = nlohmann::json::parse(ccsrm::ReadTextFile(whole + "/loop.json"));
@@ -209,6 +226,75 @@ TEST(LoopResume, ALoopKilledAtARandomMomentResumesToTheSameResult) {
   DropMachineFields(&b);
   EXPECT_EQ(a, b) << nlohmann::json::diff(a, b).dump(1);
   EXPECT_FALSE(fs::exists(journal)) << "the resumed loop is done";
+}
+
+// `ccsrm design --resume`: as the loop's, over the journal of its runs.
+// Killed at a random moment once the first candidate's first batch is on
+// disk, then resumed: the same design.json, and of the runs the killed
+// design had finished (its progress lines count them), at most one
+// candidate's are simulated again (the batch in flight at the kill).
+TEST(DesignResume, ADesignKilledAtARandomMomentResumesToTheSameResult) {
+  const fs::path dir = ScratchDirectory("design_resume");
+  // Three plans, one of two experiments: a few seconds of runs, in batches
+  // of a few runs each.
+  const std::string design = ccsrm::testing::SmallDesign(dir, "6") + "--threads 2 --out ";
+  const std::string whole = (dir / "whole").string();
+  const auto t0 = Clock::now();
+  const Outcome w = RunCcsrm(design + whole + " --quiet");
+  const double whole_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  ASSERT_EQ(w.status, 0) << w.all();
+  EXPECT_FALSE(fs::exists(whole + "/runs.journal")) << "a finished design leaves no journal";
+  EXPECT_FALSE(fs::exists(whole + "/checkpoint.json"));
+  long long whole_simulated = 0, whole_replayed = 0;
+  ASSERT_TRUE(JournalRuns(w.out, &whole_simulated, &whole_replayed)) << w.out;
+  EXPECT_EQ(whole_replayed, 0);
+  nlohmann::json a = nlohmann::json::parse(ccsrm::ReadTextFile(whole + "/design.json"));
+  long long candidate_runs = 0;  // the most runs one candidate takes
+  for (const nlohmann::json& c : a["candidates"]) {
+    candidate_runs = std::max(candidate_runs, c["simulations"].get<long long>());
+  }
+
+  const std::string stopped = (dir / "stopped").string();
+  const std::string progress = (dir / "killed.err").string();
+  const std::string journal = stopped + "/runs.journal";
+  std::string trace, why;
+  const bool killed = KillAfterFirstBatch(design, stopped, whole_s, &trace, &why, progress);
+  SCOPED_TRACE(trace);
+  ASSERT_TRUE(killed) << why;
+  EXPECT_FALSE(fs::exists(stopped + "/design.json"));
+  // One "simulation k / n" line per run finished before the kill.
+  const std::string lines = ccsrm::ReadTextFile(progress);
+  long long finished = 0;
+  for (std::size_t at = lines.find("simulation "); at != std::string::npos;
+       at = lines.find("simulation ", at + 1)) {
+    ++finished;
+  }
+
+  const Outcome refused = RunCcsrm(design + stopped + " --quiet --resume --noise-deg 0.05");
+  EXPECT_EQ(refused.status, 2) << refused.all();
+  EXPECT_EQ(CountLines(refused.err), 1) << refused.err;
+  EXPECT_THAT(refused.err, HasSubstr("checkpoint.json: inputs_digest: the checkpoint is of other "
+                                     "data or options"));
+
+  const Outcome r = RunCcsrm(design + stopped + " --quiet --resume");
+  ASSERT_EQ(r.status, 0) << r.all();
+  long long simulated = 0, replayed = 0;
+  ASSERT_TRUE(JournalRuns(r.out, &simulated, &replayed)) << r.out;
+  EXPECT_GT(replayed, 0) << "the recorded runs are taken, not simulated again";
+  EXPECT_EQ(simulated + replayed, whole_simulated) << "no run beyond the uninterrupted design's";
+  std::printf(
+      "killed after %lld finished runs; resumed: %lld from the journal, %lld simulated; "
+      "the uninterrupted design: %lld, the most of one candidate: %lld\n",
+      finished, replayed, simulated, whole_simulated, candidate_runs);
+  // The issue's bound: at most one candidate's runs done twice.
+  EXPECT_GE(finished, replayed);
+  EXPECT_LE(finished - replayed, candidate_runs) << finished << " runs finished before the kill";
+  nlohmann::json b = nlohmann::json::parse(ccsrm::ReadTextFile(stopped + "/design.json"));
+  ccsrm::testing::DropKeys(&a, {"wall_time_s"});
+  ccsrm::testing::DropKeys(&b, {"wall_time_s"});
+  EXPECT_EQ(a, b) << nlohmann::json::diff(a, b).dump(1);
+  EXPECT_FALSE(fs::exists(journal)) << "the resumed design is done";
+  EXPECT_FALSE(fs::exists(stopped + "/checkpoint.json"));
 }
 
 }  // namespace

@@ -73,7 +73,9 @@ struct DesignOptions {
   // The identification's relative finite-difference step. Default 1e-2.
   double relative_step = 1e-2;
   int threads = DefaultThreads();
-  // Another backend for the simulations (null: threads on this machine).
+  // Another backend for the simulations (null: threads on this machine):
+  // one over DesignExperiments(candidates, options), every candidate's
+  // experiments in the order given (an MPI job's, a journal's).
   std::shared_ptr<SimulationBackend> backend;
   // Called after every simulation; may be empty.
   RunFinishedCallback on_run;
@@ -223,6 +225,9 @@ PlannedExperiment PlanExperiment(const sim::Config& prior, const sim::Protocol& 
 // thrown.
 DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
                               const DesignOptions& options);
+// The checks EvaluateDesigns makes before any run, each throwing its
+// InputError: for a command to refuse bad input before it writes anything.
+void CheckDesign(const std::vector<DesignCandidate>& candidates, const DesignOptions& options);
 
 // Evaluates every point of `space` as a plan of one experiment on the arm of
 // `prior`, after `given` (plans to compare with). A point whose protocol the
@@ -231,6 +236,20 @@ DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
 DesignSummary ProposeDesign(const sim::Config& prior, const ProposalSpace& space,
                             const std::vector<DesignCandidate>& given, const DesignOptions& options,
                             std::vector<std::string>* skipped);
+// The candidates ProposeDesign evaluates: `given`, then every point of
+// `space` its checks accept. A function of its arguments alone, so that every
+// rank of an MPI job builds the same ones.
+std::vector<DesignCandidate> ProposalCandidates(const sim::Config& prior,
+                                                const ProposalSpace& space,
+                                                const std::vector<DesignCandidate>& given,
+                                                std::vector<std::string>* skipped);
+
+// Every candidate's experiments as a backend runs them (DesignOptions::
+// backend), candidate after candidate in order: recorded at
+// options.frame_rate_hz, with no measured angles yet (zeros: a run takes from
+// them only where a measurement is missing, and none is).
+std::vector<Experiment> DesignExperiments(const std::vector<DesignCandidate>& candidates,
+                                          const DesignOptions& options);
 
 // A proposed motion (its protocol text) as planned on the arm of `prior`,
 // sampled at rate_hz from 0 to its end: proposed.inputs.csv, a '#' comment
