@@ -286,8 +286,10 @@ TEST(DesignResume, ADesignKilledAtARandomMomentResumesToTheSameResult) {
       "killed after %lld finished runs; resumed: %lld from the journal, %lld simulated; "
       "the uninterrupted design: %lld, the most of one candidate: %lld\n",
       finished, replayed, simulated, whole_simulated, candidate_runs);
-  // The bound: at most one candidate's runs done twice.
-  EXPECT_GE(finished, replayed);
+  // The bound: at most one candidate's runs done twice. (A run can
+  // be in the journal without its progress line yet when the kill falls
+  // between the two: then `replayed` exceeds `finished`, and nothing was
+  // done twice. Seen once in about ten runs.)
   EXPECT_LE(finished - replayed, candidate_runs) << finished << " runs finished before the kill";
   nlohmann::json b = nlohmann::json::parse(ccsrm::ReadTextFile(stopped + "/design.json"));
   ccsrm::testing::DropKeys(&a, {"wall_time_s"});
