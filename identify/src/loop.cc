@@ -434,10 +434,9 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
     // Chosen as the best of many supports: its linear ΔBIC must pass the
     // acceptance's own threshold before a refit is worth its runs.
     cand.significant = chosen.delta_bic > options.min_delta_bic;
-    std::string terms;
-    for (const std::string& q : cand.parameters) terms += (terms.empty() ? "" : ", ") + q;
     progress(round, "discovery", cand.name,
-             "  discovery: chose " + terms + " (linear ΔBIC " + Format("%.1f", chosen.delta_bic) +
+             "  discovery: chose " + Join(cand.parameters) + " (linear ΔBIC " +
+                 Format("%.1f", chosen.delta_bic) +
                  (cand.significant ? ")"
                                    : ", not above " + Format("%g", options.min_delta_bic) +
                                          ": nothing to refit)"));
