@@ -96,6 +96,12 @@ Table DataTable(const LoopFolder& loop) {
   return table;
 }
 
+// "[lo, hi]", or "not identifiable" when the interval is unknown.
+std::string IntervalText(double lower, double upper) {
+  return std::isfinite(lower) ? "[" + Show(lower, kValue) + ", " + Show(upper, kValue) + "]"
+                              : "not identifiable";
+}
+
 // The declared values the loop corrected: the difference of calibrated.yaml
 // from the declared configuration.
 Table DeclaredCorrectionTable(const LoopFolder& loop) {
@@ -114,10 +120,7 @@ Table DeclaredCorrectionTable(const LoopFolder& loop) {
       {"corrected", "corrected", "", kConfig},    {"relative", "relative error", "", kValue},
       {"ci", "95 % interval", "", kCount},        {"alike", "indistinguishable from", "", kCount}};
   for (const LoopDeclaredCorrection& d : loop.declared_corrections) {
-    const std::string ci =
-        std::isfinite(d.relative_ci95[0])
-            ? "[" + Show(d.relative_ci95[0], kValue) + ", " + Show(d.relative_ci95[1], kValue) + "]"
-            : "not identifiable";
+    const std::string ci = IntervalText(d.relative_ci95[0], d.relative_ci95[1]);
     table.AddRow({Cell::Text(d.config_key), Cell::Number(d.declared), Cell::Number(d.corrected),
                   Cell::Number(d.relative), Cell::Text(ci),
                   Cell::Text(Names(d.indistinguishable, "-"))});
@@ -143,9 +146,7 @@ Table DiscoveredTermsTable(const LoopFolder& loop) {
                                " (segment " + std::to_string(m.segment) + ")";
     for (const LoopDiscoveredMoment::Term& t : m.terms) {
       const LoopEstimate& e = t.estimate;
-      const std::string ci = std::isfinite(e.ci95_lower) ? "[" + Show(e.ci95_lower, kValue) + ", " +
-                                                               Show(e.ci95_upper, kValue) + "]"
-                                                         : "not identifiable";
+      const std::string ci = IntervalText(e.ci95_lower, e.ci95_upper);
       table.AddRow({Cell::Text(joints), Cell::Text("θ" + m.axis), Cell::Text(t.formula),
                     Cell::Number(e.value), Cell::Text(ci), Cell::Text(t.units)});
     }
