@@ -82,17 +82,21 @@ void ListEffects(bool json, const std::string& config_path) {
       effects.push_back({{"name", e.name},
                          {"description", e.description},
                          {"measurement", e.measurement},
+                         {"library", e.library},
                          {"parameters", parameters}});
     }
-    const nlohmann::json about = {
-        {"config", config_path}, {"joints", arm.joints}, {"driving_cables", arm.cables}};
+    const nlohmann::json about = {{"config", config_path},
+                                  {"joints", arm.joints},
+                                  {"driving_cables", arm.cables},
+                                  {"segments", arm.segments}};
     std::printf("%s\n", nlohmann::json{{"arm", about}, {"effects", effects}}.dump(2).c_str());
     return;
   }
-  std::printf("effects on the arm of %s (%d joints, %d driving cables)\n", config_path.c_str(),
-              arm.joints, arm.cables);
+  std::printf("effects on the arm of %s (%d joints, %d driving cables, %d segments)\n",
+              config_path.c_str(), arm.joints, arm.cables, arm.segments);
   for (const sim::EffectInfo& e : sim::Effects()) {
-    std::printf("%s%s: %s\n", e.name.c_str(), e.measurement ? " (measurement)" : "",
+    std::printf("%s%s%s: %s\n", e.name.c_str(), e.measurement ? " (measurement)" : "",
+                e.library ? "" : " (not of the library: the loop's terms found in the data)",
                 e.description.c_str());
     for (const std::string& name : sim::EffectParameterNames(e.name, arm)) {
       const sim::ParameterInfo& p = sim::FindParameter(name, "--list-effects", arm);

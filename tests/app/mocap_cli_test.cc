@@ -451,8 +451,12 @@ TEST(Generate, ListEffectsGivesEveryEffectWithUnitsBoundsAndRealisticMagnitude) 
   const Outcome o = RunCcsrm("generate --list-effects --json");
   ASSERT_EQ(o.status, 0) << o.err;
   const nlohmann::json j = nlohmann::json::parse(o.out);
-  ASSERT_EQ(j["effects"].size(), 7u);
+  // The seven of the library, and the loop's terms' carrier, marked.
+  ASSERT_EQ(j["effects"].size(), 8u);
   EXPECT_EQ(j["effects"][0]["name"], "joint_friction");
+  EXPECT_EQ(j["effects"][7]["name"], "joint_moment");
+  EXPECT_FALSE(j["effects"][7]["library"].get<bool>());
+  EXPECT_TRUE(j["effects"][0]["library"].get<bool>());
   const nlohmann::json& p = j["effects"][0]["parameters"][0];
   EXPECT_EQ(p["name"], "joint_friction.coulomb_nm");
   EXPECT_EQ(p["units"], "N m");
@@ -462,6 +466,7 @@ TEST(Generate, ListEffectsGivesEveryEffectWithUnitsBoundsAndRealisticMagnitude) 
   ASSERT_EQ(text.status, 0) << text.err;
   EXPECT_THAT(text.out, HasSubstr("mocap_offset (measurement)"));
   EXPECT_THAT(text.out, HasSubstr("table_tilt.lateral_rad"));
+  EXPECT_THAT(text.out, HasSubstr("joint_moment (not of the library"));
 }
 
 // The second arm (configs/three-segment.yaml) with every segment given
