@@ -38,6 +38,7 @@ struct DesignArgs {
   double noise_deg = identify::DesignOptions().noise_deg;
   double effective_fraction = identify::DesignOptions().effective_sample_fraction;
   double frame_rate_hz = identify::DesignOptions().frame_rate_hz;
+  double low_pass_hz = identify::DesignOptions().low_pass_hz;
   int threads = identify::DesignOptions().threads;
   std::string noise_from;
   bool propose = false;
@@ -71,14 +72,15 @@ std::string ResultOptions(const DesignArgs& a) {
   for (const std::string& b : a.prior_box) text += b + ",";
   text += "\nchirps=";
   for (const std::string& c : a.chirps) text += c + ",";
-  text +=
-      "\npropose=" + std::to_string(a.propose) + " amplitudes=" + numbers(a.space.amplitudes_deg) +
-      " move_times=" + numbers(a.space.move_times_s) +
-      " sines=" + numbers(a.space.sine_frequencies_hz) + " planes=" + numbers(a.space.planes_deg) +
-      " figures=" +
-      numbers({a.space.budget_s, a.space.hold_s, a.noise_deg, a.effective_fraction, a.frame_rate_hz,
-               static_cast<double>(a.case_number), static_cast<double>(a.robust_candidates),
-               static_cast<double>(a.space.opposed_segments)});
+  text += "\npropose=" + std::to_string(a.propose) +
+          " amplitudes=" + numbers(a.space.amplitudes_deg) +
+          " move_times=" + numbers(a.space.move_times_s) +
+          " sines=" + numbers(a.space.sine_frequencies_hz) +
+          " planes=" + numbers(a.space.planes_deg) + " figures=" +
+          numbers({a.space.budget_s, a.space.hold_s, a.noise_deg, a.effective_fraction,
+                   a.frame_rate_hz, a.low_pass_hz, static_cast<double>(a.case_number),
+                   static_cast<double>(a.robust_candidates),
+                   static_cast<double>(a.space.opposed_segments)});
   return text;
 }
 
@@ -164,6 +166,7 @@ int RunDesign(const DesignArgs& a) {
   options.noise_deg = a.noise_deg;
   options.effective_sample_fraction = a.effective_fraction;
   options.frame_rate_hz = a.frame_rate_hz;
+  options.low_pass_hz = a.low_pass_hz;
   options.threads = a.threads;
   if (!a.noise_from.empty()) NoiseFromFit(a.noise_from, &options);
   for (const std::string& text : a.prior_box) {
@@ -194,7 +197,10 @@ int RunDesign(const DesignArgs& a) {
   }
   std::string error;
   if (!options.IsValid(&error)) {
-    ThrowInputError(error.rfind("prior_box", 0) == 0 ? "--prior-box" : "--free", "", error);
+    const std::string field = error.rfind("prior_box", 0) == 0  ? "--prior-box"
+                              : error.rfind("low_pass", 0) == 0 ? "--low-pass-hz"
+                                                                : "--free";
+    ThrowInputError(field, "", error);
   }
   std::string space_error;
   if (a.propose && !space.IsValid(&space_error)) ThrowInputError("--propose", "", space_error);
@@ -379,6 +385,12 @@ void AddDesignCommand(CLI::App& root) {
   cmd->add_option("--frame-rate", a->frame_rate_hz, "Mocap frames per second [Hz]")
       ->capture_default_str()
       ->check(Above(0.0, "Hz"));
+  cmd->add_option("--low-pass-hz", a->low_pass_hz,
+                  "Cutoff of the zero-lag low-pass the recordings' angles will pass through "
+                  "(the mocap pipeline's; a fit filters its simulated angles alike) [Hz]; 0: "
+                  "none, angles measured directly")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--threads", a->threads, "Simulations at a time (default: every core)")
       ->check(ValidIn(&identify::DesignOptions::threads, Checkable()));
   cmd->add_option("--out", a->out, "Output folder")->required();

@@ -11,7 +11,9 @@
 #   5. predicted against realised standard errors and spread over seeds
 #      (scripts/design_validation.py).
 # Usage: scripts/design_validation.sh [OUT] (default out/design-validation);
-# SEEDS="1 2 3" and STAGES="paper design proposed compare" select the work.
+# SEEDS="1 2 3" and STAGES="paper design proposed corner compare" select the
+# work; BOX="mu_c=0.17:0.25" the design's prior box (ranges separated by
+# spaces: BOX="mu=0.17:0.25 mu_c=0.17:0.25").
 # About 40 min on 2 idle cores for three seeds.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,6 +30,8 @@ start=(--set mu=0.25 --set mu_s=0.18 --set mu_c=0.25 --set T_p=45)
 # 10 s, at rest 2 s.
 paper=configs/protocols/paper.yaml@ramp_s=10,hold_s=2,return_s=10,rest_s=2
 amplitudes=(6 -5 4)
+box=()
+for range in ${BOX:-mu_c=0.17:0.25}; do box+=(--prior-box "$range"); done
 
 has() { [[ " $stages " == *" $1 "* ]]; }
 
@@ -56,7 +60,7 @@ if has design; then
   plan="$paper,amplitude_deg=6+$paper,amplitude_deg=-5+$paper,amplitude_deg=4"
   [ -f "$out/design/design.json" ] || "$ccsrm" design --case 2 --free "$free" \
     --noise-from "$out/paper_s1/fit.json" --plans "$plan" --propose --budget-s 24 --amplitudes 25 \
-    --move-times 4 --prior-box mu_c=0.17:0.25 --robust-top 1 --out "$out/design"
+    --move-times 4 "${box[@]}" --robust-top 1 --out "$out/design"
 fi
 
 if has proposed; then

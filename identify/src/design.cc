@@ -43,6 +43,12 @@ Experiment AsExperiment(const PlannedExperiment& planned, const DesignOptions& o
   e.measured_samples = static_cast<std::size_t>(e.measured_rad.size());
   e.noise_deg.assign(static_cast<std::size_t>(e.joints), options.noise_deg);
   e.noise_source = "given (design)";
+  // The recordings' low-pass, which a fit applies to its simulated angles:
+  // its Jacobian is that of the filtered angles.
+  if (options.low_pass_hz > 0.0) {
+    e.low_pass = Experiment::LowPass{options.low_pass_hz, options.low_pass_order,
+                                     options.low_pass_min_run_frames, options.frame_rate_hz};
+  }
   return e;
 }
 
@@ -74,6 +80,11 @@ bool DesignOptions::IsValid(std::string* error) const {
   if (!(relative_step > 0.0) || relative_step > 0.1) {
     return fail("relative_step must be in (0, 0.1]");
   }
+  if (!(low_pass_hz >= 0.0) || !(low_pass_hz < 0.5 * frame_rate_hz)) {
+    return fail("low_pass_hz must be >= 0 and below half the frame rate");
+  }
+  if (low_pass_order < 1 || low_pass_order > 8) return fail("low_pass_order must be in 1..8");
+  if (low_pass_min_run_frames < 2) return fail("low_pass_min_run_frames must be >= 2");
   if (threads < 1) return fail("threads must be >= 1");
   std::set<std::string> boxed;
   for (const PriorRange& range : prior_box) {
@@ -603,12 +614,15 @@ std::string PlannedMotionCsv(const sim::Config& prior, const std::string& protoc
 
 std::string DesignSummary::FullReport() const {
   std::string out;
-  out += "design: " + std::to_string(candidates.size()) + " candidate plan" +
-         (candidates.size() == 1 ? "" : "s") + ", noise " + Format("%.3g", options.noise_deg) +
-         " deg per angle at " + Format("%.4g", options.frame_rate_hz) + " Hz, N_eff/N " +
-         Format("%.3g", options.effective_sample_fraction) + "; " + std::to_string(simulations) +
-         " simulations on " + std::to_string(threads) + " thread" + (threads == 1 ? "" : "s") +
-         ", " + Format("%.1f", wall_time_s) + " s\n";
+  out +=
+      "design: " + std::to_string(candidates.size()) + " candidate plan" +
+      (candidates.size() == 1 ? "" : "s") + ", noise " + Format("%.3g", options.noise_deg) +
+      " deg per angle at " + Format("%.4g", options.frame_rate_hz) + " Hz" +
+      (options.low_pass_hz > 0.0 ? " low-passed at " + Format("%.3g", options.low_pass_hz) + " Hz"
+                                 : std::string(", not low-passed")) +
+      ", N_eff/N " + Format("%.3g", options.effective_sample_fraction) + "; " +
+      std::to_string(simulations) + " simulations on " + std::to_string(threads) + " thread" +
+      (threads == 1 ? "" : "s") + ", " + Format("%.1f", wall_time_s) + " s\n";
   out += "  predicted relative standard errors (%), best plan first:\n";
   char line[512];
   std::snprintf(line, sizeof(line), "  %-4s %-28s %8s", "rank", "plan", "time [s]");
@@ -746,6 +760,10 @@ nlohmann::json ToJson(const DesignSummary& s) {
           {"noise_deg", s.options.noise_deg},
           {"effective_sample_fraction", s.options.effective_sample_fraction},
           {"frame_rate_hz", s.options.frame_rate_hz},
+          {"low_pass",
+           {{"cutoff_hz", s.options.low_pass_hz},
+            {"order", s.options.low_pass_order},
+            {"min_run_frames", s.options.low_pass_min_run_frames}}},
           {"relative_step", s.options.relative_step},
           {"prior_box", box},
           {"robust_candidates", s.options.robust_candidates},

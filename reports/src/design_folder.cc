@@ -185,6 +185,9 @@ DesignFolder ReadDesignFolder(const std::string& folder) {
   d.effective_sample_fraction = in.NumberAt(root, "", "effective_sample_fraction");
   d.frame_rate_hz = in.NumberAt(root, "", "frame_rate_hz");
   d.relative_step = in.NumberAt(root, "", "relative_step");
+  if (root.contains("low_pass")) {
+    d.low_pass_hz = in.NumberAt(in.Object(root, "", "low_pass"), "low_pass", "cutoff_hz");
+  }
   const json& box = in.List(root, "", "prior_box");
   for (std::size_t k = 0; k < box.size(); ++k) {
     const std::string at = JsonReader::Index("prior_box", k);

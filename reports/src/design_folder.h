@@ -60,6 +60,9 @@ struct DesignFolder {
   std::vector<std::string> free;
   double noise_deg = kUnknown, effective_sample_fraction = kUnknown;
   double frame_rate_hz = kUnknown, relative_step = kUnknown;
+  // The recordings' low-pass the design assumed [Hz] (0: none); unknown in
+  // a design.json written before it was recorded.
+  double low_pass_hz = kUnknown;
   struct Range {
     std::string name;
     double lower = kUnknown, upper = kUnknown;

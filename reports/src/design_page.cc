@@ -115,6 +115,8 @@ Section SummarySection(const DesignFolder& d) {
   AddValue(&table, "noise per angle", d.noise_deg, "deg", NumberFormat::Significant(3));
   AddValue(&table, "N_eff / N", d.effective_sample_fraction, "", NumberFormat::Significant(3));
   AddValue(&table, "frame rate", d.frame_rate_hz, "Hz", NumberFormat::Significant(4));
+  AddValue(&table, "low-pass of the angles (0: none)", d.low_pass_hz, "Hz",
+           NumberFormat::Significant(3));
   AddValue(&table, "relative step", d.relative_step, "", NumberFormat::Significant(2));
   AddValue(&table, "candidate plans", static_cast<double>(d.candidates.size()), "",
            NumberFormat::Integer());

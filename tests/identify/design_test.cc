@@ -16,6 +16,7 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/identify/design.h"
 #include "ccsrm/identify/identification.h"
+#include "ccsrm/mocap/processing.h"
 #include "synthetic_experiment.h"
 
 namespace ccsrm::identify {
@@ -49,6 +50,7 @@ DesignOptions Options() {
   DesignOptions options;
   options.free_parameters = {"mu_c", "T_p"};
   options.noise_deg = 0.03;
+  options.low_pass_hz = 0.0;  // the synthetic recordings' angles are not low-passed
   return options;
 }
 
@@ -81,6 +83,46 @@ TEST(Design, PredictsTheStandardErrorsAFitOfSuchARecordingReports) {
     // variance and its effective samples differ from 1 and N only by their
     // sampling error (a few %). 10 % holds both with room.
     EXPECT_NEAR(estimate->std_error / predicted.std_error[i], 1.0, 0.1);
+  }
+}
+
+TEST(Design, PredictsTheErrorsOfALowPassedRecordingWithTheSameFilter) {
+  // The mocap pipeline low-passes the measured angles (1 Hz by default) and
+  // identification filters its simulated angles alike: the Jacobian a fit
+  // sees is that of the filtered angles. The compressed protocol's 2 s ramp
+  // has much of its motion near the cutoff.
+  constexpr double kCutoffHz = 1.0;
+  const sim::ArmParameters truth = Truth();
+  const Experiment recording =
+      MakeExperiment(Record(truth, 0.03, 7, testing_support::Nominal(), kCutoffHz), "lp.h5", {});
+  ASSERT_TRUE(recording.low_pass.has_value());
+  DesignOptions filtered = Options();
+  filtered.low_pass_hz = kCutoffHz;
+  const PlannedExperiment planned = Planned(recording, truth);
+  const DesignSummary with = EvaluateDesigns({Candidate("low-passed", {planned})}, filtered);
+  const DesignSummary without = EvaluateDesigns({Candidate("raw", {planned})}, Options());
+  ASSERT_TRUE(with.candidates[0].completed) << with.candidates[0].message;
+  ASSERT_TRUE(without.candidates[0].completed) << without.candidates[0].message;
+
+  IdentificationOptions fit;
+  fit.free_parameters = {"mu_c", "T_p"};
+  fit.values = {{"mu_c", truth.mu_c}, {"T_p", truth.T_p}};
+  const IdentificationSummary realised = Identify({recording}, fit);
+  ASSERT_TRUE(realised.covariance_available) << realised.covariance_message;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const std::string& name = with.candidates[0].parameters[i];
+    const ParameterEstimate* estimate = realised.Find(name);
+    ASSERT_NE(estimate, nullptr);
+    const double predicted = with.candidates[0].std_error[i];
+    const double unfiltered = without.candidates[0].std_error[i];
+    std::printf("%s: predicted %.4g with the filter, %.4g without; the fit reports %.4g\n",
+                name.c_str(), predicted, unfiltered, estimate->std_error);
+    // As above: the same Jacobian, white noise added after the filter.
+    EXPECT_NEAR(estimate->std_error / predicted, 1.0, 0.1);
+    // A low-pass's gain is at most 1 at every frequency, so it can only
+    // remove information: the errors with it are not smaller (to 1 %, the
+    // reflected padding at the record's ends).
+    EXPECT_GE(predicted, 0.99 * unfiltered);
   }
 }
 
@@ -257,6 +299,15 @@ TEST(Design, RefusesAPriorOfZeroAndAPlanWithoutExperiments) {
   std::string error;
   EXPECT_FALSE(bad.IsValid(&error));
   EXPECT_THAT(error, ::testing::HasSubstr("effective_sample_fraction"));
+  DesignOptions too_fast = Options();
+  // The default filter is the mocap pipeline's, which the recordings go through.
+  EXPECT_EQ(DesignOptions().low_pass_hz, mocap::ProcessingOptions().cutoff_hz);
+  EXPECT_EQ(DesignOptions().low_pass_order, mocap::ProcessingOptions().filter_order);
+  EXPECT_EQ(DesignOptions().low_pass_min_run_frames,
+            mocap::ProcessingOptions().min_filter_run_frames);
+  too_fast.low_pass_hz = 50.0;  // half the frame rate: no digital low-pass
+  EXPECT_FALSE(too_fast.IsValid(&error));
+  EXPECT_THAT(error, ::testing::HasSubstr("low_pass_hz"));
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 
 #include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/identify/experiment.h"
+#include "ccsrm/mocap/signal.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/effects.h"
 #include "ccsrm/sim/model.h"
@@ -37,9 +38,13 @@ inline sim::Config Nominal(const std::string& config = "paper.yaml") {
 
 // An experiment recorded from the arm with `truth`: inputs at 100 Hz, the
 // true angles at 100 Hz plus white noise of noise_deg, and a twist record of
-// the same noise (from which the loader estimates it).
+// the same noise (from which the loader estimates it). With low_pass_hz > 0
+// the true angles pass through the mocap pipeline's low-pass (order 2,
+// recorded in the file's quality figures, so identification filters its
+// simulated angles alike) before the noise is added.
 inline datasets::ExperimentFile Record(const sim::ArmParameters& truth, double noise_deg,
-                                       unsigned seed, const sim::Config& config = Nominal()) {
+                                       unsigned seed, const sim::Config& config = Nominal(),
+                                       double low_pass_hz = 0.0) {
   const sim::ArmModel model(config.arm);
   const double duration = config.protocol.ramp_s + config.protocol.hold_s;
   const sim::CableInputs planned =
@@ -81,15 +86,37 @@ inline datasets::ExperimentFile Record(const sim::ArmParameters& truth, double n
   file.mocap_markers = datasets::Array({frames, 0, 3});
   file.measured_joint_angles = datasets::Array({frames, joints, 2});
   file.measured_joint_twist = datasets::Array({frames, joints});
+  // What motion capture records: measurement effects (mocap_offset) included.
+  std::vector<double>& angles = file.measured_joint_angles->values;
   for (std::size_t f = 0; f < frames; ++f) {
-    // What motion capture records: measurement effects (mocap_offset) included.
     const std::vector<Eigen::Vector2d> recorded =
         sim::RecordedJointAngles(truth, run.trajectory.frames[f]);
     for (std::size_t j = 0; j < joints; ++j) {
-      for (int a = 0; a < 2; ++a) {
-        file.measured_joint_angles->values[(f * joints + j) * 2 + static_cast<std::size_t>(a)] =
-            recorded[j][a] + noise(rng);
-      }
+      for (int a = 0; a < 2; ++a)
+        angles[(f * joints + j) * 2 + static_cast<std::size_t>(a)] = recorded[j][a];
+    }
+  }
+  if (low_pass_hz > 0.0) {
+    constexpr int kOrder = 2;
+    constexpr int kMinRun = 4;
+    const auto sections = mocap::DesignButterworthLowPass(kOrder, low_pass_hz, 100.0);
+    for (std::size_t c = 0; c < 2 * joints; ++c) {
+      mocap::ZeroLagLowPass(sections, low_pass_hz, 100.0, angles.data() + c, frames, 2 * joints,
+                            kMinRun);
+    }
+    const auto figure = [&file](const char* name, double value, const char* units) {
+      file.mocap_quality[name] = datasets::Array({1});
+      file.mocap_quality[name].values[0] = value;
+      file.mocap_quality_units[name] = units;
+    };
+    figure("filter_cutoff_hz", low_pass_hz, "Hz");
+    figure("filter_order", kOrder, "1");
+    figure("filter_min_run_frames", kMinRun, "frames");
+  }
+  for (std::size_t f = 0; f < frames; ++f) {
+    for (std::size_t j = 0; j < joints; ++j) {
+      for (int a = 0; a < 2; ++a)
+        angles[(f * joints + j) * 2 + static_cast<std::size_t>(a)] += noise(rng);
       file.measured_joint_twist->at(f, j) = noise(rng);
     }
   }
