@@ -197,7 +197,7 @@ Section SummarySection(const LoopFolder& loop) {
     for (const internal::LoopBackwardCheck& b : round.backward) {
       if (b.taken_back) {
         section.blocks.push_back(Paragraph{
-            "Taken back in round " + std::to_string(round.index) + ": " + b.reason + ".", false});
+            "Backward step, round " + std::to_string(round.index) + ": " + b.reason + ".", false});
       }
     }
   }
