@@ -5,8 +5,7 @@
 // on a held-out recording. Experiments: the paper's arm on the compressed
 // protocol of synthetic_experiment.h, white noise of 0.03 deg (the mocap
 // floor). About 4 CPU minutes (label `slow`): 64 term columns, a refit, and
-// the refit after the terms indistinguishable from 0 were dropped. And the
-// backward step on friction that grows with the angle.
+// the refit after the terms indistinguishable from 0 were dropped.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -76,58 +75,6 @@ TEST(Loop, FindsAJointMomentOutsideTheLibraryAsTermsInTheJointsAngle) {
   ASSERT_TRUE(s.holdout_rms_after_deg);
   EXPECT_LT(*s.holdout_rms_after_deg, 1.5 * kNoiseDeg);
   EXPECT_TRUE(s.unexplained.empty());
-}
-
-TEST(Loop, TakesBackJointFrictionOnceTermsExplainFrictionThatGrowsWithTheAngle) {
-  // Friction that grows with the angle, M = -1.5 |θ| sign(θ̇) N m about x in
-  // both segments, and no joint friction. The library's joint friction
-  // (constant) explains part of it and may be added first; once the terms
-  // are in, its size is indistinguishable from 0 and the backward step
-  // takes it back (validation, docs/loop.md). Either way the final model
-  // must not claim joint friction.
-  sim::ArmParameters truth = Nominal().parameters;
-  for (int segment = 1; segment <= 2; ++segment) {
-    sim::SetParameter(sim::JointMomentParameter(segment, 0, "abs_angle_sign_rate"), -1.5, "test",
-                      &truth);
-  }
-  const std::vector<Experiment> training = LoopRecordings(truth, {1, 2});
-  const std::vector<Experiment> holdout = LoopRecordings(truth, {3});
-  LoopOptions options = LoopTestOptions({"joint_friction", "terms"});
-  options.on_progress = [](const LoopProgress& p) { std::printf("%s\n", p.message.c_str()); };
-  const LoopSummary s = CloseLoop(training, holdout, options);
-  EXPECT_THAT(s.added_effects, ElementsAre("joint_moment"));
-  // Added and taken back, or never added: either way it is named only as
-  // taken back, with its reason.
-  bool added_joint_friction = false;
-  for (const LoopRound& r : s.rounds) added_joint_friction |= r.winner == "joint_friction";
-  if (added_joint_friction) {
-    ASSERT_EQ(s.taken_back.size(), 1u);
-    EXPECT_EQ(s.taken_back[0].name, "joint_friction");
-    EXPECT_FALSE(s.taken_back[0].size_significant);
-    EXPECT_LE(s.taken_back[0].delta_bic_keep, options.min_delta_bic);
-    EXPECT_THAT(s.conclusion, HasSubstr("took back joint_friction"));
-  } else {
-    EXPECT_TRUE(s.taken_back.empty());
-  }
-  EXPECT_EQ(s.final_fit.Find("joint_friction.coulomb_nm"), nullptr);
-  // The terms remain, in the right state variable: |θ| sign θ̇ about x in
-  // both segments, within 20 % of the truth or with the truth inside the
-  // interval (the bar for a recovered value).
-  for (int segment = 1; segment <= 2; ++segment) {
-    const ParameterEstimate* p =
-        s.final_fit.Find(sim::JointMomentParameter(segment, 0, "abs_angle_sign_rate"));
-    ASSERT_NE(p, nullptr) << "segment " << segment;
-    ASSERT_TRUE(p->free);
-    const bool close = std::abs(p->value + 1.5) <= 0.2 * 1.5;
-    const bool covered = p->identifiable && p->ci95_lower <= -1.5 && -1.5 <= p->ci95_upper;
-    EXPECT_TRUE(close || covered) << p->name << " = " << p->value;
-  }
-  for (const DiscoveredMoment& m : s.discovered_terms) std::printf("%s\n", m.Formula().c_str());
-  EXPECT_THAT(s.conclusion, HasSubstr("|θ| sign(θ̇)"));
-  // It reaches the noise on the held-out experiment (the bar: 1.5x
-  // the noise).
-  ASSERT_TRUE(s.holdout_rms_after_deg);
-  EXPECT_LT(*s.holdout_rms_after_deg, 1.5 * kNoiseDeg);
 }
 
 }  // namespace
