@@ -294,7 +294,7 @@ std::string LoopSummary::FullReport() const {
     }
     out << "  decision: " << r.decision << "\n";
     for (const BackwardCheck& b : r.backward) {
-      out << "  backward step: " << b.name << ": " << b.reason << "\n";
+      out << "  backward step: " << (b.taken_back ? b.reason : b.name + ": " + b.reason) << "\n";
     }
   }
   out << "\nParameters of the final model:\n";
