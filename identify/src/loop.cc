@@ -15,6 +15,7 @@
 #include "ccsrm/sim/declared_values.h"
 #include "ccsrm/sim/effects.h"
 #include "declared_values.h"
+#include "loop_backward.h"
 #include "term_discovery.h"
 
 namespace ccsrm::identify {
@@ -306,6 +307,22 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
     return h;
   };
 
+  // The training cost (1/2 Σ r², weighted) at values; NaN when a run fails.
+  const auto training_cost = [&](const std::map<std::string, double>& values) {
+    std::vector<RunRequest> runs;
+    for (std::size_t e = 0; e < training.size(); ++e) {
+      runs.push_back({e, ParametersFor(training[e], values), false, {}});
+    }
+    std::vector<RunResult> results = training_backend->RunBatch(runs, nullptr);
+    simulations += static_cast<std::int64_t>(runs.size());
+    std::vector<const Eigen::MatrixXd*> angles;
+    for (const RunResult& run : results) {
+      if (!run.summary.completed()) return std::numeric_limits<double>::quiet_NaN();
+      angles.push_back(&run.angles_rad);
+    }
+    return 0.5 * Weighted(training, angles, false).squaredNorm();
+  };
+
   // The declared model.
   progress(0, "declared fit", "", "fitting the declared model");
   IdentificationOptions fit_options = options.fit;
@@ -334,6 +351,11 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
   const auto is_added = [&](const std::string& name) {
     return std::find(effects_on.begin(), effects_on.end(), name) != effects_on.end();
   };
+  // Each addition's parameters (free in every later fit), and the additions
+  // the backward step took back: not tried again, so that a round cannot
+  // add what an earlier one took back and the loop cannot cycle.
+  std::map<std::string, std::vector<std::string>> added_parameters;
+  std::set<std::string> taken_back;
   const bool discovery_on =
       std::find(candidates.begin(), candidates.end(), kTermsCandidate) != candidates.end();
 
@@ -448,6 +470,123 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
     }
     return cand;
   };
+  // The backward step (issue 28), after a round's winner is added: an
+  // earlier addition can be made redundant by a later one. On friction that
+  // grows with the angle, joint friction was added first (56 % of the
+  // excess) and the terms |θ| sign θ̇ next; in their fit joint friction's
+  // Coulomb moment went to 0 and its viscous coefficient to 0.0076, neither
+  // identifiable, and the conclusion still named it: a lab told its joints
+  // have friction they do not have. So every earlier addition is checked
+  // in the new fit by the acceptance's own size test; one whose size is
+  // indistinguishable from 0 is refitted away from the new fit's point
+  // (its parameters off, or a declared value back at the configuration's)
+  // and taken back when keeping it is not worth min_delta_bic, the
+  // criterion that added it: what the loop would not add now it does not
+  // keep. At most one per round, the least useful first (the smallest ΔBIC
+  // at 0): taking one back changes the fit the others are judged in, so
+  // they are checked again after the next addition. The addition just
+  // made is not checked: it has passed every criterion in this fit.
+  const auto backward_step = [&](int round, const std::string& winner_label, LoopRound* lr) {
+    if (effects_on.size() < 2) return;  // no earlier addition: nothing to check
+    const double nres = static_cast<double>(current.residuals);
+    const double neff = current.effective_samples;
+    std::vector<internal::AdditionCheck> checks;
+    for (std::size_t a = 0; a + 1 < effects_on.size(); ++a) {
+      BackwardCheck b;
+      b.name = effects_on[a];
+      b.parameters = added_parameters.at(b.name);
+      internal::AdditionCheck c;
+      c.parameters = b.parameters.size();
+      for (const std::string& q : b.parameters) {
+        if (const ParameterEstimate* est = current.Find(q)) {
+          c.interval_excludes_zero |= internal::IntervalExcludesZero(*est);
+        }
+      }
+      if (!c.interval_excludes_zero) {
+        std::map<std::string, double> zeroed = ValuesOf(current, fixed);
+        for (const std::string& q : b.parameters) zeroed[q] = 0.0;
+        const double cost_zeroed = training_cost(zeroed);
+        c.delta_bic_zeroed =
+            internal::DeltaBic(cost_zeroed, current.final_cost, neff, nres, c.parameters);
+        c.delta_chi2_zeroed =
+            c.delta_bic_zeroed + static_cast<double>(c.parameters) * std::log(neff);
+      }
+      b.delta_chi2_zeroed = c.delta_chi2_zeroed;
+      b.size_significant =
+          internal::SizeSignificant(c.interval_excludes_zero, c.delta_chi2_zeroed, c.parameters);
+      b.reason = b.size_significant ? "its size is still distinguishable from 0: kept"
+                                    : (std::isfinite(c.delta_chi2_zeroed)
+                                           ? "its size is indistinguishable from 0 (Δχ²_eff " +
+                                                 Format("%.1f", c.delta_chi2_zeroed) + " at 0)"
+                                           : "its run at 0 failed: not judged, kept");
+      checks.push_back(c);
+      lr->backward.push_back(std::move(b));
+    }
+    for (std::size_t a : internal::TakeBackOrder(checks)) {
+      BackwardCheck& b = lr->backward[a];
+      progress(round, "backward", b.name, "  backward step: refitting without " + b.name);
+      IdentificationOptions o = options.fit;
+      o.free_parameters.clear();
+      for (const std::string& q : free) {
+        if (std::find(b.parameters.begin(), b.parameters.end(), q) == b.parameters.end()) {
+          o.free_parameters.push_back(q);
+        }
+      }
+      o.values = ValuesOf(current, fixed);
+      for (const std::string& q : b.parameters) o.values.erase(q);
+      IdentificationSummary without = Identify(training, o);
+      simulations += without.simulations;
+      if (without.termination == IdentificationTermination::kFailed) {
+        b.reason += "; the refit without it failed (" + without.message + "): kept";
+        continue;
+      }
+      b.refitted = true;
+      b.rms_deg_without = without.errors.rms_deg_overall;
+      b.delta_bic_keep =
+          internal::DeltaBic(without.final_cost, current.final_cost,
+                             std::min(neff, without.effective_samples), nres, b.parameters.size());
+      const std::string keep = "ΔBIC of keeping it " + Format("%.1f", b.delta_bic_keep);
+      if (b.delta_bic_keep > options.min_delta_bic) {
+        b.reason += "; " + keep + " > " + Format("%g", options.min_delta_bic) + ": kept";
+        progress(round, "backward", b.name, "  " + b.name + ": " + b.reason);
+        continue;
+      }
+      // Take it back: the refit without it is the current model.
+      HoldoutResult h = run_holdout(ValuesOf(without, fixed));
+      if (!holdout.empty()) b.holdout_rms_deg_without = h.rms_deg;
+      b.taken_back = true;
+      b.reason = "took back " + (b.name == kTermsEffect ? "the terms found in the data" : b.name) +
+                 ": after " + winner_label + " its size is indistinguishable from 0 (" + keep +
+                 " <= " + Format("%g", options.min_delta_bic) + "; training RMS " +
+                 Format("%.4f", current.errors.rms_deg_overall) + " -> " +
+                 Format("%.4f", b.rms_deg_without) + " deg" +
+                 (holdout.empty() ? std::string()
+                                  : ", held out " + Format("%.4f", current_holdout.rms_deg) +
+                                        " -> " + Format("%.4f", h.rms_deg) + " deg") +
+                 ")";
+      progress(round, "backward", b.name, "  " + b.reason);
+      lr->decision += " T" + b.reason.substr(1) + ".";  // "took back" -> "Took back"
+      for (const std::string& q : b.parameters) {
+        free.erase(std::remove(free.begin(), free.end(), q), free.end());
+        fixed.erase(q);
+      }
+      effects_on.erase(std::find(effects_on.begin(), effects_on.end(), b.name));
+      added_parameters.erase(b.name);
+      taken_back.insert(b.name);
+      current = std::move(without);
+      current_holdout = std::move(h);
+      summary.taken_back.push_back(b);
+      break;
+    }
+    const bool took = std::any_of(lr->backward.begin(), lr->backward.end(),
+                                  [](const BackwardCheck& b) { return b.taken_back; });
+    for (BackwardCheck& b : lr->backward) {
+      if (took && !b.size_significant && !b.refitted && !b.taken_back &&
+          std::isfinite(b.delta_chi2_zeroed)) {
+        b.reason += "; another was taken back first: checked again after the next addition";
+      }
+    }
+  };
   std::map<std::string, std::vector<std::string>> winner_indistinguishable;
   const bool declared_ok = summary.declared.termination != IdentificationTermination::kFailed &&
                            summary.declared.jacobian.size() > 0;
@@ -467,18 +606,20 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       const auto added = [&](const std::string& n) {
         return std::find(effects_on.begin(), effects_on.end(), n) != effects_on.end();
       };
-      if (added(c.name)) continue;
+      if (added(c.name) || taken_back.count(c.name)) continue;
       Spec r = c;
       if (c.kind == Spec::Kind::kDeclaredBlock) {
         r.parameters.clear();
         for (const std::string& q : c.parameters) {
-          if (!added(q)) r.parameters.push_back(q);
+          if (!added(q) && !taken_back.count(q)) r.parameters.push_back(q);
         }
         if (r.parameters.empty()) continue;
       }
       remaining.push_back(std::move(r));
     }
-    if (remaining.empty() && !(discovery_on && !is_added(kTermsEffect))) {
+    const bool discovery_left =
+        discovery_on && !is_added(kTermsEffect) && !taken_back.count(kTermsEffect);
+    if (remaining.empty() && !discovery_left) {
       lr.decision = "every candidate is already in the model.";
       summary.rounds.push_back(std::move(lr));
       break;
@@ -707,8 +848,7 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
         std::vector<std::string> kept, dropped;
         for (const std::string& q : cand.parameters) {
           const ParameterEstimate* est = refit.Find(q);
-          const bool sized = est != nullptr && est->identifiable &&
-                             (est->ci95_lower > 0.0 || est->ci95_upper < 0.0);
+          const bool sized = est != nullptr && internal::IntervalExcludesZero(*est);
           (sized ? kept : dropped).push_back(q);
         }
         if (dropped.empty() || kept.empty()) break;
@@ -742,31 +882,15 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       // the current fit and the refit without the candidate.
       std::map<std::string, double> without = ValuesOf(refit, fixed);
       for (const std::string& q : cand.parameters) without[q] = 0.0;
-      double cost_without = current.final_cost;
-      double cost_zeroed = std::numeric_limits<double>::quiet_NaN();
-      {
-        std::vector<RunRequest> runs;
-        for (std::size_t e = 0; e < training.size(); ++e) {
-          runs.push_back({e, ParametersFor(training[e], without), false, {}});
-        }
-        std::vector<RunResult> results = training_backend->RunBatch(runs, nullptr);
-        simulations += static_cast<std::int64_t>(runs.size());
-        std::vector<const Eigen::MatrixXd*> angles;
-        bool ok = true;
-        for (const RunResult& run : results) {
-          ok = ok && run.summary.completed();
-          angles.push_back(&run.angles_rad);
-        }
-        if (ok) {
-          cost_zeroed = 0.5 * Weighted(training, angles, false).squaredNorm();
-          cost_without = std::max(cost_without, cost_zeroed);
-        }
-      }
+      const double cost_zeroed = training_cost(without);
+      const double cost_without = std::isfinite(cost_zeroed)
+                                      ? std::max(current.final_cost, cost_zeroed)
+                                      : current.final_cost;
       cand.cost_without = cost_without;
       const double neff = std::min(current.effective_samples, refit.effective_samples);
       const double nres = static_cast<double>(refit.residuals);
-      const double dchi2 = 2.0 * (cost_without - refit.final_cost) * neff / nres;
-      cand.delta_bic = dchi2 - static_cast<double>(cand.parameters.size()) * std::log(neff);
+      cand.delta_bic =
+          internal::DeltaBic(cost_without, refit.final_cost, neff, nres, cand.parameters.size());
       // Its size is distinguishable from 0 when one of its parameters'
       // interval excludes 0, or when its parameters together do: removing
       // it at the refit's point raises the effective chi-square beyond the
@@ -775,19 +899,16 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       // an effect whose parameters the data determine only in combination
       // (a delay's time constant and dead time both lag the motion, by
       // their sum).
-      const double k = static_cast<double>(cand.parameters.size());
-      if (std::isfinite(cost_zeroed) &&
-          2.0 * (cost_zeroed - refit.final_cost) * neff / nres > gsl_cdf_chisq_Pinv(0.95, k)) {
-        cand.size_significant = true;
-      }
+      bool interval_excludes_zero = false;
       for (const std::string& q : cand.parameters) {
         if (const ParameterEstimate* est = refit.Find(q)) {
           cand.estimates[q] = *est;
-          if (est->identifiable && (est->ci95_lower > 0.0 || est->ci95_upper < 0.0)) {
-            cand.size_significant = true;
-          }
+          interval_excludes_zero |= internal::IntervalExcludesZero(*est);
         }
       }
+      cand.size_significant = internal::SizeSignificant(
+          interval_excludes_zero, 2.0 * (cost_zeroed - refit.final_cost) * neff / nres,
+          cand.parameters.size());
       HoldoutResult h = run_holdout(ValuesOf(refit, fixed));
       if (!holdout.empty()) {
         // Held out likewise: from the worse of the current model and the
@@ -888,7 +1009,7 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
     for (const CandidateResult& c : lr.candidates) {
       effect_accepted |= c.accepted && c.kind == "effect";
     }
-    if (!effect_accepted && discovery_on && !is_added(kTermsEffect)) {
+    if (!effect_accepted && discovery_left) {
       const double ms_current =
           2.0 * current.final_cost / static_cast<double>(std::max<Eigen::Index>(r.size(), 1));
       bool correlated = false;
@@ -984,11 +1105,14 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       lr.decision += " Tie (ΔBIC within " + Format("%g", options.tie_delta_bic) + "): " + names +
                      "; the one with the fewest parameters is kept.";
     }
-    progress(round, "done", lr.winner, "round " + std::to_string(round) + ": " + lr.decision);
     for (const std::string& q : winner->parameters) free.push_back(q);
     effects_on.push_back(lr.winner);
+    added_parameters[lr.winner] = winner->parameters;
     current = std::move(refit_fits.at(lr.winner));
     current_holdout = std::move(refit_holdouts.at(lr.winner));
+    backward_step(
+        round, winner->kind == "discovered terms" ? "the terms found in the data" : lr.winner, &lr);
+    progress(round, "done", lr.winner, "round " + std::to_string(round) + ": " + lr.decision);
     summary.rounds.push_back(std::move(lr));
   }
 
@@ -1096,6 +1220,7 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
     }
     conclusion << ".";
   }
+  for (const BackwardCheck& b : summary.taken_back) conclusion << " " << b.reason << ".";
   for (const DiscoveredMoment& m : summary.discovered_terms)
     conclusion << " " << m.Formula() << ".";
   for (const DeclaredCorrection& d : summary.declared_corrections) {

@@ -64,6 +64,21 @@ std::string WithUnit(double value, const std::string& key) {
   return Format("%.4g", angle ? value * kDeg : value) + " " + unit;
 }
 
+// The backward step's check of an earlier addition (loop.json rounds[].backward).
+nlohmann::json Backward(const BackwardCheck& b, int round) {
+  return {{"round", round},
+          {"name", b.name},
+          {"parameters", b.parameters},
+          {"size_significant", b.size_significant},
+          {"delta_chi2_zeroed", Number(b.delta_chi2_zeroed)},
+          {"refitted", b.refitted},
+          {"delta_bic_keep", Number(b.delta_bic_keep)},
+          {"rms_deg_without", Number(b.rms_deg_without)},
+          {"holdout_rms_deg_without", Optional(b.holdout_rms_deg_without)},
+          {"taken_back", b.taken_back},
+          {"reason", b.reason}};
+}
+
 }  // namespace
 
 std::string DeclaredCorrection::Sentence() const {
@@ -158,9 +173,26 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
                       {"tie", r.tie},
                       {"decision", r.decision}});
     if (!r.discovery.empty()) rounds.back()["discovery"] = r.discovery;
+    // The backward step (issue 28): every earlier addition checked, and the
+    // one taken back (null: none).
+    json backward = json::array();
+    json taken = nullptr;
+    for (const BackwardCheck& b : r.backward) {
+      backward.push_back(Backward(b, r.index));
+      if (b.taken_back) taken = backward.back();
+    }
+    rounds.back()["backward"] = backward;
+    rounds.back()["taken_back"] = taken;
   }
   j["rounds"] = rounds;
   j["added_effects"] = s.added_effects;
+  json taken_back = json::array();
+  for (const LoopRound& r : s.rounds) {
+    for (const BackwardCheck& b : r.backward) {
+      if (b.taken_back) taken_back.push_back(Backward(b, r.index));
+    }
+  }
+  j["taken_back"] = taken_back;
   json corrections = json::array();
   for (const DeclaredCorrection& d : s.declared_corrections) {
     corrections.push_back(
@@ -261,6 +293,9 @@ std::string LoopSummary::FullReport() const {
       out << line;
     }
     out << "  decision: " << r.decision << "\n";
+    for (const BackwardCheck& b : r.backward) {
+      out << "  backward step: " << (b.taken_back ? b.reason : b.name + ": " + b.reason) << "\n";
+    }
   }
   out << "\nParameters of the final model:\n";
   for (const ParameterEstimate& p : final_fit.parameters) {

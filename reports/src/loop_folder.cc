@@ -172,6 +172,25 @@ LoopRound ReadRound(const JsonReader& in, const json& r, std::size_t index) {
   if (winner.is_string()) x.winner = winner.get<std::string>();
   x.tie = in.Texts(r, at, "tie");
   x.decision = in.Text(r, at, "decision");
+  if (r.contains("backward")) {
+    const json& backward = in.List(r, at, "backward");
+    for (std::size_t k = 0; k < backward.size(); ++k) {
+      const std::string bat = JsonReader::Index(at + ".backward", k);
+      const json& b = backward[k];
+      LoopBackwardCheck c;
+      c.name = in.Text(b, bat, "name");
+      c.parameters = in.Texts(b, bat, "parameters");
+      c.size_significant = in.Flag(b, bat, "size_significant");
+      c.delta_chi2_zeroed = in.NumberAt(b, bat, "delta_chi2_zeroed", true);
+      c.refitted = in.Flag(b, bat, "refitted");
+      c.delta_bic_keep = in.NumberAt(b, bat, "delta_bic_keep", true);
+      c.rms_deg_without = in.NumberAt(b, bat, "rms_deg_without", true);
+      c.holdout_rms_deg_without = in.NumberAt(b, bat, "holdout_rms_deg_without", true);
+      c.taken_back = in.Flag(b, bat, "taken_back");
+      c.reason = in.Text(b, bat, "reason");
+      x.backward.push_back(std::move(c));
+    }
+  }
   return x;
 }
 

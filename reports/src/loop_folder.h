@@ -87,6 +87,20 @@ struct LoopCandidate {
   std::string reason;
 };
 
+// The backward step's check of an earlier addition (loop.json
+// rounds[].backward, issue 28; absent in files written before it).
+struct LoopBackwardCheck {
+  std::string name;
+  std::vector<std::string> parameters;
+  bool size_significant = true;
+  double delta_chi2_zeroed = kUnknown;
+  bool refitted = false;
+  double delta_bic_keep = kUnknown, rms_deg_without = kUnknown;
+  double holdout_rms_deg_without = kUnknown;
+  bool taken_back = false;
+  std::string reason;
+};
+
 struct LoopRound {
   int index = 0;
   std::vector<std::string> effects_on;
@@ -96,6 +110,7 @@ struct LoopRound {
   std::string winner;  // empty: none
   std::vector<std::string> tie;
   std::string decision;
+  std::vector<LoopBackwardCheck> backward;  // after the winner's addition
 };
 
 // `before`, `after`, `holdout_before`, `holdout_after`: overall and per

@@ -63,6 +63,13 @@ Table LoopTable(const LoopFolder& loop) {
       "per-joint measurement noise: an RMS error near it leaves nothing to explain.");
   AddText(&table, "declared free parameters", Names(loop.declared_free, "none"));
   AddText(&table, "effects added", Names(loop.added_effects, "none"));
+  std::vector<std::string> taken_back;
+  for (const LoopRound& round : loop.rounds) {
+    for (const internal::LoopBackwardCheck& b : round.backward) {
+      if (b.taken_back) taken_back.push_back(b.name);
+    }
+  }
+  if (!taken_back.empty()) AddText(&table, "taken back (backward step)", ListNames(taken_back));
   AddValue(&table, "rounds", static_cast<double>(loop.rounds.size()), "", kCount);
   AddValue(&table, "training RMS before", loop.rms_before_deg, "deg", kRms);
   AddValue(&table, "training RMS after", loop.rms_after_deg, "deg", kRms);
@@ -186,6 +193,14 @@ Section SummarySection(const LoopFolder& loop) {
           (std::filesystem::path(loop.folder) / "declared").string() + " (or final).",
       false});
   section.blocks.push_back(LoopTable(loop));
+  for (const LoopRound& round : loop.rounds) {
+    for (const internal::LoopBackwardCheck& b : round.backward) {
+      if (b.taken_back) {
+        section.blocks.push_back(Paragraph{
+            "Backward step, round " + std::to_string(round.index) + ": " + b.reason + ".", false});
+      }
+    }
+  }
   if (!loop.declared_corrections.empty()) {
     for (const LoopDeclaredCorrection& d : loop.declared_corrections) {
       section.blocks.push_back(Paragraph{"Declared value: " + d.sentence + ".", false});
@@ -608,6 +623,38 @@ Table CandidateTable(const std::string& id, const LoopRound& round) {
   return table;
 }
 
+// The backward step of a round (issue 28): each earlier addition checked
+// in the fit after the round's winner, and whether it was taken back.
+Table BackwardTable(const std::string& id, const LoopRound& round) {
+  Table table;
+  table.id = id;
+  table.title = "Backward step";
+  table.caption =
+      "loop.json 'backward': after the round's winner was added, every earlier addition is "
+      "checked in the new fit. Size ≠ 0: an interval of its parameters excludes 0, or setting "
+      "them to 0 raises the effective chi-square (Δχ² at 0) beyond its 95 % quantile. One whose "
+      "size is indistinguishable from 0 is refitted away; it is taken back when the ΔBIC of "
+      "keeping it is 10 or less (docs/loop.md). At most one per round.";
+  table.columns = {{"addition", "addition", "", kScore},
+                   {"parameters", "parameters", "", kScore, true},
+                   {"size_significant", "size ≠ 0", "", kScore},
+                   {"delta_chi2_zeroed", "Δχ² at 0", "", kScore},
+                   {"refitted", "refitted without", "", kScore},
+                   {"delta_bic_keep", "ΔBIC of keeping", "", kScore},
+                   {"rms_deg_without", "RMS without", "deg", kRms},
+                   {"holdout_rms_deg_without", "held-out RMS without", "deg", kRms},
+                   {"taken_back", "taken back", "", kScore},
+                   {"reason", "reason", "", kScore, true}};
+  for (const internal::LoopBackwardCheck& b : round.backward) {
+    table.AddRow({Cell::Text(b.name), Cell::Text(ListNames(b.parameters)),
+                  Cell::Text(YesNo(b.size_significant)), Cell::Number(b.delta_chi2_zeroed),
+                  Cell::Text(YesNo(b.refitted)), Cell::Number(b.delta_bic_keep),
+                  Cell::Number(b.rms_deg_without), Cell::Number(b.holdout_rms_deg_without),
+                  Cell::Text(YesNo(b.taken_back)), Cell::Text(b.reason)});
+  }
+  return table;
+}
+
 // Each candidate's size parameters: the score test's linear estimate and,
 // when refitted, the refit's estimate with its interval.
 Table EstimateTable(const std::string& id, const LoopRound& round) {
@@ -685,6 +732,9 @@ Section RoundSection(const LoopRound& round) {
           " scored. Decision: " + round.decision;
   section.blocks.push_back(Paragraph{text, false});
   section.blocks.push_back(CandidateTable("round_" + k + "_candidates", round));
+  if (!round.backward.empty()) {
+    section.blocks.push_back(BackwardTable("round_" + k + "_backward", round));
+  }
   section.blocks.push_back(EstimateTable("round_" + k + "_estimates", round));
   section.blocks.push_back(CrossCorrelationBlock(
       "cross_correlation_round_" + k, round.evidence, "Residual against the signals, round " + k,

@@ -669,6 +669,50 @@ TEST(LoopPage, CorrectedDeclaredValuesAreShownWithTheirConfigurationDifference) 
   EXPECT_FALSE(ToJson(before)["tables"].contains("declared_corrections"));
 }
 
+TEST(LoopPage, AnAdditionTakenBackHasARowAndASentence) {
+  // Issue 28: the backward step of round 2 took back round 1's addition, as
+  // loop.json writes it.
+  json loop = KnownLoopJson();
+  const json check = {{"round", 2},
+                      {"name", "table_tilt"},
+                      {"parameters", {"table_tilt.lateral_rad"}},
+                      {"size_significant", false},
+                      {"delta_chi2_zeroed", 0.4},
+                      {"refitted", true},
+                      {"delta_bic_keep", -9.1},
+                      {"rms_deg_without", 0.0301},
+                      {"holdout_rms_deg_without", 0.0299},
+                      {"taken_back", true},
+                      {"reason", "took back table_tilt: after x its size is indistinguishable"}};
+  loop["rounds"][1]["backward"] = json::array({check});
+  loop["rounds"][1]["taken_back"] = check;
+  loop["taken_back"] = json::array({check});
+  const Document document =
+      BuildLoopDocument(WriteLoopFolder("taken_back", loop).string(), ReportOptions());
+  const json summary = ToJson(document);
+  ASSERT_TRUE(summary["tables"].contains("round_2_backward"));
+  const json& rows = summary["tables"]["round_2_backward"]["rows"];
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0]["addition"], "table_tilt");
+  EXPECT_EQ(rows[0]["taken_back"], "yes");
+  EXPECT_DOUBLE_EQ(rows[0]["delta_bic_keep"].get<double>(), -9.1);
+  EXPECT_FALSE(summary["tables"].contains("round_1_backward"));  // nothing earlier to check
+  bool sentence = false;
+  for (const Section& section : document.sections) {
+    for (const Block& block : section.blocks) {
+      if (const auto* p = std::get_if<Paragraph>(&block)) {
+        sentence |=
+            p->text.find("Backward step, round 2: took back table_tilt") != std::string::npos;
+      }
+    }
+  }
+  EXPECT_TRUE(sentence);
+  // A loop.json without the key (written before the backward step) has no such table.
+  const Document before = BuildLoopDocument(
+      WriteLoopFolder("before_backward", KnownLoopJson()).string(), ReportOptions());
+  EXPECT_FALSE(ToJson(before)["tables"].contains("round_2_backward"));
+}
+
 // Renders the loop page in headless Chromium into
 // <build>/report_screenshots/loop.png for a person to look at; checks only
 // that an image of some size came out.

@@ -55,6 +55,15 @@
 //  5. The winner has the largest ΔBIC. Candidates within tie_delta_bic of
 //     it (2: "not worth more than a bare mention") tie; of those the one
 //     with the fewest parameters wins, and the tie is reported.
+//  6. Backward step (issue 28): after the winner is added, every earlier
+//     addition (effect, declared value, discovered terms) is checked in the
+//     new fit by the size test of step 4. One whose size is now
+//     indistinguishable from 0 is refitted away (its parameters back at
+//     their declared value or off) from the new fit's point, and taken back
+//     when keeping it is not worth min_delta_bic (ΔBIC of keeping it, the
+//     refit without it against the new fit, <= 10): at most one per round,
+//     the least useful first; the others are checked again after the next
+//     addition. A taken-back candidate is not tried again (no cycles).
 // Rounds repeat until no candidate earns its place or max_rounds.
 //
 // Declared values (issue 28, sim/declared_values.h): the configuration's
@@ -216,6 +225,25 @@ struct CandidateResult {
   std::string reason;  // why (not) accepted, one line
 };
 
+// The backward step's check of an earlier addition after a round's winner
+// was added (issue 28).
+struct BackwardCheck {
+  std::string name;  // as in added_effects: an effect, declared.<value>, joint_moment
+  std::vector<std::string> parameters;
+  // The size test in the new fit: an interval excludes 0, or setting its
+  // parameters to 0 at the new fit's point costs more than the 95 %
+  // quantile (delta_chi2_zeroed, effective units; NaN when not needed).
+  bool size_significant = true;
+  double delta_chi2_zeroed = std::numeric_limits<double>::quiet_NaN();
+  // The refit without it, from the new fit's point (when refitted).
+  bool refitted = false;
+  double delta_bic_keep = std::numeric_limits<double>::quiet_NaN();  // of keeping it
+  double rms_deg_without = std::numeric_limits<double>::quiet_NaN();
+  std::optional<double> holdout_rms_deg_without;  // when taken back
+  bool taken_back = false;
+  std::string reason;  // one line; when taken back: "took back X: ..."
+};
+
 struct LoopRound {
   int index = 1;
   std::vector<std::string> effects_on;  // at the round's start
@@ -228,6 +256,9 @@ struct LoopRound {
   std::string decision;                     // one or two sentences
   // Why no terms were sought when none of the others earned its place.
   std::string discovery;
+  // The backward step after the winner's addition: every earlier addition
+  // checked (empty when there was none); at most one taken back.
+  std::vector<BackwardCheck> backward;
 };
 
 // A discovered term's moment on one axis of a segment's joints (issue 28):
@@ -276,7 +307,11 @@ struct DeclaredCorrection {
 struct LoopSummary {
   LoopOptions options;  // what the loop ran with (its thresholds go to loop.json)
   std::vector<LoopRound> rounds;
-  std::vector<std::string> added_effects;  // effects and declared values, in order
+  // Effects (and joint_moment, the discovered terms) in the final model, in
+  // order; an addition the backward step took back is not among them.
+  std::vector<std::string> added_effects;
+  // Additions the backward step took back (BackwardCheck::taken_back), in order.
+  std::vector<BackwardCheck> taken_back;
   std::vector<DeclaredCorrection> declared_corrections;
   // The terms found in the data, when the discovered terms were added
   // (joint_moment among added_effects).
