@@ -13,10 +13,12 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/identify/mpi_backend.h"
 #include "ccsrm/identify/sensitivity.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/paper_run.h"
 #include "commands.h"
+#include "fit_inputs.h"
 #include "option_checks.h"
 #include "output_kinds.h"
 #include "paper_run.h"
@@ -41,6 +43,7 @@ struct DerivativesArgs {
   std::string span;
   std::string json;
   bool quiet = false;
+  double run_timeout_s = identify::MpiOptions().run_timeout_s;
 };
 
 int ParseCount(const std::string& text, const std::string& option) {
@@ -72,8 +75,9 @@ int ParseCount(const std::string& text, const std::string& option) {
 identify::ProgressCallback Progress(bool quiet) {
   if (quiet) return nullptr;
   return [](const identify::RunProgress& p) {
-    std::fprintf(stderr, "  [%zu/%zu] %s: %s\n", p.finished, p.total, p.label.c_str(),
-                 p.summary.BriefReport().c_str());
+    // A backend (MPI) does not say which run finished: no label then.
+    std::fprintf(stderr, "  [%zu/%zu] %s%s%s\n", p.finished, p.total, p.label.c_str(),
+                 p.label.empty() ? "" : ": ", p.summary.BriefReport().c_str());
   };
 }
 
@@ -146,10 +150,26 @@ int RunDerivatives(const DerivativesArgs& a) {
       sim::ParseConfig(run.config_text, a.run.config_path).parameters;
   std::printf("%s\n", Describe(a, run).c_str());
 
+  // Under mpirun with more than one rank, every rank has prepared the same
+  // run from the command line (milliseconds) and rank 0 hands the runs to
+  // all of them (docs/cluster.md). The runs are experiment 0 of
+  // FrameExperiment, every frame's angles, so the check sees what it sees
+  // on threads, to the bit. Alone, the runs stay on this process's threads.
+  std::vector<identify::Experiment> experiments;
+  std::shared_ptr<identify::SimulationBackend> backend;
+  if (identify::MpiRanks() > 1) {
+    experiments.push_back(
+        identify::FrameExperiment(Describe(a, run), run.model, run.inputs, run.simulation));
+    const auto backends = RunBackends({&experiments}, threads, a.run_timeout_s);
+    if (backends.empty()) return 0;  // another rank of an MPI job: it served rank 0's runs
+    backend = backends[0];
+  }
+
   nlohmann::json json;
   int status = 0;
   if (sweep) {
     sweep_options.scale_at_zero = nominal;
+    sweep_options.backend = backend;
     const identify::SweepSummary summary = identify::ParameterSweep(
         run.model, run.config.parameters, run.inputs, run.simulation, sweep_options);
     std::printf("%s", summary.FullReport().c_str());
@@ -157,6 +177,7 @@ int RunDerivatives(const DerivativesArgs& a) {
     if (!summary.all_runs_completed()) status = kRunDidNotComplete;
   } else {
     check.scale_at_zero = nominal;
+    check.backend = backend;
     const identify::DerivativeCheckSummary summary = identify::DerivativeCheck(
         run.model, run.config.parameters, run.inputs, run.simulation, check);
     std::printf("%s", summary.FullReport().c_str());
@@ -190,7 +211,8 @@ void AddDerivativesCommand(CLI::App& root) {
                   "Parameters to differentiate, comma-separated (default: all of them)");
   cmd->add_option("--steps", a->steps, "Relative steps, comma-separated, at least two")
       ->capture_default_str();
-  cmd->add_option("--threads", a->threads, "Runs at a time")->capture_default_str();
+  cmd->add_option("--threads", a->threads, "Runs at a time (per rank under mpirun)")
+      ->capture_default_str();
   cmd->add_option("--negligible-deg", a->negligible,
                   "A derivative is negligible (does not fail) when a 1 % change moves the angles "
                   "by less than this, RMS [deg] (default 0.003, a tenth of the mocap noise "
@@ -201,6 +223,7 @@ void AddDerivativesCommand(CLI::App& root) {
   cmd->add_option("--span", a->span, "Relative half-width of the sweep (default 0.05)");
   cmd->add_option("--json", a->json, "Also write the summary as JSON to this file");
   cmd->add_flag("--quiet", a->quiet, "No progress lines");
+  AddRunTimeoutOption(cmd, &a->run_timeout_s);
   cmd->callback([a] {
     const int code = RunDerivatives(*a);
     if (code != 0) throw CLI::RuntimeError(code);

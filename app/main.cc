@@ -30,7 +30,8 @@ int ExitOnParseError(const CLI::App& root, const CLI::ParseError& e) {
 
 // The commands whose runs go to every rank of an MPI job (docs/cluster.md).
 bool SharesRuns(const std::string& command) {
-  return command == "identify" || command == "loop" || command == "design";
+  return command == "identify" || command == "loop" || command == "design" ||
+         command == "derivatives";
 }
 
 int Run(int argc, char** argv) {

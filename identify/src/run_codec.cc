@@ -82,6 +82,7 @@ void PutRequest(const RunRequest& q, Packer* out) {
   PutParameters(q.parameters, out);
   out->Put<std::uint64_t>(q.measurement_variants.size());
   for (const sim::ArmParameters& v : q.measurement_variants) PutParameters(v, out);
+  out->Put<std::uint8_t>(q.every_frame ? 1 : 0);
 }
 
 RunRequest GetRequest(Unpacker* in) {
@@ -90,6 +91,7 @@ RunRequest GetRequest(Unpacker* in) {
   q.parameters = GetParameters(in);
   q.measurement_variants.resize(in->Get<std::uint64_t>());
   for (sim::ArmParameters& v : q.measurement_variants) v = GetParameters(in);
+  q.every_frame = in->Get<std::uint8_t>() != 0;
   return q;
 }
 

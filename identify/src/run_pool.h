@@ -31,15 +31,18 @@ struct RunOutcome {
   std::vector<double> angles_deg;  // SampledJointAnglesDeg of the trajectory
 };
 
-// One Simulate per request, `threads` at a time (threads >= 1). Outcome k
-// belongs to requests[k] whatever the number of threads: each task writes
-// only its own slot. Only the sampled angles of each trajectory are kept.
-// simulation.progress is not called. An exception of a run (InputError for
-// invalid input) is rethrown here once every thread has stopped.
+// One Simulate per request, `threads` at a time (threads >= 1), or on
+// `backend` (not null: one batch of every_frame runs of its experiment 0,
+// FrameExperiment of model, inputs and simulation; progress without labels).
+// Outcome k belongs to requests[k] whatever the number of threads or ranks:
+// each task writes only its own slot. Only the sampled angles of each
+// trajectory are kept. simulation.progress is not called. An exception of a
+// run (InputError for invalid input) is rethrown here once every thread has
+// stopped.
 std::vector<RunOutcome> RunAll(const sim::ArmModel& model, const sim::CableInputs& inputs,
                                const sim::SimulationOptions& simulation,
                                const std::vector<RunRequest>& requests, int threads,
-                               const ProgressCallback& progress);
+                               const ProgressCallback& progress, SimulationBackend* backend);
 
 // One run of a backend's request on experiment e (every backend's runs go
 // through here, so they agree to the bit whichever backend ran them).

@@ -147,6 +147,29 @@ std::vector<double> SampledJointAnglesDeg(const sim::Trajectory& trajectory) {
   return angles;
 }
 
+Experiment FrameExperiment(const std::string& name, const sim::ArmModel& model,
+                           const sim::CableInputs& inputs,
+                           const sim::SimulationOptions& simulation) {
+  std::string error;
+  if (!simulation.IsValid(&error)) ThrowInputError("SimulationOptions", "", error);
+  if (simulation.cancel != nullptr || simulation.wall_time_budget_s != 0.0) {
+    ThrowInputError("SimulationOptions", "",
+                    "cancel and wall_time_budget_s do not reach a backend's runs");
+  }
+  Experiment e;
+  e.name = name;
+  e.path = name;
+  e.config.solver = simulation.solver;
+  // Not owned (no deleter): the caller keeps model and inputs alive.
+  e.model = std::shared_ptr<const sim::ArmModel>(std::shared_ptr<void>(), &model);
+  e.inputs = std::shared_ptr<const sim::CableInputs>(std::shared_ptr<void>(), &inputs);
+  e.sample_time_s = simulation.sample_times;
+  e.simulated_s = simulation.duration_s;
+  e.joints = model.num_joints();
+  e.measured_rad.resize(0, 2 * e.joints);
+  return e;
+}
+
 bool DerivativeCheckOptions::IsValid(std::string* error) const {
   std::set<std::string> seen;
   if (parameters.empty()) {
@@ -267,7 +290,7 @@ DerivativeCheckSummary DerivativeCheck(const sim::ArmModel& model, const sim::Ar
   summary.relative_steps = options.relative_steps;
   summary.tolerance = options.tolerance;
   summary.negligible_change_deg = options.negligible_change_deg;
-  summary.threads = options.threads;
+  summary.threads = options.backend ? options.backend->parallelism() : options.threads;
 
   // Plan every run: the base run first, then two trials per parameter and step.
   std::vector<internal::RunRequest> requests = {{base, "base"}};
@@ -316,7 +339,8 @@ DerivativeCheckSummary DerivativeCheck(const sim::ArmModel& model, const sim::Ar
   }
 
   const std::vector<internal::RunOutcome> outcomes =
-      internal::RunAll(model, inputs, simulation, requests, options.threads, options.progress);
+      internal::RunAll(model, inputs, simulation, requests, options.threads, options.progress,
+                       options.backend.get());
   summary.runs = outcomes.size();
   summary.base_run = outcomes[0].summary;
   summary.sampled_angles = outcomes[0].angles_deg.size();

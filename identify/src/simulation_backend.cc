@@ -18,6 +18,24 @@ RunResult RunExperiment(const Experiment& e, const identify::RunRequest& request
   sim::SimulationResult result = sim::Simulate(*e.model, request.parameters, *e.inputs, options);
 
   RunResult out;
+  if (request.every_frame) {
+    CCSRM_CHECK(request.measurement_variants.empty());
+    const std::size_t frames = result.trajectory.size();
+    const int joints = e.model->num_joints();
+    out.angles_rad.resize(static_cast<Eigen::Index>(frames), 2 * joints);
+    for (std::size_t f = 0; f < frames; ++f) {
+      const std::vector<Eigen::Vector2d>& theta = result.trajectory.frames[f].joint_angles;
+      for (int j = 0; j < joints; ++j) {
+        out.angles_rad(static_cast<Eigen::Index>(f), 2 * j) =
+            theta[static_cast<std::size_t>(j)].x();
+        out.angles_rad(static_cast<Eigen::Index>(f), 2 * j + 1) =
+            theta[static_cast<std::size_t>(j)].y();
+      }
+    }
+    out.summary = std::move(result.summary);
+    if (request.keep_trajectory) out.trajectory = std::move(result.trajectory);
+    return out;
+  }
   const auto record = [&](const sim::ArmParameters& parameters) {
     Eigen::MatrixXd angles = Eigen::MatrixXd::Constant(e.measured_rad.rows(), e.measured_rad.cols(),
                                                        std::numeric_limits<double>::quiet_NaN());

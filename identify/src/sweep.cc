@@ -94,7 +94,7 @@ SweepSummary ParameterSweep(const sim::ArmModel& model, const sim::ArmParameters
   s.value = sim::GetParameter(base, info.name);
   s.scale = internal::ParameterScale(info, s.value, options.scale_at_zero);
   s.span = options.span;
-  s.threads = options.threads;
+  s.threads = options.backend ? options.backend->parallelism() : options.threads;
   if (s.scale == 0.0) {
     ThrowInputError(info.name, "",
                     "value 0 and no scale at zero: a relative span does not move it");
@@ -116,7 +116,8 @@ SweepSummary ParameterSweep(const sim::ArmModel& model, const sim::ArmParameters
     requests.push_back({p, info.name + " = " + Format("%.6g", value)});
   }
   const std::vector<internal::RunOutcome> outcomes =
-      internal::RunAll(model, inputs, simulation, requests, options.threads, options.progress);
+      internal::RunAll(model, inputs, simulation, requests, options.threads, options.progress,
+                       options.backend.get());
   for (const internal::RunOutcome& o : outcomes) s.runs.push_back(o.summary);
   s.sampled_angles = outcomes[0].angles_deg.size();
 

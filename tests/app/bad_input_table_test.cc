@@ -298,6 +298,9 @@ const std::vector<BadInput>& Rows() {
        "identify --data {d}/processed.h5 --run-timeout 0 --out {d}/fit",
        {"--run-timeout"}},  // issue 29
       {"overrides",
+       "derivatives --config {d}/c.yaml --duration 0.1 --run-timeout -1",
+       {"--run-timeout"}},  // issue 29
+      {"overrides",
        "loop --data {d}/processed.h5 --candidates '' --out {d}/loop",
        {"--candidates", "empty"}},  // 3
       // A declared value of a segment the arm does not have (issue 28).

@@ -1,7 +1,7 @@
-// `mpirun -n 3 ccsrm identify` (issue 29): the same fit as on threads, to the
-// bit, and a rank that dies or hangs mid-fit ends the job with one line and
-// exit status 7 within the run timeout, without a result. Skips when the
-// build has no MPI or mpirun is missing.
+// `mpirun -n 3 ccsrm identify|design|derivatives` (issue 29): the same
+// result as on threads, to the bit, and a rank that dies or hangs mid-job
+// ends it with one line and exit status 7 within the run timeout, without a
+// result. Skips when the build has no MPI or mpirun is missing.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -115,28 +115,34 @@ TEST(MpiIdentify, ThreeRanksGiveTheThreadBackendsFitToTheBit) {
   }
 }
 
-// A rank lost after a few runs: rank 0 waits for its run no longer than
-// --run-timeout, then says which rank and which run in one line and ends
-// the job with status 7 (README), writing no result.
-void ExpectLostRankEndsTheJob(const std::string& mode) {
-  std::string why;
-  if (MpiMissing(&why)) GTEST_SKIP() << why;
-  const SmallFit& fit = MakeSmallFit();
-  const std::string out = (fit.dir / ("lost_" + mode)).string();
-  setenv("CCSRM_MPI_TEST_LOSE_RANK", ("2:3:" + mode).c_str(), 1);
+// Rank 2 lost once it has run `runs` runs (`mode` exit or hang): rank 0
+// waits for its run no longer than --run-timeout, then says which rank and
+// which run in one line and ends the job with status 7 (README), writing no
+// `result` (the command's output, given after `args`).
+void ExpectLostRankEndsTheJob(const std::string& args, int runs, const std::string& mode,
+                              const std::string& result) {
+  setenv("CCSRM_MPI_TEST_LOSE_RANK", ("2:" + std::to_string(runs) + ":" + mode).c_str(), 1);
   // `timeout` only guards the test against a job that hangs (its 124 fails it).
-  const Outcome m =
-      RunCommand("timeout 300 " + Mpirun(3) + " " + fit.args + " --run-timeout 5 --out " + out);
+  const Outcome m = RunCommand("timeout 300 " + Mpirun(3) + " " + args + " --run-timeout 5 " +
+                               (result.empty() ? "" : result));
   unsetenv("CCSRM_MPI_TEST_LOSE_RANK");
   EXPECT_EQ(m.status, 7) << m.all();
   EXPECT_EQ(CountLines(m.err), 1) << m.err;
   EXPECT_THAT(m.err, HasSubstr("ccsrm: rank 2 did not return run "));
   EXPECT_THAT(m.err, HasSubstr("within 5 s (--run-timeout)"));
+}
+
+void ExpectLostRankEndsTheFit(const std::string& mode) {
+  std::string why;
+  if (MpiMissing(&why)) GTEST_SKIP() << why;
+  const SmallFit& fit = MakeSmallFit();
+  const std::string out = (fit.dir / ("lost_" + mode)).string();
+  ExpectLostRankEndsTheJob(fit.args, 3, mode, "--out " + out);
   EXPECT_FALSE(fs::exists(out + "/fit.json")) << "no result from a job that lost a rank";
 }
 
-TEST(MpiIdentify, ARankThatDiesEndsTheJobWithOneLine) { ExpectLostRankEndsTheJob("exit"); }
-TEST(MpiIdentify, ARankThatHangsEndsTheJobWithOneLine) { ExpectLostRankEndsTheJob("hang"); }
+TEST(MpiIdentify, ARankThatDiesEndsTheJobWithOneLine) { ExpectLostRankEndsTheFit("exit"); }
+TEST(MpiIdentify, ARankThatHangsEndsTheJobWithOneLine) { ExpectLostRankEndsTheFit("hang"); }
 
 // `mpirun -n 3 ccsrm design`: every rank builds the plans from the command
 // line, rank 0 ranks them, every rank simulates; design.json is the thread
@@ -163,6 +169,67 @@ TEST(MpiDesign, ThreeRanksGiveTheThreadRunsDesignToTheBit) {
   ccsrm::testing::DropKeys(&a, {"wall_time_s"});
   ccsrm::testing::DropKeys(&b, {"wall_time_s"});
   EXPECT_EQ(a, b) << nlohmann::json::diff(a, b).dump(1);
+}
+
+// `mpirun -n 3 ccsrm derivatives`: every rank prepares the run from the
+// command line, rank 0 forms the derivatives, every rank simulates. The
+// first 0.3 s of the paper's case 2 (about 0.1 s per run): the angles move
+// little yet, but they move (asserted), and the JSON's 17 digits tell runs
+// that differ in any bit apart.
+std::string Derivatives() {
+  return "derivatives --config " + std::string(CCSRM_SOURCE_DIR) +
+         "/configs/paper.yaml --case 2 --duration 0.3 --quiet ";
+}
+
+// The JSON of a thread run on 3 threads and of 3 ranks of 1 thread each:
+// equal but for the clocks (and the status, printed and exited alike).
+// `moved` points at a figure that is > 0 when the runs saw the parameter.
+void ExpectSameJsonOnThreeRanks(const std::string& args, const std::string& name,
+                                const std::string& moved) {
+  const fs::path dir = ScratchDirectory("mpi_" + name + "_" + std::to_string(getpid()));
+  const std::string threads_json = (dir / "threads.json").string();
+  const std::string ranks_json = (dir / "ranks.json").string();
+  const Outcome t = RunCcsrm(Derivatives() + args + " --threads 3 --json " + threads_json);
+  ASSERT_TRUE(t.status == 0 || t.status == 4) << t.all();
+  const Outcome m =
+      RunCommand(Mpirun(3) + " " + Derivatives() + args + " --threads 1 --json " + ranks_json);
+  ASSERT_EQ(m.status, t.status) << m.all();
+  EXPECT_THAT(m.out, HasSubstr("runs on 3 MPI ranks, 3 at a time"));
+  nlohmann::json a = nlohmann::json::parse(ccsrm::ReadTextFile(threads_json));
+  nlohmann::json b = nlohmann::json::parse(ccsrm::ReadTextFile(ranks_json));
+  EXPECT_GT(a.at(nlohmann::json::json_pointer(moved)).get<double>(), 0.0)
+      << "a real comparison: the angles depend on the parameter";
+  // Every run went through the ranks (rank 0's closing line).
+  const std::size_t runs =
+      a.contains("runs") && a["runs"].is_number() ? a["runs"].get<std::size_t>() : a["runs"].size();
+  EXPECT_THAT(m.out, HasSubstr("MPI: " + std::to_string(runs) + " runs on 3 ranks"));
+  ccsrm::testing::DropKeys(&a, {"wall_time_s", "real_time_factor"});
+  ccsrm::testing::DropKeys(&b, {"wall_time_s", "real_time_factor"});
+  EXPECT_EQ(a, b) << nlohmann::json::diff(a, b).dump(1);
+}
+
+TEST(MpiDerivatives, ThreeRanksGiveTheThreadRunsCheckToTheBit) {
+  std::string why;
+  if (MpiMissing(&why)) GTEST_SKIP() << why;
+  ExpectSameJsonOnThreeRanks("--parameters c_sc,T_p", "derivatives",
+                             "/parameters/1/steps/0/rms_deg");
+}
+
+TEST(MpiDerivatives, ThreeRanksGiveTheThreadRunsSweepToTheBit) {
+  std::string why;
+  if (MpiMissing(&why)) GTEST_SKIP() << why;
+  ExpectSameJsonOnThreeRanks("--sweep T_d0 --points 5 --span 0.02", "sweep", "/variation_rms_deg");
+}
+
+// Rank 2 dies on its first runs: one line, status 7, no JSON.
+TEST(MpiDerivatives, ARankThatDiesEndsTheJobWithOneLine) {
+  std::string why;
+  if (MpiMissing(&why)) GTEST_SKIP() << why;
+  const fs::path dir = ScratchDirectory("mpi_derivatives_lost_" + std::to_string(getpid()));
+  const std::string json = (dir / "d.json").string();
+  ExpectLostRankEndsTheJob(Derivatives() + "--parameters c_sc,T_p --threads 1", 0, "exit",
+                           "--json " + json);
+  EXPECT_FALSE(fs::exists(json)) << "no result from a job that lost a rank";
 }
 
 }  // namespace

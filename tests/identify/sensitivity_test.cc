@@ -1,17 +1,19 @@
 // The derivative check and the parameter sweep on short runs whose answers
 // the tests compute themselves: the table's derivative is the difference of
-// runs made here, thread count changes no bit, trial points stay inside the
-// bounds, zero and missing derivatives give statuses rather than NaN, and
-// the cubic fit is exact for cubics and blind to nothing else.
+// runs made here, thread count and backend change no bit, trial points stay
+// inside the bounds, zero and missing derivatives give statuses rather than
+// NaN, and the cubic fit is exact for cubics and blind to nothing else.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/identify/sensitivity.h"
+#include "ccsrm/identify/simulation_backend.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/parameters.h"
@@ -296,6 +298,62 @@ TEST(DerivativeCheck, OptionsNameTheFieldTheyReject) {
 }
 
 // ---------------------------------------------------------------- the sweep
+
+// A backend's runs (what `mpirun ccsrm derivatives` hands to its ranks) give
+// the thread pool's derivatives and sweep to the bit. 0.295 s is off the
+// 100 Hz output grid: the backend's runs are simulated for the duration
+// asked (Experiment::simulated_s), not to the last frame, as the pool's are.
+TEST(DerivativeCheck, ABackendGivesThePoolsResultToTheBit) {
+  const ShortCase& c = Case2();
+  sim::SimulationOptions options = c.options;
+  options.duration_s = 0.295;
+  const std::vector<Experiment> experiments = {
+      FrameExperiment("short case 2", c.model, c.inputs, options)};
+  const std::shared_ptr<SimulationBackend> backend = MakeThreadBackend(&experiments, 2);
+
+  DerivativeCheckOptions on_backend = Only({"mu_s", "T_p"});
+  on_backend.backend = backend;
+  const DerivativeCheckSummary a =
+      DerivativeCheck(c.model, c.config.parameters, c.inputs, options, Only({"mu_s", "T_p"}));
+  const DerivativeCheckSummary b =
+      DerivativeCheck(c.model, c.config.parameters, c.inputs, options, on_backend);
+  EXPECT_EQ(a.runs, b.runs);
+  EXPECT_EQ(a.sampled_angles, b.sampled_angles);
+  EXPECT_EQ(a.base_run.simulated_s, b.base_run.simulated_s);
+  EXPECT_EQ(a.base_run.steps, b.base_run.steps);
+  EXPECT_EQ(a.base_run.rhs_evaluations, b.base_run.rhs_evaluations);
+  ASSERT_EQ(a.parameters.size(), b.parameters.size());
+  for (std::size_t i = 0; i < a.parameters.size(); ++i) {
+    ASSERT_EQ(a.parameters[i].steps.size(), b.parameters[i].steps.size());
+    for (std::size_t k = 0; k < a.parameters[i].steps.size(); ++k) {
+      EXPECT_GT(a.parameters[i].steps[k].rms_deg, 0.0) << a.parameters[i].name;
+      EXPECT_EQ(a.parameters[i].steps[k].derivative_deg, b.parameters[i].steps[k].derivative_deg)
+          << a.parameters[i].name;
+    }
+    EXPECT_EQ(a.parameters[i].disagreement, b.parameters[i].disagreement);
+  }
+
+  SweepOptions sweep;
+  sweep.parameter = "T_p";
+  sweep.points = 5;
+  sweep.threads = 2;
+  const SweepSummary x = ParameterSweep(c.model, c.config.parameters, c.inputs, options, sweep);
+  sweep.backend = backend;
+  const SweepSummary y = ParameterSweep(c.model, c.config.parameters, c.inputs, options, sweep);
+  ASSERT_TRUE(x.all_runs_completed());
+  EXPECT_GT(x.variation_max, 0.0);
+  EXPECT_EQ(x.angles_deg, y.angles_deg);
+  EXPECT_EQ(x.residual_rms, y.residual_rms);
+}
+
+// A backend cannot cancel its runs or hold them to a wall time budget: such
+// options are refused, not dropped.
+TEST(DerivativeCheck, FrameExperimentRefusesWhatABackendCannotCarry) {
+  const ShortCase& c = Case2();
+  sim::SimulationOptions options = c.options;
+  options.wall_time_budget_s = 10.0;
+  EXPECT_THROW(FrameExperiment("budget", c.model, c.inputs, options), InputError);
+}
 
 // (The sweep's runs go through the pool of DerivativeCheck, whose
 // independence of the thread count is tested above.)

@@ -88,7 +88,15 @@ struct Experiment {
   // would trade damping for that difference.
   void AsMeasured(Eigen::MatrixXd* angles_rad) const;
 
-  double duration_s() const { return sample_time_s.empty() ? 0.0 : sample_time_s.back(); }
+  // Simulated time [s] of a run sampled on the solver's output grid rather
+  // than at sample times (FrameExperiment: `ccsrm derivatives` under MPI,
+  // sample_time_s empty); 0 for a recording, whose runs end at its last frame.
+  double simulated_s = 0.0;
+
+  double duration_s() const {
+    if (simulated_s > 0.0) return simulated_s;
+    return sample_time_s.empty() ? 0.0 : sample_time_s.back();
+  }
 };
 
 // Builds the experiment from a file already read. A file without

@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "ccsrm/identify/experiment.h"
+#include "ccsrm/identify/simulation_backend.h"
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/parameters.h"
 #include "ccsrm/sim/protocol.h"
@@ -80,8 +82,14 @@ struct DerivativeCheckOptions {
   // its derivative is s dθ/dp. Unset (the default), or 0 for that
   // parameter: the parameter is reported as not checked.
   std::optional<sim::ArmParameters> scale_at_zero;
-  // Called after each run; may be empty.
+  // Called after each run; may be empty. With a backend its label is empty
+  // (a backend reports runs as they finish, not which one).
   ProgressCallback progress;
+  // Where the runs go (e.g. every rank of an MPI job, ShareRuns): a backend
+  // whose experiment 0 is FrameExperiment of the same model, inputs and
+  // simulation as DerivativeCheck's (precondition); `threads` is then not
+  // used. Null (the default): `threads` threads of this process.
+  std::shared_ptr<SimulationBackend> backend;
 
   // False, with the reason in *error naming the field, when a parameter
   // name is unknown or repeated, there are fewer than two steps or a step is
@@ -197,6 +205,8 @@ struct SweepOptions {
   // As DerivativeCheckOptions::scale_at_zero.
   std::optional<sim::ArmParameters> scale_at_zero;
   ProgressCallback progress;
+  // As DerivativeCheckOptions::backend.
+  std::shared_ptr<SimulationBackend> backend;
 
   // False, with the reason naming the field, for an unknown parameter,
   // points < 5, span outside (0, 1) or threads < 1.
@@ -247,6 +257,20 @@ SweepSummary ParameterSweep(const sim::ArmModel& model, const sim::ArmParameters
 
 // The sampled angles of a trajectory [deg], in the order above.
 std::vector<double> SampledJointAnglesDeg(const sim::Trajectory& trajectory);
+
+// The run (model, inputs, simulation) of a DerivativeCheck or a
+// ParameterSweep as a backend's experiment, so that its runs can go to the
+// ranks of an MPI job: simulated for simulation.duration_s, sampled at
+// simulation.sample_times (empty: the solver's output grid) with
+// simulation.solver, its runs requested every_frame. A backend's run of it
+// calls Simulate with the same options as the thread pool, so it gives the
+// same angles to the bit. `name` stands for the run in messages and in the
+// check that every rank built the same. The experiment refers to model and
+// inputs without owning them: they must outlive it. Throws InputError for
+// options a backend cannot carry over (cancel, a wall time budget).
+Experiment FrameExperiment(const std::string& name, const sim::ArmModel& model,
+                           const sim::CableInputs& inputs,
+                           const sim::SimulationOptions& simulation);
 
 // The residuals of a least-squares cubic in x fitted to each column of y
 // (row k holds the values at x[k]). The fit is made in x mapped to [-1, 1],

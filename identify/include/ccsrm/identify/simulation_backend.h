@@ -25,6 +25,11 @@ struct RunRequest {
   // effects' parameters (mocap_offset): the same run is recorded once more
   // through each, without simulating again (RunResult::variant_angles_rad).
   std::vector<sim::ArmParameters> measurement_variants;
+  // Return the physical joint angles of every frame the run sampled instead
+  // of the recorded ones at the experiment's frames (RunResult::angles_rad):
+  // what `ccsrm derivatives` differentiates (SampledJointAnglesDeg), so that
+  // its runs go to a backend's ranks like any other. No measurement variants.
+  bool every_frame = false;
 };
 
 struct RunResult {
@@ -32,7 +37,9 @@ struct RunResult {
   // The simulated angles at the experiment's sample times [rad], laid out as
   // Experiment::measured_rad and made comparable with them
   // (Experiment::AsMeasured: the measurement's gaps and low-pass); rows
-  // beyond a run that ended early are NaN.
+  // beyond a run that ended early are NaN. With RunRequest::every_frame:
+  // the joint angles θx, θy of joint j in columns 2 j, 2 j + 1, one row per
+  // frame the run reached, nothing recorded or filtered.
   Eigen::MatrixXd angles_rad;
   sim::Trajectory trajectory;  // only with keep_trajectory
   // The angles as recorded through each of the request's measurement_variants.
