@@ -46,6 +46,16 @@ DesignCandidate Candidate(const std::string& name, std::vector<PlannedExperiment
   return candidate;
 }
 
+// What a lab's fit of the recording reports: mu_c and T_p free, started at
+// the truth.
+IdentificationSummary FitFromTheTruth(const Experiment& recording,
+                                      const sim::ArmParameters& truth) {
+  IdentificationOptions fit;
+  fit.free_parameters = {"mu_c", "T_p"};
+  fit.values = {{"mu_c", truth.mu_c}, {"T_p", truth.T_p}};
+  return Identify({recording}, fit);
+}
+
 DesignOptions Options() {
   DesignOptions options;
   options.free_parameters = {"mu_c", "T_p"};
@@ -63,10 +73,7 @@ TEST(Design, PredictsTheStandardErrorsAFitOfSuchARecordingReports) {
   const CandidateInformation& predicted = design.candidates[0];
   ASSERT_TRUE(predicted.completed) << predicted.message;
 
-  IdentificationOptions fit;
-  fit.free_parameters = {"mu_c", "T_p"};
-  fit.values = {{"mu_c", truth.mu_c}, {"T_p", truth.T_p}};
-  const IdentificationSummary realised = Identify({recording}, fit);
+  const IdentificationSummary realised = FitFromTheTruth(recording, truth);
   ASSERT_TRUE(realised.covariance_available) << realised.covariance_message;
   for (std::size_t i = 0; i < 2; ++i) {
     const ParameterEstimate* estimate = realised.Find(predicted.parameters[i]);
@@ -104,10 +111,7 @@ TEST(Design, PredictsTheErrorsOfALowPassedRecordingWithTheSameFilter) {
   ASSERT_TRUE(with.candidates[0].completed) << with.candidates[0].message;
   ASSERT_TRUE(without.candidates[0].completed) << without.candidates[0].message;
 
-  IdentificationOptions fit;
-  fit.free_parameters = {"mu_c", "T_p"};
-  fit.values = {{"mu_c", truth.mu_c}, {"T_p", truth.T_p}};
-  const IdentificationSummary realised = Identify({recording}, fit);
+  const IdentificationSummary realised = FitFromTheTruth(recording, truth);
   ASSERT_TRUE(realised.covariance_available) << realised.covariance_message;
   for (std::size_t i = 0; i < 2; ++i) {
     const std::string& name = with.candidates[0].parameters[i];
