@@ -152,7 +152,11 @@ std::string DiscoveredMoment::Formula() const {
     out += size + (t.formula == "1" ? "" : " " + t.formula);
     first = false;
   }
-  return out + " N m (θ in rad, θ̇ in rad/s, t in s)";
+  bool commanded = false;
+  for (const Term& t : terms) commanded = commanded || t.name == "input_rate";
+  // θ̇_in is named where it appears: it is not the joint's own state.
+  return out + " N m (θ in rad, θ̇ in rad/s, t in s" +
+         (commanded ? "; θ̇_in: the segment's bending rate its inputs command, rad/s" : "") + ")";
 }
 
 bool LoopOptions::IsValid(std::string* error) const {
@@ -380,7 +384,9 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       const int links = arm_config.segments[static_cast<std::size_t>(s - 1)].links;
       for (int axis = 0; axis < 2; ++axis) {
         // A term in the angle or rate of an axis the fitted motion leaves at
-        // 0 moves nothing to first order: no column, no simulation.
+        // 0 moves nothing to first order: no column, no simulation. The
+        // input rate goes with them: inputs that command a bending of an
+        // axis move it.
         double largest = 0.0;
         for (const Eigen::MatrixXd& a : fitted) {
           for (int j = first_joint; j < first_joint + links; ++j) {

@@ -35,10 +35,18 @@ constexpr double kRegularization = 1e-10;
 // evaluation (effects/effect.h).
 class ArmDynamics::EffectLoadsView final : public EffectLoads {
  public:
-  explicit EffectLoadsView(ArmDynamics* dynamics) : d_(dynamics) {}
+  // The map from input lengths to commanded bending is built only for a
+  // run whose effects add loads (its cost: 4 S kinematic evaluations).
+  explicit EffectLoadsView(ArmDynamics* dynamics) : d_(dynamics) {
+    if (!d_->load_effects_.empty()) {
+      bending_per_pulled_ = SegmentBendingPerPulledLength(d_->model_);
+      input_rate_.resize(d_->model_.num_cables());
+    }
+  }
   void Bind(double t, const double* qd) {
     t_ = t;
     qd_ = qd;
+    bending_rate_valid_ = false;
   }
   double time() const override { return t_; }
   int num_links() const override { return d_->model_.num_links(); }
@@ -51,6 +59,17 @@ class ArmDynamics::EffectLoadsView final : public EffectLoads {
     return Position(qd_, d_->model_.link_offset(link));
   }
   double link_mass(int link) const override { return d_->model_.link(link).mass_kg; }
+  double commanded_bending_rate(int segment, int axis) const override {
+    if (!bending_rate_valid_) {
+      for (int c = 0; c < d_->model_.num_cables(); ++c) {
+        double value, accel;
+        d_->inputs_.Evaluate(c, t_, &value, &input_rate_[c], &accel);
+      }
+      bending_rate_ = bending_per_pulled_ * input_rate_;
+      bending_rate_valid_ = true;
+    }
+    return bending_rate_[2 * (segment - 1) + axis];
+  }
   void AddLinkForce(int link, const Vector3& f_W) override {
     d_->force_.segment<3>(d_->model_.link_offset(link)) += f_W;
   }
@@ -63,6 +82,11 @@ class ArmDynamics::EffectLoadsView final : public EffectLoads {
   ArmDynamics* d_;
   double t_ = 0.0;
   const double* qd_ = nullptr;
+  Eigen::MatrixXd bending_per_pulled_;  // SegmentBendingPerPulledLength
+  // The inputs' rates [m/s] and the bending rates they command [rad/s] at
+  // t_, evaluated on the first request after Bind.
+  mutable Eigen::VectorXd input_rate_, bending_rate_;
+  mutable bool bending_rate_valid_ = false;
 };
 
 ArmDynamics::~ArmDynamics() = default;

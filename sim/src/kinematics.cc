@@ -1,5 +1,6 @@
 #include "ccsrm/sim/kinematics.h"
 
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 
@@ -58,6 +59,33 @@ double CablePathLength(const ArmModel& model, int cable, const std::vector<LinkP
     previous = p;
   }
   return length;
+}
+
+Eigen::MatrixXd SegmentBendingPerPulledLength(const ArmModel& model) {
+  const int segments = static_cast<int>(model.arm().segments.size());
+  const int cables = model.num_cables();
+  // Pulled-in length per joint angle of a whole segment: −dL/dθ by central
+  // differences at the straight arm. The path lengths are smooth there and
+  // a step of 1e-5 rad leaves an error of order h² relative to the slope.
+  constexpr double kStepRad = 1e-5;
+  Eigen::MatrixXd pulled_per_angle(cables, 2 * segments);
+  for (int k = 0; k < segments; ++k) {
+    for (int axis = 0; axis < 2; ++axis) {
+      JointAngles plus(model.num_joints(), Eigen::Vector2d::Zero()), minus = plus;
+      for (int j = 1; j <= model.num_joints(); ++j) {
+        if (model.link(j).segment != k) continue;
+        plus[j - 1][axis] = kStepRad;
+        minus[j - 1][axis] = -kStepRad;
+      }
+      const std::vector<LinkPose> up = ForwardKinematics(model, plus);
+      const std::vector<LinkPose> down = ForwardKinematics(model, minus);
+      for (int c = 0; c < cables; ++c) {
+        pulled_per_angle(c, 2 * k + axis) =
+            -(CablePathLength(model, c, up) - CablePathLength(model, c, down)) / (2.0 * kStepRad);
+      }
+    }
+  }
+  return pulled_per_angle.completeOrthogonalDecomposition().pseudoInverse();
 }
 
 }  // namespace ccsrm::sim

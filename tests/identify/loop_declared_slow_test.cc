@@ -105,7 +105,9 @@ TEST(LoopDeclaredValues, WithoutTheDeclaredValuesNoEffectIsNamedForTheirResidual
   EXPECT_FALSE(s.unexplained.empty());  // and the residual stays listed
   for (const LoopRound& r : s.rounds) {
     for (const CandidateResult& c : r.candidates) {
-      if (c.partial) EXPECT_THAT(r.decision, HasSubstr("not explained")) << r.decision;
+      if (c.partial) {
+        EXPECT_THAT(r.decision, HasSubstr("not explained")) << r.decision;
+      }
     }
   }
 }

@@ -94,6 +94,31 @@ TEST(ResidualDiagnostics, SplitsTheProtocolIntoMotionAndHold) {
   EXPECT_NEAR(phases[1].start_s, 1.93, 0.015);
 }
 
+TEST(DiscoveredMoment, FormulaGivesEachTermWithItsErrorAndSaysWhatTheInputRateIs) {
+  DiscoveredMoment m;
+  m.segment = 2;
+  m.first_joint = 7;
+  m.last_joint = 12;
+  const auto term = [](const std::string& name, double value, double std_error) {
+    DiscoveredMoment::Term t;
+    t.name = name;
+    for (const sim::JointMomentTerm& known : sim::JointMomentTerms()) {
+      if (known.name == name) t.formula = known.formula;
+    }
+    t.estimate.value = value;
+    t.estimate.std_error = std_error;
+    return t;
+  };
+  m.terms = {term("angle3", -201.0, 9.0)};
+  EXPECT_EQ(m.Formula(),
+            "joints 7-12 (segment 2) θx: M = (-201 ± 9) θ³ N m (θ in rad, θ̇ in rad/s, t in s)");
+  // θ̇_in is no state of the joint: the formula says what it is.
+  m.terms.push_back(term("input_rate", -0.52, 0.04));
+  EXPECT_EQ(m.Formula(),
+            "joints 7-12 (segment 2) θx: M = (-201 ± 9) θ³ - (0.52 ± 0.04) θ̇_in N m (θ in rad, "
+            "θ̇ in rad/s, t in s; θ̇_in: the segment's bending rate its inputs command, rad/s)");
+}
+
 TEST(LoopOptions, RefusesUnknownAndDeclaredCandidates) {
   std::string error;
   LoopOptions o = LoopTestOptions({"joint_friction", "friction_of_the_table"});

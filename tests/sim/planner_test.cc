@@ -64,6 +64,39 @@ TEST(KinematicPlanner, InputLengthsMatchClosedFormPathLengthsAtSixDegrees) {
   EXPECT_GT(pulled(5), 0.0);
 }
 
+TEST(KinematicPlanner, BendingPerPulledLengthRecoversEverySegmentsSmallBending) {
+  // Each segment bent by its own small (θx, θy) at every joint: the map
+  // takes the planned pulled-in lengths back to the four bendings. It is
+  // the planning linearised at the straight arm, so what is left is of
+  // second order: a chord's curvature over its slope, about d θ / (8 R)
+  // (2e-4 of the angle at 0.3°, d = 16 mm, R = 16 mm); 1 % of the largest
+  // angle bounds it with room for the x-y coupling of the Cardan angles.
+  const Config c = LoadConfig(kPaper);
+  const ArmModel model(c.arm);
+  const double deg = M_PI / 180.0;
+  const Eigen::Vector4d bending(0.2 * deg, -0.3 * deg, 0.15 * deg, 0.25 * deg);
+  JointAngles bent(model.num_joints());
+  for (int j = 1; j <= model.num_joints(); ++j) {
+    bent[j - 1] = bending.segment<2>(2 * model.link(j).segment);
+  }
+  const auto poses0 =
+      ForwardKinematics(model, JointAngles(model.num_joints(), Eigen::Vector2d::Zero()));
+  const auto poses = ForwardKinematics(model, bent);
+  Eigen::VectorXd pulled(model.num_cables());
+  for (int k = 0; k < model.num_cables(); ++k) {
+    pulled[k] = CablePathLength(model, k, poses0) - CablePathLength(model, k, poses);
+  }
+  const Eigen::MatrixXd map = SegmentBendingPerPulledLength(model);
+  ASSERT_EQ(map.rows(), 4);
+  ASSERT_EQ(map.cols(), model.num_cables());
+  const Eigen::VectorXd recovered = map * pulled;
+  for (int r = 0; r < 4; ++r) {
+    std::printf("segment %d θ%c: bent %+.5f°, recovered %+.5f°\n", r / 2 + 1, r % 2 ? 'y' : 'x',
+                bending[r] / deg, recovered[r] / deg);
+    EXPECT_NEAR(recovered[r], bending[r], 0.01 * bending.cwiseAbs().maxCoeff()) << "row " << r;
+  }
+}
+
 TEST(KinematicPlanner, PaperProtocolFollowsTheQuinticAndHolds) {
   Config c = LoadConfig(kPaper);
   const ArmModel model(c.arm);

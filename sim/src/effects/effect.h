@@ -40,6 +40,12 @@ class EffectLoads {
   virtual int joint_segment(int joint) const = 0;                   // 1-based
   virtual Eigen::Vector3d link_velocity(int link) const = 0;        // mass centre, world [m/s]
   virtual double link_mass(int link) const = 0;                     // [kg]
+  // The bending rate [rad/s] about axis `axis` that the driving cables'
+  // input rates command of every joint of segment `segment` (1-based),
+  // kinematically (SegmentBendingPerPulledLength, sim/kinematics.h): the
+  // inputs' motion in the joints' own units. Realised inputs, after any
+  // effect that changes them (actuator_delay).
+  virtual double commanded_bending_rate(int segment, int axis) const = 0;
   // A force on link `link`'s mass centre, world frame [N].
   virtual void AddLinkForce(int link, const Eigen::Vector3d& f_W) = 0;
   // A joint-space moment [N m] on joint `joint`'s angle `axis`, and its

@@ -6,10 +6,11 @@
 //   M = Σ_terms c(segment, axis, term) φ_term(θ, θ̇, t)
 //
 // with φ from JointMomentTerms() in the joint's own angle θ and rate θ̇ of
-// that axis (and time). One coefficient per segment rather than per joint:
-// the connecting cables make a segment's joints turn together (the
-// mechanism's synchrony), so per-joint coefficients of the same term would
-// be seen only through their sum.
+// that axis, the bending rate θ̇_in its segment's inputs command about that
+// axis (EffectLoads::commanded_bending_rate), and time. One coefficient per
+// segment rather than per joint: the connecting cables make a segment's
+// joints turn together (the mechanism's synchrony), so per-joint coefficients
+// of the same term would be seen only through their sum.
 //
 // A term's slope in θ̇ is model-smoothed by the simulator like joint
 // friction's (EffectLoads::AddJointMoment, only where it damps); the power
@@ -19,10 +20,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "ccsrm/common/error.h"
 #include "ccsrm/sim/effects.h"
 #include "effect.h"
 
@@ -37,6 +40,7 @@ const std::vector<JointMomentTerm>& JointMomentTerms() {
       {"rate", "θ̇", "N m s/rad", -1.0, 1},
       {"sign_rate", "sign(θ̇)", "N m", -0.01, 1},
       {"abs_angle_sign_rate", "|θ| sign(θ̇)", "N m/rad", -0.1, 2},
+      {"input_rate", "θ̇_in", "N m s/rad", -1.0, 1},
       {"time", "t", "N m/s", 0.001, 1},
   };
   return terms;
@@ -52,11 +56,15 @@ namespace {
 // The rate over which sign(θ̇) is smoothed: joint friction's default
 // (joint_friction.cc), a tenth of the paper's peak ramp rate.
 constexpr double kSignRateRadps = 1e-3;
+// The number of terms and the index of the input rate's, in
+// JointMomentTerms()' order (checked against it where the effect is built).
+constexpr std::size_t kNumTerms = 9, kInputRate = 7;
 
 class JointMoment final : public Effect {
  public:
   explicit JointMoment(const ArmParameters& p) {
     const std::vector<JointMomentTerm>& terms = JointMomentTerms();
+    CCSRM_CHECK(terms.size() == kNumTerms && terms[kInputRate].name == "input_rate");
     coefficients_.resize(static_cast<std::size_t>(p.arm.segments));
     for (int k = 1; k <= p.arm.segments; ++k) {
       for (int axis = 0; axis < 2; ++axis) {
@@ -80,9 +88,14 @@ class JointMoment final : public Effect {
         const double q = loads->joint_angle(j)[axis], w = loads->joint_rate(j)[axis];
         const double s = std::tanh(w / kSignRateRadps);
         const double ds = (1.0 - s * s) / kSignRateRadps;  // d sign / d θ̇
+        // The inputs' rate is asked for only where its term is on: it
+        // costs an evaluation of every cable's input spline.
+        const double w_in =
+            c[kInputRate] != 0.0 ? loads->commanded_bending_rate(segment, axis) : 0.0;
         // φ and dφ/dθ̇ in JointMomentTerms()' order.
-        const double phi[] = {1.0, q, q * q, q * q * q, w, s, std::abs(q) * s, t};
-        const double dphi[] = {0.0, 0.0, 0.0, 0.0, 1.0, ds, std::abs(q) * ds, 0.0};
+        const double phi[] = {1.0, q, q * q, q * q * q, w, s, std::abs(q) * s, w_in, t};
+        const double dphi[] = {0.0, 0.0, 0.0, 0.0, 1.0, ds, std::abs(q) * ds, 0.0, 0.0};
+        static_assert(std::size(phi) == kNumTerms && std::size(dphi) == kNumTerms);
         double moment = 0.0, slope = 0.0;
         for (std::size_t k = 0; k < c.size(); ++k) {
           moment += c[k] * phi[k];

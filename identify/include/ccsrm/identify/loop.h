@@ -79,20 +79,20 @@
 // scoring one is refitted and stands for them. A value that earns its place is reported as "the
 // declared X is off by Δ ± σ", and the corrected configuration is written (calibrated.yaml).
 //
-// Terms found in the data (issue 28, "terms"): when no effect of the
-// library earns its place in a round (a declared value may: the terms then
-// compete with it by ΔBIC) and the residual is still structured (its weighted mean
+// Terms found in the data (issue 28, "terms"): when no effect of the library
+// earns its place in a round (a declared value may: the terms then compete
+// with it by ΔBIC) and the residual is still structured (its weighted mean
 // square above unexplained_noise_ratio², or correlated with one of the
 // effects' signals), a moment at every joint axis is sought as a sparse
-// combination of joint_moment's terms in the joint's own angle, rate and
-// time (sim::JointMomentTerms(); one coefficient per segment, axis and
-// term). Each term's column is one simulation per training experiment;
-// sequentially thresholded least squares on them (term_discovery.h) picks
-// the combination with the best linear ΔBIC, simpler terms winning ties;
-// if that ΔBIC passes min_delta_bic the combination is refitted and judged
-// by every criterion above, held-out error and the partial-explanation
-// rule included. Reported as a formula per segment's joints and axis
-// (LoopSummary::discovered_terms).
+// combination of joint_moment's terms in the joint's own angle and rate, the
+// bending rate its inputs command, and time (sim::JointMomentTerms(); one
+// coefficient per segment, axis and term). Each term's column is one
+// simulation per training experiment; sequentially thresholded least squares
+// on them (term_discovery.h) picks the combination with the best linear ΔBIC,
+// simpler terms winning ties; if that ΔBIC passes min_delta_bic the
+// combination is refitted and judged by every criterion above, held-out error
+// and the partial-explanation rule included. Reported as a formula per
+// segment's joints and axis (LoopSummary::discovered_terms).
 //
 // At the end, every (experiment, joint, axis) whose RMS residual exceeds
 // unexplained_noise_ratio (1.5) times its noise is reported as

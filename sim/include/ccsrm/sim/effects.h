@@ -54,7 +54,8 @@ struct EffectInfo {
 };
 
 // One term of joint_moment's library: a function of a joint axis's own
-// angle θ [rad] and rate θ̇ [rad/s], or of time t [s], whose coefficient is
+// angle θ [rad] and rate θ̇ [rad/s], of the bending rate its inputs
+// command θ̇_in [rad/s], or of time t [s], whose coefficient is
 // the parameter "joint_moment.segment<k>_<x|y>_<name>" (the moment on every
 // joint of segment k about that axis, in N m per unit of the term).
 struct JointMomentTerm {
@@ -63,9 +64,10 @@ struct JointMomentTerm {
   std::string units;    // of its coefficient: "N m/rad^3"
   // The coefficient's realistic value (its score step in the loop): a
   // moment of 0.01 N m (joint friction's realistic Coulomb moment) at
-  // θ = 0.1 rad, θ̇ = 0.01 rad/s, t = 10 s; negative where the physical
-  // direction is: a restoring spring (θ, θ³), a friction (θ̇, sign θ̇,
-  // |θ| sign θ̇), whose step then damps the motion rather than drive it.
+  // θ = 0.1 rad, θ̇ = θ̇_in = 0.01 rad/s, t = 10 s; negative where the
+  // physical direction is: a restoring spring (θ, θ³), a friction (θ̇,
+  // sign θ̇, |θ| sign θ̇), a drag against the drive (θ̇_in), whose step then
+  // damps the motion rather than drive it.
   double realistic = 0.0;
   // The simpler wins a tie in the discovery: powers count their degree.
   int complexity = 1;
@@ -73,8 +75,11 @@ struct JointMomentTerm {
 
 // const (1), angle (θ), angle2 (θ²), angle3 (θ³), rate (θ̇), sign_rate
 // (sign θ̇, smoothed as joint friction's: tanh(θ̇ / 1e-3 rad/s)),
-// abs_angle_sign_rate (|θ| sign θ̇: friction that grows with the angle) and
-// time (t), in that order.
+// abs_angle_sign_rate (|θ| sign θ̇: friction that grows with the angle),
+// input_rate (θ̇_in [rad/s]: the bending rate of the joint's segment about
+// that axis that the driving cables' input rates command kinematically,
+// SegmentBendingPerPulledLength in sim/kinematics.h) and time (t), in that
+// order.
 const std::vector<JointMomentTerm>& JointMomentTerms();
 
 // "joint_moment.segment2_x_angle3" (segment 1-based, axis 0 = θx, 1 = θy).
