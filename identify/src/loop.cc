@@ -484,7 +484,10 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
   // identifiable, and the conclusion still named it: a lab told its joints
   // have friction they do not have. So every earlier addition is checked
   // in the new fit by the acceptance's own size test; one whose size is
-  // indistinguishable from 0 is refitted away from the new fit's point
+  // indistinguishable from 0, or that the new fit cannot identify (an
+  // input-rate drag first taken for softer driving cables: beside the
+  // terms the cables' E·A is not identifiable, yet setting it back at the
+  // new fit's point costs much), is refitted away from the new fit's point
   // (its parameters off, or a declared value back at the configuration's)
   // and taken back when keeping it is not worth min_delta_bic, the
   // criterion that added it: what the loop would not add now it does not
@@ -506,6 +509,7 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       for (const std::string& q : b.parameters) {
         if (const ParameterEstimate* est = current.Find(q)) {
           c.interval_excludes_zero |= internal::IntervalExcludesZero(*est);
+          c.identifiable = c.identifiable && est->identifiable;
         }
       }
       if (!c.interval_excludes_zero) {
@@ -520,11 +524,17 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       b.delta_chi2_zeroed = c.delta_chi2_zeroed;
       b.size_significant =
           internal::SizeSignificant(c.interval_excludes_zero, c.delta_chi2_zeroed, c.parameters);
-      b.reason = b.size_significant ? "its size is still distinguishable from 0: kept"
-                                    : (std::isfinite(c.delta_chi2_zeroed)
-                                           ? "its size is indistinguishable from 0 (Δχ²_eff " +
-                                                 Format("%.1f", c.delta_chi2_zeroed) + " at 0)"
-                                           : "its run at 0 failed: not judged, kept");
+      if (!std::isfinite(c.delta_chi2_zeroed) && !c.interval_excludes_zero) {
+        b.reason = "its run at 0 failed: not judged, kept";
+      } else if (!b.size_significant) {
+        b.reason = "its size is indistinguishable from 0 (Δχ²_eff " +
+                   Format("%.1f", c.delta_chi2_zeroed) + " at 0)";
+      } else if (!c.interval_excludes_zero && !c.identifiable) {
+        b.reason = "it is not identifiable beside " + winner_label + " (Δχ²_eff " +
+                   Format("%.1f", c.delta_chi2_zeroed) + " at 0 without a refit)";
+      } else {
+        b.reason = "its size is still distinguishable from 0: kept";
+      }
       checks.push_back(c);
       lr->backward.push_back(std::move(b));
     }
@@ -562,8 +572,10 @@ LoopSummary CloseLoop(const std::vector<Experiment>& training,
       if (!holdout.empty()) b.holdout_rms_deg_without = h.rms_deg;
       b.taken_back = true;
       b.reason = "took back " + (b.name == kTermsEffect ? "the terms found in the data" : b.name) +
-                 ": after " + winner_label + " its size is indistinguishable from 0 (" + keep +
-                 " <= " + Format("%g", options.min_delta_bic) + "; training RMS " +
+                 ": after " + winner_label +
+                 (b.size_significant ? " it is not identifiable"
+                                     : " its size is indistinguishable from 0") +
+                 " (" + keep + " <= " + Format("%g", options.min_delta_bic) + "; training RMS " +
                  Format("%.4f", current.errors.rms_deg_overall) + " -> " +
                  Format("%.4f", b.rms_deg_without) + " deg" +
                  (holdout.empty() ? std::string()

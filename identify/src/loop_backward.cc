@@ -28,7 +28,9 @@ std::vector<std::size_t> TakeBackOrder(const std::vector<AdditionCheck>& checks)
   for (std::size_t a = 0; a < checks.size(); ++a) {
     const AdditionCheck& c = checks[a];
     if (c.interval_excludes_zero || !std::isfinite(c.delta_chi2_zeroed)) continue;
-    if (!SizeSignificant(false, c.delta_chi2_zeroed, c.parameters)) order.push_back(a);
+    if (!c.identifiable || !SizeSignificant(false, c.delta_chi2_zeroed, c.parameters)) {
+      order.push_back(a);
+    }
   }
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return checks[a].delta_bic_zeroed < checks[b].delta_bic_zeroed;

@@ -38,11 +38,18 @@ struct AdditionCheck {
   // k ln N_eff (how much it still earns there, before any refit).
   double delta_chi2_zeroed = std::numeric_limits<double>::quiet_NaN();
   double delta_bic_zeroed = std::numeric_limits<double>::quiet_NaN();
+  // Every one of its parameters identifiable in the new fit. One that is
+  // not lies (nearly) along a flat direction of the fit: setting it to 0
+  // without a refit moves off that direction, and the cost there says
+  // nothing about what a refit without it would lose.
+  bool identifiable = true;
 };
 
 // The additions to try taking back, least useful first: those whose size
-// is indistinguishable from 0 (SizeSignificant), by delta_bic_zeroed, the
-// smallest first. One whose run at 0 failed is not judged, so not listed.
+// is indistinguishable from 0 (SizeSignificant), and those with a
+// parameter the new fit cannot identify (whatever the cost at 0: only the
+// refit without them can tell), by delta_bic_zeroed, the smallest first.
+// One whose run at 0 failed is not judged, so not listed.
 std::vector<std::size_t> TakeBackOrder(const std::vector<AdditionCheck>& checks);
 
 }  // namespace ccsrm::identify::internal

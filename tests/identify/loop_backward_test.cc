@@ -62,6 +62,15 @@ TEST(LoopBackwardStep, TriesOnlyAdditionsOfUnsizedSizeLeastUsefulFirst) {
   ASSERT_EQ(order.size(), 2u);
   EXPECT_EQ(order[0], 1u);
   EXPECT_EQ(order[1], 3u);
+  // 2 again, with its parameter not identifiable in the new fit: its cost
+  // at 0 (no refit) cannot size it, so the refit is tried; last, as its
+  // ΔBIC at 0 is the largest.
+  checks[2].identifiable = false;
+  EXPECT_EQ(TakeBackOrder(checks), (std::vector<std::size_t>{1, 3, 2}));
+  // An interval that excludes 0 sizes an addition whatever the rest.
+  checks[0].identifiable = false;
+  EXPECT_EQ(TakeBackOrder(checks), (std::vector<std::size_t>{1, 3, 2}));
+  checks[0].identifiable = checks[2].identifiable = true;
   // Nothing earlier, or everything sized: no backward step.
   EXPECT_TRUE(TakeBackOrder({}).empty());
   EXPECT_TRUE(TakeBackOrder({checks[0], checks[2]}).empty());
