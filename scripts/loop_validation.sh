@@ -16,8 +16,8 @@
 # Scenarios: null backlash mocap_offset table_tilt joint_friction
 #            actuator_delay two outside (default: all), the declared
 #            values: hole_radius hole_radius_s1 pulley_radius link_length
-#            disk_gap disk_gap_2mm disk_gap_20deg, and terms found in the data: cubic angle_friction
-#            input_drag
+#            disk_gap disk_gap_2mm disk_gap_20deg, and terms found in
+#            the data: cubic angle_friction input_drag
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:?usage: scripts/loop_validation.sh OUT_DIR [SCENARIO ...]}
