@@ -301,6 +301,22 @@ TEST(EffectsOff, RunsAreBitIdenticalToAConfigurationWithoutEffects) {
 
 // ----------------------------------------------------------- the physics
 
+// The settled deflection: every joint's angle about `axis` (0 θx, 1 θy)
+// averaged over the frames from t = 2.5 s on (the last 0.5 s of the 3 s
+// runs below, after the damped arm has settled).
+Eigen::VectorXd SettledAngles(const Trajectory& trajectory, int axis) {
+  const std::size_t n = trajectory.frames.empty() ? 0 : trajectory.frames[0].joint_angles.size();
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+  int count = 0;
+  for (std::size_t f = 0; f < trajectory.size(); ++f) {
+    if (trajectory.time[f] < 2.5) continue;
+    for (std::size_t j = 0; j < n; ++j) mean[j] += trajectory.frames[f].joint_angles[j][axis];
+    ++count;
+  }
+  EXPECT_GT(count, 0);
+  return count > 0 ? Eigen::VectorXd(mean / count) : mean;
+}
+
 // Quasi-static planar estimate of the frictionless arm's θx under in-plane
 // loads `tau` (generalised forces on θx of joints 1..N): the stiffness of
 // the driving cables (axial, EA/L ∇L ∇Lᵀ, and geometric, T_d0 ∇²L: each
@@ -364,19 +380,8 @@ TEST(TableTilt, TiltedTableBendsArmAtRest) {
   const SimulationResult r = Simulate(arm.model, p, held, OptionsFor(arm.config, 3.0));
   ASSERT_TRUE(r.summary.completed()) << r.summary.message;
   const int n = arm.model.num_joints();
-  // The settled deflection: the mean over the last 0.5 s.
-  Eigen::VectorXd sim_x = Eigen::VectorXd::Zero(n), sim_y = Eigen::VectorXd::Zero(n);
-  int count = 0;
-  for (std::size_t f = 0; f < r.trajectory.size(); ++f) {
-    if (r.trajectory.time[f] < 2.5) continue;
-    for (int j = 0; j < n; ++j) {
-      sim_x[j] += r.trajectory.frames[f].joint_angles[j][0];
-      sim_y[j] += r.trajectory.frames[f].joint_angles[j][1];
-    }
-    ++count;
-  }
-  sim_x /= count;
-  sim_y /= count;
+  const Eigen::VectorXd sim_x = SettledAngles(r.trajectory, 0);
+  const Eigen::VectorXd sim_y = SettledAngles(r.trajectory, 1);
   // Generalised gravity forces on θx: sum over links of m g_y ∂y_i/∂θx_j.
   const double g_y = 9.80665 * std::sin(tilt);
   Eigen::VectorXd tau(n);
@@ -834,14 +839,8 @@ TEST(JointMoment, ConstantMomentBendsTheArmAsTheQuasiStaticModelPredicts) {
       Simulate(arm.model, p, Held(arm.model, 3.0), OptionsFor(arm.config, 3.0));
   ASSERT_TRUE(r.summary.completed()) << r.summary.message;
   const int n = arm.model.num_joints();
-  Eigen::VectorXd sim_x = Eigen::VectorXd::Zero(n), tau(n);
-  int count = 0;
-  for (std::size_t f = 0; f < r.trajectory.size(); ++f) {
-    if (r.trajectory.time[f] < 2.5) continue;
-    for (int j = 0; j < n; ++j) sim_x[j] += r.trajectory.frames[f].joint_angles[j][0];
-    ++count;
-  }
-  sim_x /= count;
+  const Eigen::VectorXd sim_x = SettledAngles(r.trajectory, 0);
+  Eigen::VectorXd tau(n);
   for (int j = 0; j < n; ++j) tau[j] = arm.model.link(j + 1).segment == 0 ? m1 : m2;
   const Eigen::VectorXd estimate = QuasiStaticDeflection(arm.model, p, tau);
   for (int j = 0; j < n; ++j) {
@@ -888,18 +887,9 @@ TEST(JointMoment, InputRateTermActsWhileTheInputsMoveAsTheMomentOfTheRateTheyCom
   ASSERT_TRUE(a.summary.completed()) << a.summary.message;
   ASSERT_TRUE(b.summary.completed()) << b.summary.message;
   const int n = arm.model.num_joints();
-  Eigen::VectorXd difference = Eigen::VectorXd::Zero(n), tau(n);
-  int count = 0;
-  for (std::size_t f = 0; f < a.trajectory.size(); ++f) {
-    if (a.trajectory.time[f] < 2.5) continue;
-    for (int j = 0; j < n; ++j) {
-      difference[j] +=
-          a.trajectory.frames[f].joint_angles[j][0] - b.trajectory.frames[f].joint_angles[j][0];
-    }
-    ++count;
-  }
-  ASSERT_GT(count, 0);
-  difference /= count;
+  const Eigen::VectorXd difference =
+      SettledAngles(a.trajectory, 0) - SettledAngles(b.trajectory, 0);
+  Eigen::VectorXd tau(n);
   for (int j = 0; j < n; ++j) tau[j] = arm.model.link(j + 1).segment == 0 ? c * omega : 0.0;
   const Eigen::VectorXd estimate = QuasiStaticDeflection(arm.model, p, tau);
   for (int j = 0; j < n; ++j) {
