@@ -142,8 +142,9 @@ Table DiscoveredTermsTable(const LoopFolder& loop) {
   table.title = "Terms found in the data (joint_moment)";
   table.caption =
       "loop.json 'discovered_terms': the moment the final model adds at every joint of a "
-      "segment about one axis, M = sum of coefficient x term, in the joint's own angle θ [rad], "
-      "rate θ̇ [rad/s] and time t [s]; chosen by sparse regression on the residual and refitted "
+      "segment about one axis, M = sum of coefficient x term, in the joint's own angle θ [rad] "
+      "and rate θ̇ [rad/s], the bending rate its inputs command θ̇_in [rad/s] and time t [s]; "
+      "chosen by sparse regression on the residual and refitted "
       "in the simulator (docs/loop.md). Coefficients with their 95 % intervals.";
   table.columns = {{"joints", "joints", "", kCount},    {"axis", "axis", "", kCount},
                    {"term", "term", "", kCount},        {"value", "coefficient", "", kValue},
