@@ -35,14 +35,7 @@ constexpr double kRegularization = 1e-10;
 // evaluation (effects/effect.h).
 class ArmDynamics::EffectLoadsView final : public EffectLoads {
  public:
-  // The map from input lengths to commanded bending is built only for a
-  // run whose effects add loads (its cost: 4 S kinematic evaluations).
-  explicit EffectLoadsView(ArmDynamics* dynamics) : d_(dynamics) {
-    if (!d_->load_effects_.empty()) {
-      bending_per_pulled_ = SegmentBendingPerPulledLength(d_->model_);
-      input_rate_.resize(d_->model_.num_cables());
-    }
-  }
+  explicit EffectLoadsView(ArmDynamics* dynamics) : d_(dynamics) {}
   void Bind(double t, const double* qd) {
     t_ = t;
     qd_ = qd;
@@ -61,6 +54,12 @@ class ArmDynamics::EffectLoadsView final : public EffectLoads {
   double link_mass(int link) const override { return d_->model_.link(link).mass_kg; }
   double commanded_bending_rate(int segment, int axis) const override {
     if (!bending_rate_valid_) {
+      // The map is built on the first request of the run (4 S kinematic
+      // evaluations), so a run that never asks pays nothing.
+      if (bending_per_pulled_.size() == 0) {
+        bending_per_pulled_ = SegmentBendingPerPulledLength(d_->model_);
+        input_rate_.resize(d_->model_.num_cables());
+      }
       for (int c = 0; c < d_->model_.num_cables(); ++c) {
         double value, accel;
         d_->inputs_.Evaluate(c, t_, &value, &input_rate_[c], &accel);
@@ -82,9 +81,10 @@ class ArmDynamics::EffectLoadsView final : public EffectLoads {
   ArmDynamics* d_;
   double t_ = 0.0;
   const double* qd_ = nullptr;
-  Eigen::MatrixXd bending_per_pulled_;  // SegmentBendingPerPulledLength
-  // The inputs' rates [m/s] and the bending rates they command [rad/s] at
-  // t_, evaluated on the first request after Bind.
+  // SegmentBendingPerPulledLength; the inputs' rates [m/s] and the bending
+  // rates they command [rad/s] at t_, evaluated on the first request after
+  // Bind.
+  mutable Eigen::MatrixXd bending_per_pulled_;
   mutable Eigen::VectorXd input_rate_, bending_rate_;
   mutable bool bending_rate_valid_ = false;
 };

@@ -61,31 +61,44 @@ double CablePathLength(const ArmModel& model, int cable, const std::vector<LinkP
   return length;
 }
 
-Eigen::MatrixXd SegmentBendingPerPulledLength(const ArmModel& model) {
-  const int segments = static_cast<int>(model.arm().segments.size());
+Eigen::MatrixXd SegmentMomentArms(const ArmModel& model, const JointAngles& angles) {
   const int cables = model.num_cables();
-  // Pulled-in length per joint angle of a whole segment: −dL/dθ by central
-  // differences at the straight arm. The path lengths are smooth there and
-  // a step of 1e-5 rad leaves an error of order h² relative to the slope.
-  constexpr double kStepRad = 1e-5;
-  Eigen::MatrixXd pulled_per_angle(cables, 2 * segments);
-  for (int k = 0; k < segments; ++k) {
+  const int segments = static_cast<int>(model.arm().segments.size());
+  // Central differences. Where they balance tensions the moments cancel to
+  // first order (Σ_c ∂L_c/∂Θ is second order in the bend), so rounding in
+  // the path lengths (~1e-15 m) is amplified: a 1e-3 rad step keeps it to
+  // ~1e-12 of them, where 1e-6 rad left noise of ~1e-11 m in the planned
+  // lengths, 1e-5 m/s² in their splines' second derivative. The step's
+  // truncation, ~δ²/6 = 2e-7 of the moment arms, is smooth in the angles.
+  constexpr double kStep = 1e-3;
+  Eigen::MatrixXd moment_arm(cables, 2 * segments);
+  int first_joint = 0;
+  for (int s = 0; s < segments; ++s) {
+    const int joints = model.arm().segments[s].links;
     for (int axis = 0; axis < 2; ++axis) {
-      JointAngles plus(model.num_joints(), Eigen::Vector2d::Zero()), minus = plus;
-      for (int j = 1; j <= model.num_joints(); ++j) {
-        if (model.link(j).segment != k) continue;
-        plus[j - 1][axis] = kStepRad;
-        minus[j - 1][axis] = -kStepRad;
+      JointAngles plus = angles, minus = angles;
+      for (int j = first_joint; j < first_joint + joints; ++j) {
+        plus[j][axis] += kStep;
+        minus[j][axis] -= kStep;
       }
-      const std::vector<LinkPose> up = ForwardKinematics(model, plus);
-      const std::vector<LinkPose> down = ForwardKinematics(model, minus);
+      const std::vector<LinkPose> poses_plus = ForwardKinematics(model, plus);
+      const std::vector<LinkPose> poses_minus = ForwardKinematics(model, minus);
       for (int c = 0; c < cables; ++c) {
-        pulled_per_angle(c, 2 * k + axis) =
-            -(CablePathLength(model, c, up) - CablePathLength(model, c, down)) / (2.0 * kStepRad);
+        moment_arm(c, 2 * s + axis) =
+            (CablePathLength(model, c, poses_plus) - CablePathLength(model, c, poses_minus)) /
+            (2.0 * kStep);
       }
     }
+    first_joint += joints;
   }
-  return pulled_per_angle.completeOrthogonalDecomposition().pseudoInverse();
+  return moment_arm;
+}
+
+Eigen::MatrixXd SegmentBendingPerPulledLength(const ArmModel& model) {
+  // Pulled in is −ΔL: the map inverts −∂L/∂Θ at the straight arm.
+  const Eigen::MatrixXd moment_arm =
+      SegmentMomentArms(model, JointAngles(model.num_joints(), Eigen::Vector2d::Zero()));
+  return (-moment_arm).completeOrthogonalDecomposition().pseudoInverse();
 }
 
 }  // namespace ccsrm::sim

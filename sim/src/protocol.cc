@@ -148,35 +148,7 @@ Eigen::VectorXd StaticEquilibriumStretch(const ArmModel& model, const JointAngle
                                          double time_s, const InputPlanning& planning,
                                          const std::string& source) {
   const int cables = model.num_cables();
-  const int segments = static_cast<int>(model.arm().segments.size());
-  // ∂L_c/∂Θ by central differences. The moments cancel to first order
-  // (Σ_c ∂L_c/∂Θ is second order in the bend), so rounding in the path
-  // lengths (~1e-15 m) is amplified into the tensions: a 1e-3 rad step keeps
-  // it to ~1e-12 of them, where 1e-6 rad left noise of ~1e-11 m in the
-  // planned lengths, 1e-5 m/s² in their splines' second derivative. The
-  // step's truncation, ~δ²/6 = 2e-7 of the moment arms, is smooth in the
-  // plan.
-  constexpr double kStep = 1e-3;
-  Eigen::MatrixXd moment_arm(cables, 2 * segments);
-  int first_joint = 0;
-  for (int s = 0; s < segments; ++s) {
-    const int joints = model.arm().segments[s].links;
-    for (int axis = 0; axis < 2; ++axis) {
-      JointAngles plus = angles, minus = angles;
-      for (int j = first_joint; j < first_joint + joints; ++j) {
-        plus[j][axis] += kStep;
-        minus[j][axis] -= kStep;
-      }
-      const std::vector<LinkPose> poses_plus = ForwardKinematics(model, plus);
-      const std::vector<LinkPose> poses_minus = ForwardKinematics(model, minus);
-      for (int c = 0; c < cables; ++c) {
-        moment_arm(c, 2 * s + axis) =
-            (CablePathLength(model, c, poses_plus) - CablePathLength(model, c, poses_minus)) /
-            (2.0 * kStep);
-      }
-    }
-    first_joint += joints;
-  }
+  const Eigen::MatrixXd moment_arm = SegmentMomentArms(model, angles);
   // Balance: moment_armᵀ (T_d0 + ΔT) = 0, ΔT of least norm. Straight, the
   // moment arms of a segment's cables cancel and ΔT = 0.
   const Eigen::VectorXd unbalanced =

@@ -47,14 +47,21 @@ Eigen::Vector3d CableNodePosition(const ArmModel& model, int cable, int node,
 // every hole to its anchor [m].
 double CablePathLength(const ArmModel& model, int cable, const std::vector<LinkPose>& poses);
 
+// The moment arms of the driving cables on each segment's bending at
+// `angles`: a C × 2S matrix (C cables, S segments) of ∂L_c/∂Θ [m/rad],
+// column 2(k − 1) + axis the derivative of cable c's path length
+// (CablePathLength) when every joint of segment k turns together about x
+// (axis 0) or y (axis 1).
+Eigen::MatrixXd SegmentMomentArms(const ArmModel& model, const JointAngles& angles);
+
 // The bending each segment's joints take, kinematically, for given
 // pulled-in lengths of the driving cables: a 2S × C matrix (S segments, C
 // cables) whose row 2(k − 1) + axis maps the C pulled-in lengths [m] to the
 // angle [rad] about x (axis 0) or y (axis 1) that every joint of segment k
-// would take. SPEC 3's kinematic planning linearised at the straight arm and
-// inverted by least squares (minimum norm where the cables cannot tell two
-// bendings apart). Applied to the input rates it gives the bending rate the
-// inputs command (the discovered terms' input rate, sim/effects.h).
+// would take. SPEC 3's kinematic planning linearised at the straight arm
+// (SegmentMomentArms there) and inverted by least squares (minimum norm where the cables cannot
+// tell two bendings apart). Applied to the input rates it gives the bending rate the inputs command
+// (the discovered terms' input rate, sim/effects.h).
 Eigen::MatrixXd SegmentBendingPerPulledLength(const ArmModel& model);
 
 }  // namespace ccsrm::sim
