@@ -574,14 +574,17 @@ TEST_F(BadInputTable, OwnOutputsAreReplacedAndAKilledRunsTemporariesRemoved) {
   EXPECT_EQ(std::distance(fs::directory_iterator(d), fs::directory_iterator()), 1);
 }
 
-// `ccsrm <args>` started with exec, interrupted with `signal_number`
+// `ccsrm <args>` started with exec and interrupted with `signal_number`
 // `delay` after its first progress line on stderr (so that the program is
-// at work, past its start); returns the wait status.
-int RunAndInterrupt(const std::string& args, std::chrono::milliseconds delay, int signal_number,
-                    std::string* err) {
+// at work, past its start). False, with *why, when the premise of the test
+// did not hold: the command printed nothing within 120 s (a guard against a
+// hung test, not a speed) or ended by itself before the signal.
+bool RunAndInterrupt(const std::string& args, std::chrono::milliseconds delay, int signal_number,
+                     int* status, std::string* err, std::string* why) {
   const std::string err_path =
       (fs::temp_directory_path() / ("ccsrm_interrupt_" + std::to_string(::getpid()) + ".err"))
           .string();
+  fs::remove(err_path);
   const std::string command =
       "exec " + std::string(CCSRM_PROGRAM) + " " + args + " >/dev/null 2>" + err_path;
   const pid_t pid = ::fork();
@@ -594,37 +597,54 @@ int RunAndInterrupt(const std::string& args, std::chrono::milliseconds delay, in
     const std::uintmax_t size = fs::file_size(err_path, ec);
     return !ec && size > 0;
   };
-  for (int i = 0; i < 1000 && !started(); ++i) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  bool ended_by_itself = false;
+  while (!started() && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
+  if (!started()) *why = "it printed no progress within 120 s";
   std::this_thread::sleep_for(delay);
-  ::kill(pid, signal_number);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
+  // Still at work? A command that ended before the signal tests nothing.
+  if (::waitpid(pid, status, WNOHANG) == pid) {
+    ended_by_itself = true;
+  } else {
+    ::kill(pid, signal_number);
+    ::waitpid(pid, status, 0);
+  }
   *err = ccsrm::ReadTextFile(err_path);
   fs::remove(err_path);
-  return status;
+  if (ended_by_itself) {
+    *why = "it ended by itself (status " + std::to_string(WEXITSTATUS(*status)) +
+           ") before the signal: give it more work";
+  }
+  return why->empty();
 }
 
 // Interrupts at several moments of a run and of a fit: whatever the moment,
 // the process ends by the signal and the output folder holds no temporary.
 TEST_F(BadInputTable, InterruptsLeaveNoTemporaries) {
   const fs::path d = ccsrm::testing::ScratchDirectory("bad_input_table_interrupt");
-  // Both run for seconds past the latest signal (20 s of case 2 at about
-  // 10x real time; a fit of the bundled 48 s sample), so every signal lands
-  // while the command works: a run that finished first would test nothing.
+  // Work that lasts far beyond the latest signal on any machine: 600 s of
+  // case 2 (minutes at the simulator's 25x real time), and a fit of four
+  // parameters over the bundled 48 s sample (five 48 s runs an iteration).
+  // Each is signalled about a second after it starts, so its length costs
+  // nothing; RunAndInterrupt still checks that it was at work.
   const std::string sample = std::string(CCSRM_SOURCE_DIR) + "/datasets/samples/loop/train1.h5";
   const std::vector<std::pair<std::string, int>> commands = {
-      {"simulate --config " + Paper() + " --case 2 --duration 20 --out " + (d / "run.h5").string(),
+      {"simulate --config " + Paper() + " --case 2 --duration 600 --out " + (d / "run.h5").string(),
        SIGINT},
-      {"identify --data " + sample + " --free mu --threads 2 --out " + (d / "fit").string(),
+      {"identify --data " + sample + " --free mu,mu_c,T_p,c_sc --max-iterations 100 --threads 2 " +
+           "--out " + (d / "fit").string(),
        SIGTERM},
   };
   for (const auto& [args, signal_number] : commands) {
     for (const int ms : {300, 900}) {
       SCOPED_TRACE(args + " interrupted after " + std::to_string(ms) + " ms");
-      std::string err;
-      const int status = RunAndInterrupt(args, std::chrono::milliseconds(ms), signal_number, &err);
+      int status = 0;
+      std::string err, why;
+      ASSERT_TRUE(
+          RunAndInterrupt(args, std::chrono::milliseconds(ms), signal_number, &status, &err, &why))
+          << why << ": " << err;
       ASSERT_TRUE(WIFSIGNALED(status)) << "exited with " << WEXITSTATUS(status) << ": " << err;
       EXPECT_EQ(WTERMSIG(status), signal_number);
       EXPECT_THAT(err, HasSubstr("ccsrm: interrupted")) << err;

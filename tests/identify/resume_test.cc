@@ -51,23 +51,40 @@ pid_t Launch(const std::string& args, const std::string& err) {
   return pid;
 }
 
-// Runs `ccsrm <args>` and kills it with SIGKILL `delay_s` after `ready`
-// holds (polled; 120 s at most, which only guards a hung test). False, with
-// *why, when `ready` never held or the command ended before the kill.
-bool KillWhenReady(const std::string& args, const std::function<bool()>& ready, double delay_s,
-                   std::string* why, const std::string& err = "/dev/null") {
-  const pid_t pid = Launch(args, err);
-  const auto deadline = Clock::now() + std::chrono::seconds(120);
-  while (!ready() && Clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+// Runs `ccsrm <args><out>` and kills it with SIGKILL `*delay_s` after
+// `ready` holds (polled; 120 s at most, which only guards a hung test).
+// The delay is drawn from a whole run timed earlier, and the machine's load
+// can change between that run and this one: when the command ends by itself
+// before the kill, `out` is removed and the command run again with half the
+// delay (*delay_s says the one that took), so no speed is assumed. False,
+// with *why, when `ready` never held, or the command ended before even the
+// shortest delay.
+bool KillWhenReady(const std::string& args, const std::string& out,
+                   const std::function<bool()>& ready, double* delay_s, std::string* why,
+                   const std::string& err = "/dev/null") {
+  for (int attempt = 0; attempt < 8; ++attempt, *delay_s *= 0.5) {
+    fs::remove_all(out);
+    const pid_t pid = Launch(args + out, err);
+    const auto deadline = Clock::now() + std::chrono::seconds(120);
+    while (!ready() && Clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    if (!ready()) {
+      *why = "it never got to the point of the kill";
+      kill(pid, SIGKILL);
+      waitpid(pid, nullptr, 0);
+      return false;
+    }
+    std::this_thread::sleep_for(std::chrono::duration<double>(*delay_s));
+    int raw = 0;
+    if (waitpid(pid, &raw, WNOHANG) == pid) continue;  // ended by itself: a shorter delay
+    kill(pid, SIGKILL);
+    waitpid(pid, &raw, 0);
+    if (WIFSIGNALED(raw)) return true;
   }
-  if (!ready()) *why = "it never got to the point of the kill";
-  std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
-  kill(pid, SIGKILL);
-  int raw = 0;
-  waitpid(pid, &raw, 0);
-  if (why->empty() && !WIFSIGNALED(raw)) *why = "it ended before it was killed";
-  return why->empty();
+  *why = "it ended before it was killed, even " + std::to_string(*delay_s * 2.0) +
+         " s after the point of the kill";
+  return false;
 }
 
 TEST(IdentifyResume, AFitKilledAtARandomMomentResumesToTheSameResult) {
@@ -98,13 +115,13 @@ TEST(IdentifyResume, AFitKilledAtARandomMomentResumesToTheSameResult) {
   const std::string stopped = (dir / "stopped").string();
   const unsigned seed = std::random_device{}();
   std::mt19937 random(seed);
-  const double delay_s = std::uniform_real_distribution<double>(0.0, 0.6 * whole_s)(random);
+  double delay_s = std::uniform_real_distribution<double>(0.0, 0.6 * whole_s)(random);
+  std::string why;
+  const bool killed = KillWhenReady(
+      fit, stopped, [&] { return fs::exists(stopped + "/checkpoint.json"); }, &delay_s, &why);
   SCOPED_TRACE("seed " + std::to_string(seed) + ", killed " + std::to_string(delay_s) +
                " s after the first checkpoint");
-  std::string why;
-  ASSERT_TRUE(KillWhenReady(
-      fit + stopped, [&] { return fs::exists(stopped + "/checkpoint.json"); }, delay_s, &why))
-      << why;
+  ASSERT_TRUE(killed) << why;
   EXPECT_FALSE(fs::exists(stopped + "/fit.json"));
   const nlohmann::json saved =
       nlohmann::json::parse(ccsrm::ReadTextFile(stopped + "/checkpoint.json"));
@@ -152,13 +169,14 @@ bool KillAfterFirstBatch(const std::string& args, const std::string& stopped, do
                          const std::string& err = "/dev/null") {
   const unsigned seed = std::random_device{}();
   std::mt19937 random(seed);
-  const double delay_s = std::uniform_real_distribution<double>(0.0, 0.5 * whole_s)(random);
+  double delay_s = std::uniform_real_distribution<double>(0.0, 0.5 * whole_s)(random);
+  const std::string journal = stopped + "/runs.journal";
+  const bool killed = KillWhenReady(
+      args, stopped, [&] { return fs::exists(journal) && fs::file_size(journal) > 0; }, &delay_s,
+      why, err);
   *trace = "seed " + std::to_string(seed) + ", killed " + std::to_string(delay_s) +
            " s after the first batch was recorded";
-  const std::string journal = stopped + "/runs.journal";
-  return KillWhenReady(
-      args + stopped, [&] { return fs::exists(journal) && fs::file_size(journal) > 0; }, delay_s,
-      why, err);
+  return killed;
 }
 
 // Runs simulated and taken from the journal, from the closing line of a
