@@ -13,12 +13,13 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/identify/job.h"
 #include "ccsrm/identify/mpi_backend.h"
 #include "ccsrm/identify/sensitivity.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/paper_run.h"
 #include "commands.h"
-#include "fit_inputs.h"
+#include "job_options.h"
 #include "option_checks.h"
 #include "output_kinds.h"
 #include "paper_run.h"
@@ -160,7 +161,8 @@ int RunDerivatives(const DerivativesArgs& a) {
   if (identify::MpiRanks() > 1) {
     experiments.push_back(
         identify::FrameExperiment(Describe(a, run), run.model, run.inputs, run.simulation));
-    const auto backends = RunBackends({&experiments}, threads, a.run_timeout_s);
+    const auto backends =
+        identify::JobBackends({&experiments}, {threads, a.run_timeout_s}, PrintNow);
     if (backends.empty()) return 0;  // another rank of an MPI job: it served rank 0's runs
     backend = backends[0];
   }

@@ -16,13 +16,13 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/number_text.h"
 #include "ccsrm/identify/design.h"
+#include "ccsrm/identify/job.h"
 #include "ccsrm/identify/mpi_backend.h"
 #include "ccsrm/identify/run_journal.h"
 #include "ccsrm/sim/paper_run.h"
 #include "commands.h"
-#include "fit_inputs.h"
+#include "job_options.h"
 #include "option_checks.h"
-#include "output_kinds.h"
 #include "paper_run.h"
 
 namespace ccsrm::app {
@@ -218,11 +218,12 @@ int RunDesign(const DesignArgs& a) {
     }
     candidates.push_back(std::move(candidate));
   }
-  CheckOut(a.out, DesignFolderOutput(), inputs);
+  CheckOutputPath(a.out, "--out", identify::DesignFolderOutput(), inputs);
   // A design is resumed by running it again over the journal of its runs
   // (as a loop is): it asks for the same runs in the same order.
-  const CheckpointKey key = MakeCheckpointKey("design", ResultOptions(a), inputs);
-  if (a.resume) ReadCheckpoint(a.out, key);  // refuses other data, options or version
+  const identify::CheckpointKey key =
+      identify::MakeCheckpointKey("design", ResultOptions(a), inputs);
+  if (a.resume) identify::ReadCheckpoint(a.out, key);  // refuses other data, options or version
   std::vector<std::string> skipped;
   // The prior: the arm with the case, --params and --set, as a plan's.
   sim::PaperRunOptions prior_run;
@@ -240,9 +241,10 @@ int RunDesign(const DesignArgs& a) {
   identify::CheckDesign(candidates, options);  // before the checkpoint is written
   const std::vector<identify::Experiment> experiments =
       identify::DesignExperiments(candidates, options);
-  const auto backends = RunBackends({&experiments}, options.threads, a.run_timeout_s);
+  const auto backends =
+      identify::JobBackends({&experiments}, {options.threads, a.run_timeout_s}, PrintNow);
   if (backends.empty()) return 0;  // another rank of an MPI job: it served rank 0's runs
-  WriteCheckpoint(a.out, key, {{"runs_journal", "runs.journal"}});
+  identify::WriteCheckpoint(a.out, key, {{"runs_journal", "runs.journal"}});
   const auto journal = std::make_shared<identify::RunJournal>(
       (std::filesystem::path(a.out) / "runs.journal").string(), a.resume);
   if (a.resume) {
@@ -279,7 +281,7 @@ int RunDesign(const DesignArgs& a) {
         identify::PlannedMotionCsv(prior, best->protocol_yaml, best->name, options.frame_rate_hz));
   }
   out.Commit();  // the folder replaced as a whole: the checkpoint and journal go with it
-  RemoveCheckpoint(a.out);
+  identify::RemoveCheckpoint(a.out);
   std::printf("  output: %s/design.json\n", a.out.c_str());
   std::printf("  runs: %lld simulated, %lld taken from the journal of a stopped run\n",
               static_cast<long long>(journal->simulated()),

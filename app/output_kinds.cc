@@ -18,15 +18,6 @@ bool HasSchemaPrefix(const std::string& path, const std::string& prefix) {
   return datasets::ReadSchemaAttribute(path).rfind(prefix, 0) == 0;
 }
 
-// A JSON file `name` inside `folder` whose "schema" is `schema`.
-bool FolderJsonHasSchema(const std::string& folder, const std::string& name,
-                         const std::string& schema) {
-  std::ifstream in(fs::path(folder) / name);
-  if (!in) return false;
-  const nlohmann::json json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  return json.is_object() && json.contains("schema") && json["schema"] == schema;
-}
-
 // A line "schema: X" (or "schema: \"X\"", as OpenCV writes it) at the top
 // level of a YAML file, within its first 64 KiB: our YAML outputs all carry
 // one, and a user's file of another kind does not.
@@ -76,37 +67,6 @@ OutputKind DerivativesJsonOutput() {
             const nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
             return json.is_object() && json.contains("run") && json["run"].is_object() &&
                    json["run"].contains("config");
-          }};
-}
-
-OutputKind FitFolderOutput() {
-  return {"ccsrm fit folder (fit.json, ccsrm-fit/1)", true, [](const std::string& p) {
-            // Or one a stopped fit left its checkpoint in (--resume).
-            return FolderJsonHasSchema(p, "fit.json", "ccsrm-fit/1") ||
-                   FolderJsonHasSchema(p, "checkpoint.json", "ccsrm-checkpoint/1");
-          }};
-}
-
-OutputKind LoopFolderOutput() {
-  return {"ccsrm loop folder (loop.json, ccsrm-loop/1)", true, [](const std::string& p) {
-            // Or one a stopped loop left its checkpoint in (--resume).
-            return FolderJsonHasSchema(p, "loop.json", "ccsrm-loop/1") ||
-                   FolderJsonHasSchema(p, "checkpoint.json", "ccsrm-checkpoint/1");
-          }};
-}
-
-OutputKind PredictionFolderOutput() {
-  return {"ccsrm prediction folder (pred.json, ccsrm-prediction/1)", true,
-          [](const std::string& p) {
-            return FolderJsonHasSchema(p, "pred.json", "ccsrm-prediction/1");
-          }};
-}
-
-OutputKind DesignFolderOutput() {
-  return {"ccsrm design folder (design.json, ccsrm-design/1)", true, [](const std::string& p) {
-            // Or one a stopped design left its checkpoint in (--resume).
-            return FolderJsonHasSchema(p, "design.json", "ccsrm-design/1") ||
-                   FolderJsonHasSchema(p, "checkpoint.json", "ccsrm-checkpoint/1");
           }};
 }
 

@@ -1,5 +1,6 @@
 #pragma once
-// The kinds of output the ccsrm commands write, for the one output policy
+// The kinds of output the ccsrm commands write (the jobs' folders are
+// identify/job.h's), for the one output policy
 // (common/output_policy.h, docs/conventions.md "Outputs"): each says how an
 // earlier output of its kind is recognised, so that a command replaces its
 // own outputs and refuses to replace anything else.
@@ -16,12 +17,8 @@ OutputKind C3dFileOutput();         // mocap export, cameras reconstruct
 // A YAML file whose top level has `schema: <schema>` (rigid bodies, camera
 // files, the truth of generate).
 OutputKind YamlFileOutput(const std::string& schema, const std::string& description);
-OutputKind CameraFileOutput();        // cameras rig, calibrate: ccsrm-cameras/1
-OutputKind DerivativesJsonOutput();   // derivatives --json
-OutputKind FitFolderOutput();         // identify: fit.json, schema ccsrm-fit/1
-OutputKind LoopFolderOutput();        // loop: loop.json, schema ccsrm-loop/1
-OutputKind PredictionFolderOutput();  // predict: pred.json, schema ccsrm-prediction/1
-OutputKind DesignFolderOutput();      // design: design.json, schema ccsrm-design/1
+OutputKind CameraFileOutput();       // cameras rig, calibrate: ccsrm-cameras/1
+OutputKind DerivativesJsonOutput();  // derivatives --json
 // cameras render: cameras.yaml (ccsrm-cameras/1) with its videos.
 OutputKind RenderFolderOutput();
 // cameras render-board: the checkerboard images (PNG files only).

@@ -119,14 +119,14 @@ void ApplyParameterFile(const std::string& yaml_text, const std::string& file,
 }
 
 void ApplyFitParameters(const std::vector<std::string>* free, const std::string& params_path,
-                        const std::vector<std::string>& sets, IdentificationOptions* options) {
+                        const std::vector<std::pair<std::string, double>>& values,
+                        IdentificationOptions* options) {
   if (free != nullptr) options->free_parameters = *free;
   for (const std::string& name : options->free_parameters) sim::FindParameter(name, "--free");
   if (!params_path.empty()) {
     ApplyParameterFile(ReadTextFile(params_path), params_path, options);
   }
-  for (const std::string& text : sets) {
-    const auto [name, value] = sim::ParseParameterAssignment(text, "--set");
+  for (const auto& [name, value] : values) {
     const std::string problem =
         sim::ParameterValueProblem(sim::FindParameter(name, "--set"), value);
     if (!problem.empty()) ThrowInputError("--set", "", problem);

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <utility>
 
+#include "ccsrm/common/digest.h"
 #include "ccsrm/common/error.h"
 #include "run_codec.h"
 
@@ -13,15 +14,11 @@ namespace ccsrm::identify {
 
 namespace {
 
-// 64-bit FNV-1a of a record's bytes: a record cut short, or written over,
-// does not pass.
+// A record cut short, or written over, does not pass its checksum.
 std::uint64_t Checksum(const std::vector<char>& bytes) {
-  std::uint64_t h = 14695981039346656037ULL;
-  for (const char c : bytes) {
-    h ^= static_cast<unsigned char>(c);
-    h *= 1099511628211ULL;
-  }
-  return h;
+  Fnv1aDigest digest;
+  digest.Add(bytes.data(), bytes.size());
+  return digest.value();
 }
 
 struct Record {

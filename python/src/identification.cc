@@ -14,7 +14,9 @@
 #include "ccsrm/common/name_list.h"
 #include "ccsrm/identify/experiment.h"
 #include "ccsrm/identify/identification.h"
+#include "ccsrm/identify/job.h"
 #include "ccsrm/identify/loop.h"
+#include "ccsrm/sim/parameters.h"
 
 namespace ccsrm::python {
 namespace {
@@ -32,21 +34,34 @@ std::vector<std::string> Names(const py::object& names, const std::string& optio
   return names.cast<std::vector<std::string>>();
 }
 
-// Values as --set takes them ("name=value"), from a dict or from strings.
-std::vector<std::string> Assignments(const py::object& values) {
-  if (values.is_none()) return {};
+// Values by name, from a dict of numbers or from "name=value" strings as
+// --set takes them.
+std::vector<std::pair<std::string, double>> Values(const py::object& values) {
+  std::vector<std::pair<std::string, double>> out;
+  if (values.is_none()) return out;
   if (py::isinstance<py::dict>(values)) {
-    std::vector<std::string> out;
     for (const auto& [name, value] : values.cast<py::dict>()) {
-      // repr of a float is the shortest text that reads back to the same
-      // double, so the value reaches the fit unchanged.
-      out.push_back(name.cast<std::string>() + "=" +
-                    py::repr(py::float_(value.cast<double>())).cast<std::string>());
+      out.emplace_back(name.cast<std::string>(), value.cast<double>());
     }
     return out;
   }
-  return values.cast<std::vector<std::string>>();
+  for (const std::string& text : values.cast<std::vector<std::string>>()) {
+    out.push_back(sim::ParseParameterAssignment(text, "--set"));
+  }
+  return out;
 }
+
+// The fit's parameters as the jobs take them.
+identify::FitParameterChoice Parameters(const py::object& free, const py::object& params,
+                                        const py::object& set) {
+  identify::FitParameterChoice choice;
+  if (!free.is_none()) choice.free = Names(free, "--free");
+  if (!params.is_none()) choice.params_path = PathString(params);
+  choice.values = Values(set);
+  return choice;
+}
+
+std::string OptionalPath(const py::object& path) { return path.is_none() ? "" : PathString(path); }
 
 // Calls a Python function from the fit's own thread (the GIL is released
 // around the fit): the iteration's figures as a dict, or the loop's progress
@@ -108,54 +123,37 @@ std::vector<std::string> Paths(const py::object& data) {
   return paths;
 }
 
-std::vector<identify::Experiment> LoadAll(const std::vector<std::string>& paths,
-                                          std::optional<double> noise_deg) {
-  identify::ExperimentLoadOptions load;
-  if (noise_deg) load.noise_deg = *noise_deg;
-  std::vector<identify::Experiment> experiments;
-  for (const std::string& path : paths) experiments.push_back(identify::LoadExperiment(path, load));
-  return experiments;
-}
-
 std::shared_ptr<Loop> RunLoop(const py::object& data, const py::object& holdout,
                               const py::object& candidates, const py::object& free,
                               const py::object& params, const py::object& set,
-                              std::optional<int> threads, int max_rounds, int max_iterations,
-                              std::optional<double> noise_deg, const py::object& out,
-                              const py::object& progress) {
-  const std::vector<std::string> training_paths = Paths(data);
-  if (training_paths.empty()) ThrowInputError("data", "", "give at least one experiment file");
-  const std::vector<std::string> holdout_paths = Paths(holdout);
-  identify::LoopOptions options;
-  if (threads) options.fit.threads = *threads;
-  options.fit.max_iterations = max_iterations;
-  options.max_rounds = max_rounds;
-  std::optional<std::vector<std::string>> free_names;
-  if (!free.is_none()) free_names = Names(free, "--free");
-  if (!candidates.is_none()) options.candidates = Names(candidates, "--candidates");
-  const std::string params_path = params.is_none() ? "" : PathString(params);
-  const std::vector<std::string> sets = Assignments(set);
-  const std::string out_dir = out.is_none() ? "" : PathString(out);
-
-  auto loop = std::make_shared<Loop>();
+                              const py::object& config, std::optional<int> threads, int max_rounds,
+                              int max_iterations, std::optional<double> noise_deg,
+                              const py::object& out, bool resume, const py::object& progress) {
+  identify::LoopJobOptions job;
+  job.data = Paths(data);
+  job.holdout = Paths(holdout);
+  if (!candidates.is_none()) job.candidates = Names(candidates, "--candidates");
+  job.parameters = Parameters(free, params, set);
+  job.config_path = OptionalPath(config);
+  if (threads) job.runs.threads = *threads;
+  job.max_rounds = max_rounds;
+  job.max_iterations = max_iterations;
+  job.noise_deg = noise_deg;
+  job.out = OptionalPath(out);
+  job.resume = resume;
   ProgressRelay relay(progress);
   if (relay.active()) {
-    options.on_progress = [&relay](const identify::LoopProgress& p) {
+    job.reporting.on_loop_progress = [&relay](const identify::LoopProgress& p) {
       relay.Call([&] { return py::str(p.message); });
     };
   }
+  auto loop = std::make_shared<Loop>();
   {
     py::gil_scoped_release release;
-    // The command's order: options, then every experiment, before any run.
-    identify::ApplyFitParameters(free_names ? &*free_names : nullptr, params_path, sets,
-                                 &options.fit);
-    std::string error;
-    if (!options.IsValid(&error)) ThrowInputError("loop", "", error);
-    loop->training = LoadAll(training_paths, noise_deg);
-    loop->holdout = LoadAll(holdout_paths, noise_deg);
-    loop->summary = identify::CloseLoop(loop->training, loop->holdout, options);
-    if (!out_dir.empty())
-      identify::WriteLoopDirectory(loop->summary, loop->training, loop->holdout, out_dir);
+    identify::LoopJobResult r = identify::RunLoopJob(job);
+    loop->summary = std::move(r.summary);
+    loop->training = std::move(r.training);
+    loop->holdout = std::move(r.holdout);
   }
   relay.RaiseIfFailed();
   return loop;
@@ -165,37 +163,30 @@ std::shared_ptr<Fit> RunIdentify(const py::object& data, const py::object& free,
                                  const py::object& params, const py::object& set,
                                  std::optional<int> threads, int max_iterations,
                                  double relative_step, std::optional<double> noise_deg,
-                                 bool central_throughout, const py::object& out,
+                                 bool central_throughout, const py::object& out, bool resume,
                                  const py::object& progress) {
-  const std::vector<std::string> paths = Paths(data);
-  if (paths.empty()) ThrowInputError("data", "", "give at least one experiment file");
-  identify::IdentificationOptions options;
-  if (threads) options.threads = *threads;
-  options.max_iterations = max_iterations;
-  options.relative_step = relative_step;
-  options.central_differences_throughout = central_throughout;
-  std::optional<std::vector<std::string>> free_names;
-  if (!free.is_none()) free_names = Names(free, "--free");
-  const std::string params_path = params.is_none() ? "" : PathString(params);
-  const std::vector<std::string> sets = Assignments(set);
-  const std::string out_dir = out.is_none() ? "" : PathString(out);
-
-  auto fit = std::make_shared<Fit>();
+  identify::IdentifyJobOptions job;
+  job.data = Paths(data);
+  job.parameters = Parameters(free, params, set);
+  if (threads) job.runs.threads = *threads;
+  job.max_iterations = max_iterations;
+  job.relative_step = relative_step;
+  job.noise_deg = noise_deg;
+  job.central_differences_throughout = central_throughout;
+  job.out = OptionalPath(out);
+  job.resume = resume;
   ProgressRelay relay(progress);
   if (relay.active()) {
-    options.on_iteration = [&relay](const identify::IterationProgress& p) {
+    job.reporting.on_iteration = [&relay](const identify::IterationProgress& p) {
       relay.Call([&] { return IterationDict(p); });
     };
   }
+  auto fit = std::make_shared<Fit>();
   {
     py::gil_scoped_release release;
-    // The command's order: options, then every experiment, before any run.
-    identify::ApplyFitParameters(free_names ? &*free_names : nullptr, params_path, sets, &options);
-    std::string error;
-    if (!options.IsValid(&error)) ThrowInputError("identify", "", error);
-    fit->experiments = LoadAll(paths, noise_deg);
-    fit->summary = identify::Identify(fit->experiments, options);
-    if (!out_dir.empty()) identify::WriteFitDirectory(fit->summary, fit->experiments, out_dir);
+    identify::IdentifyJobResult r = identify::RunIdentifyJob(job);
+    fit->summary = std::move(r.summary);
+    fit->experiments = std::move(r.experiments);
   }
   relay.RaiseIfFailed();
   return fit;
@@ -288,12 +279,14 @@ void AddIdentification(py::module_& m) {
         py::arg("max_iterations") = identify::IdentificationOptions().max_iterations,
         py::arg("relative_step") = identify::IdentificationOptions().relative_step,
         py::arg("noise_deg") = py::none(), py::arg("central_throughout") = false,
-        py::arg("out") = py::none(), py::arg("progress") = py::none(),
+        py::arg("out") = py::none(), py::arg("resume") = false, py::arg("progress") = py::none(),
         "Fits parameters to recorded experiments as `ccsrm identify` does, with its options: "
         "data (one or more ccsrm-dataset/1 files), free (names, a list or 'mu,T_p'; default "
         "SPEC 6's nine), params (a parameter file), set (dict or 'name=value' strings), "
         "threads (default every core), max_iterations, relative_step, noise_deg (default "
-        "estimated), central_throughout, out (also write the fit folder), progress (called "
+        "estimated), central_throughout, out (also write the fit folder, under the command's "
+        "output policy: an earlier fit folder is replaced, anything else refused), resume "
+        "(continue the fit stopped in out from its checkpoint), progress (called "
         "after every iteration with a dict: iteration, cost, rms_deg, step_accepted, "
         "simulations, wall_time_s, values). Returns a Fit. The "
         "GIL is released during the fit.");
@@ -352,16 +345,18 @@ void AddIdentification(py::module_& m) {
 
   m.def("loop", &RunLoop, py::arg("data"), py::kw_only(), py::arg("holdout") = py::none(),
         py::arg("candidates") = py::none(), py::arg("free") = py::none(),
-        py::arg("params") = py::none(), py::arg("set") = py::none(),
+        py::arg("params") = py::none(), py::arg("set") = py::none(), py::arg("config") = py::none(),
         py::arg("threads") = py::none(), py::arg("max_rounds") = identify::LoopOptions().max_rounds,
         py::arg("max_iterations") = identify::IdentificationOptions().max_iterations,
-        py::arg("noise_deg") = py::none(), py::arg("out") = py::none(),
+        py::arg("noise_deg") = py::none(), py::arg("out") = py::none(), py::arg("resume") = false,
         py::arg("progress") = py::none(),
         "Closes the loop as `ccsrm loop` does, with its options: data (training experiments), "
         "holdout (held-out experiments), candidates (effects, a list or 'a,b'; default every "
         "effect that is off), free (the declared model's free parameters; default mu,mu_c,T_p), "
-        "params, set, threads, max_rounds, max_iterations, noise_deg, out (also write the loop "
-        "folder), progress (called with each progress line). Returns a Loop. The GIL is "
+        "params, set, config (the declared arm instead of each recording's own), threads, "
+        "max_rounds, max_iterations, noise_deg, out (also write the loop folder, under the "
+        "command's output policy), resume (run again over the journal of the loop stopped in "
+        "out), progress (called with each progress line). Returns a Loop. The GIL is "
         "released while it runs.");
   m.def("default_threads", &identify::DefaultThreads, "Simulations at a time by default.");
 }

@@ -343,12 +343,13 @@ void ApplyParameterFile(const std::string& yaml_text, const std::string& file,
 // The fit's parameter options as `ccsrm identify` and `ccsrm loop` take
 // them, applied in this order: the free list (when `free` is not null; each
 // name checked), a parameter file (when `params_path` is not empty:
-// ApplyParameterFile), then "name=value" assignments (values; start values
-// of free parameters). Errors name the options --free, --params' file and
-// --set, as every door that takes them (the commands, the Python module).
-// Throws InputError.
+// ApplyParameterFile), then values by name (start values of free
+// parameters; `--set name=value`). Errors name the options --free, --params'
+// file and --set, as every door that takes them (the commands, the Python
+// module). Throws InputError.
 void ApplyFitParameters(const std::vector<std::string>* free, const std::string& params_path,
-                        const std::vector<std::string>& sets, IdentificationOptions* options);
+                        const std::vector<std::pair<std::string, double>>& values,
+                        IdentificationOptions* options);
 
 // fit.json: every number of the summary, SPEC 6 names.
 nlohmann::json ToJson(const IdentificationSummary& summary);

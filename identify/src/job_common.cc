@@ -1,0 +1,179 @@
+// What every job of job.h does alike: its output folder's kind, loading
+// experiments, where the runs go, checkpoints.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "ccsrm/common/atomic_file.h"
+#include "ccsrm/common/digest.h"
+#include "ccsrm/common/error.h"
+#include "ccsrm/common/version.h"
+#include "ccsrm/identify/job.h"
+#include "ccsrm/sim/config.h"
+#include "job_text.h"
+
+namespace ccsrm::identify {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kCheckpointSchema = "ccsrm-checkpoint/1";
+
+// A JSON file `name` inside `folder` whose "schema" is `schema`.
+bool FolderJsonHasSchema(const std::string& folder, const std::string& name,
+                         const std::string& schema) {
+  std::ifstream in(fs::path(folder) / name);
+  if (!in) return false;
+  const nlohmann::json json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  return json.is_object() && json.contains("schema") && json["schema"] == schema;
+}
+
+// The folder of `file` (schema `schema`), or one a stopped job left its
+// checkpoint in (--resume) when `resumable`.
+OutputKind JobFolder(const std::string& description, const std::string& file,
+                     const std::string& schema, bool resumable) {
+  return {description, true, [=](const std::string& p) {
+            return FolderJsonHasSchema(p, file, schema) ||
+                   (resumable && FolderJsonHasSchema(p, "checkpoint.json", kCheckpointSchema));
+          }};
+}
+
+}  // namespace
+
+OutputKind FitFolderOutput() {
+  return JobFolder("ccsrm fit folder (fit.json, ccsrm-fit/1)", "fit.json", "ccsrm-fit/1", true);
+}
+
+OutputKind LoopFolderOutput() {
+  return JobFolder("ccsrm loop folder (loop.json, ccsrm-loop/1)", "loop.json", "ccsrm-loop/1",
+                   true);
+}
+
+OutputKind PredictionFolderOutput() {
+  return JobFolder("ccsrm prediction folder (pred.json, ccsrm-prediction/1)", "pred.json",
+                   "ccsrm-prediction/1", false);
+}
+
+OutputKind DesignFolderOutput() {
+  return JobFolder("ccsrm design folder (design.json, ccsrm-design/1)", "design.json",
+                   "ccsrm-design/1", true);
+}
+
+std::string JoinNames(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& n : names) text += (text.empty() ? "" : ", ") + n;
+  return text;
+}
+
+std::vector<Experiment> LoadExperiments(const std::vector<std::string>& paths,
+                                        std::optional<double> noise_deg, const char* role,
+                                        const std::string& config_path,
+                                        const std::function<void(const std::string&)>& line) {
+  ExperimentLoadOptions load;
+  load.noise_deg = noise_deg;
+  if (!config_path.empty()) {
+    load.config_yaml = ReadTextFile(config_path);
+    load.config_source = config_path;
+    sim::ParseConfig(load.config_yaml, config_path);  // its own errors first, naming it
+  }
+  std::vector<Experiment> experiments;
+  for (const std::string& path : paths) {
+    experiments.push_back(LoadExperiment(path, load));
+    const Experiment& e = experiments.back();
+    if (!line) continue;
+    if (e.angles_from_pipeline) line("mocap " + path + ": " + e.pipeline_report + "\n");
+    double noise = 0.0;
+    for (double s : e.noise_deg) noise += s / static_cast<double>(e.noise_deg.size());
+    line(Format("%s %s (%s): %zu frames, %.4g s, %zu measured angles, noise %.4f deg (%s)%s\n",
+                role, e.name.c_str(), path.c_str(), e.frame_time_s.size(), e.duration_s(),
+                e.measured_samples, noise, e.noise_source.c_str(),
+                e.angles_from_pipeline
+                    ? "; no measured joint angles in the file: computed by the mocap "
+                      "pipeline with default settings"
+                    : ""));
+  }
+  return experiments;
+}
+
+std::vector<std::shared_ptr<SimulationBackend>> JobBackends(
+    const std::vector<const std::vector<Experiment>*>& sets, const JobRuns& runs,
+    const std::function<void(const std::string&)>& line) {
+  MpiOptions mpi;
+  mpi.threads = runs.threads;
+  mpi.run_timeout_s = runs.run_timeout_s;
+  std::vector<std::shared_ptr<SimulationBackend>> backends = ShareRuns(sets, mpi);
+  if (!backends.empty() && MpiRanks() > 1 && line) {
+    line(Format("runs on %d MPI ranks, %d at a time\n", MpiRanks(),
+                backends.front()->parallelism()));
+  }
+  return backends;
+}
+
+CheckpointKey MakeCheckpointKey(const std::string& command, const std::string& options_text,
+                                const std::vector<std::string>& input_files) {
+  Fnv1aDigest digest;
+  for (const std::string& part : {std::string(kVersion), command, options_text}) {
+    digest.Add(part.data(), part.size() + 1);  // with its terminator: parts stay apart
+  }
+  for (const std::string& file : input_files) {
+    if (file.empty()) continue;
+    std::ifstream in(file, std::ios::binary);
+    char buffer[1 << 16];
+    while (in.read(buffer, sizeof(buffer)) || in.gcount() > 0) {
+      digest.Add(buffer, static_cast<std::size_t>(in.gcount()));
+    }
+  }
+  return {command, digest.Hex()};
+}
+
+std::string CheckpointPath(const std::string& out) {
+  return (fs::path(out) / "checkpoint.json").string();
+}
+
+nlohmann::json ReadCheckpoint(const std::string& out, const CheckpointKey& key) {
+  const std::string path = CheckpointPath(out);
+  if (!fs::exists(path)) {
+    ThrowInputError(path, "--resume",
+                    "no checkpoint here: nothing to resume (run without --resume)");
+  }
+  const nlohmann::json json = nlohmann::json::parse(ReadTextFile(path), nullptr, false);
+  if (!json.is_object() || json.value("schema", "") != kCheckpointSchema) {
+    ThrowInputError(path, "schema", std::string("not a ") + kCheckpointSchema + " file");
+  }
+  const std::string refuse = "; refusing to resume (run without --resume to start over)";
+  if (json.value("command", "") != key.command) {
+    ThrowInputError(path, "command",
+                    "the checkpoint is of `ccsrm " + json.value("command", "") + "`" + refuse);
+  }
+  if (json.value("version", "") != kVersion) {
+    ThrowInputError(
+        path, "version",
+        "written by ccsrm " + json.value("version", "") + ", this is " + kVersion + refuse);
+  }
+  if (json.value("inputs_digest", "") != key.digest) {
+    ThrowInputError(path, "inputs_digest",
+                    "the checkpoint is of other data or options (digest " +
+                        json.value("inputs_digest", "") + ", these give " + key.digest + ")" +
+                        refuse);
+  }
+  return json.at("state");
+}
+
+void WriteCheckpoint(const std::string& out, const CheckpointKey& key,
+                     const nlohmann::json& state) {
+  fs::create_directories(out);
+  const nlohmann::json json = {{"schema", kCheckpointSchema},
+                               {"command", key.command},
+                               {"version", kVersion},
+                               {"inputs_digest", key.digest},
+                               {"state", state}};
+  WriteTextFileAtomically(CheckpointPath(out), json.dump() + "\n");
+}
+
+void RemoveCheckpoint(const std::string& out) {
+  std::error_code ignored;
+  fs::remove(CheckpointPath(out), ignored);
+}
+
+}  // namespace ccsrm::identify
