@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "ccsrm/common/error.h"
-#include "ccsrm/identify/sensitivity.h"
+#include "ccsrm/identify/experiment.h"
 #include "ccsrm/mocap/recording.h"
 #include "ccsrm/mocap/signal.h"
 #include "ccsrm/sim_io/experiment_check.h"

@@ -2,9 +2,11 @@
 // The trial points and weights of a second-order finite difference that
 // stays inside a parameter's bounds.
 #include <array>
+#include <nlohmann/json.hpp>
 #include <optional>
 
-#include "ccsrm/identify/sensitivity.h"
+#include "ccsrm/identify/difference.h"
+#include "ccsrm/identify/runs.h"
 #include "ccsrm/sim/parameters.h"
 
 namespace ccsrm::identify::internal {

@@ -15,8 +15,9 @@
 #include <thread>
 
 #include "ccsrm/common/error.h"
+#include "parallel.h"
 #include "run_codec.h"
-#include "run_pool.h"
+#include "run_experiment.h"
 
 #ifdef CCSRM_HAVE_MPI
 #include <mpi.h>

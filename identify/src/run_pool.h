@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "ccsrm/identify/sensitivity.h"
+#include "ccsrm/identify/runs.h"
 #include "ccsrm/identify/simulation_backend.h"
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/parameters.h"
@@ -12,14 +12,6 @@
 #include "ccsrm/sim/simulator.h"
 
 namespace ccsrm::identify::internal {
-
-// Calls task(k) for every k in [0, count) on `threads` threads (the calling
-// thread is one of them), then finished(k, n) under a lock, n counting the
-// tasks done so far. After the first exception no new task starts; it is
-// rethrown once every thread has stopped. Each task must write only its own
-// slot, so results do not depend on the number of threads.
-void ForEachInParallel(std::size_t count, int threads, const std::function<void(std::size_t)>& task,
-                       const std::function<void(std::size_t, std::size_t)>& finished);
 
 struct RunRequest {
   sim::ArmParameters parameters;
@@ -43,9 +35,5 @@ std::vector<RunOutcome> RunAll(const sim::ArmModel& model, const sim::CableInput
                                const sim::SimulationOptions& simulation,
                                const std::vector<RunRequest>& requests, int threads,
                                const ProgressCallback& progress, SimulationBackend* backend);
-
-// One run of a backend's request on experiment e (every backend's runs go
-// through here, so they agree to the bit whichever backend ran them).
-RunResult RunExperiment(const Experiment& e, const identify::RunRequest& request);
 
 }  // namespace ccsrm::identify::internal

@@ -20,7 +20,7 @@
 #include <utility>
 #include <vector>
 
-#include "ccsrm/identify/sensitivity.h"
+#include "ccsrm/identify/runs.h"
 #include "ccsrm/identify/simulation_backend.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"

@@ -15,6 +15,10 @@
 
 namespace ccsrm::identify {
 
+// The noise floor of measured joint angles, RMS per angle [deg]: what
+// identification weights its residuals by (issue 10).
+inline constexpr double kMocapNoiseFloorDeg = 0.03;
+
 struct ExperimentLoadOptions {
   // Measurement noise of every joint angle, standard deviation after
   // processing [deg]: the weight of the residuals. Unset (the default): it is

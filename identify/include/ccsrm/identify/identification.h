@@ -54,7 +54,7 @@
 #include <vector>
 
 #include "ccsrm/identify/experiment.h"
-#include "ccsrm/identify/sensitivity.h"
+#include "ccsrm/identify/runs.h"
 #include "ccsrm/identify/simulation_backend.h"
 #include "ccsrm/sim/parameters.h"
 #include "ccsrm/sim/simulator.h"

@@ -20,7 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "ccsrm/identify/experiment.h"
+#include "ccsrm/identify/difference.h"
+#include "ccsrm/identify/runs.h"
 #include "ccsrm/identify/simulation_backend.h"
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/parameters.h"
@@ -28,26 +29,6 @@
 #include "ccsrm/sim/simulator.h"
 
 namespace ccsrm::identify {
-
-// Reported after every finished run, from the thread that ran it, one call
-// at a time (calls are serialised by a lock).
-struct RunProgress {
-  std::size_t finished = 0;  // runs finished so far, this one included
-  std::size_t total = 0;
-  std::string label;  // which run, e.g. "mu = 0.2121 (step 0.01)"
-  sim::SimulationSummary summary;
-};
-using ProgressCallback = std::function<void(const RunProgress&)>;
-
-// std::thread::hardware_concurrency(), or 1 when it is unknown.
-int DefaultThreads();
-
-// The names of every entry of sim::Parameters(), in table order.
-std::vector<std::string> AllParameterNames();
-
-// The noise floor of measured joint angles, RMS per angle [deg]: what
-// identification weights its residuals by (issue 10).
-inline constexpr double kMocapNoiseFloorDeg = 0.03;
 
 struct DerivativeCheckOptions {
   // Parameters to differentiate, by their SPEC 6 names. Default: all of
@@ -97,15 +78,6 @@ struct DerivativeCheckOptions {
   // negligible_change_deg < 0.
   bool IsValid(std::string* error) const;
 };
-
-// How a derivative is formed from the base run f(p) and two trial runs.
-// All three are second-order accurate, so steps of either kind compare.
-enum class DifferenceScheme {
-  kCentral,   // trials p - h, p + h:   (f(p+h) - f(p-h)) / 2h
-  kForward,   // trials p + h, p + 2h:  (-3 f(p) + 4 f(p+h) - f(p+2h)) / 2h
-  kBackward,  // trials p - h, p - 2h:  (3 f(p) - 4 f(p-h) + f(p-2h)) / 2h
-};
-const char* SchemeName(DifferenceScheme scheme);  // "central", "forward", "backward"
 
 struct TrialRun {
   double value = 0.0;  // the parameter's value in this run
@@ -254,23 +226,6 @@ struct SweepSummary {
 SweepSummary ParameterSweep(const sim::ArmModel& model, const sim::ArmParameters& base,
                             const sim::CableInputs& inputs,
                             const sim::SimulationOptions& simulation, const SweepOptions& options);
-
-// The sampled angles of a trajectory [deg], in the order above.
-std::vector<double> SampledJointAnglesDeg(const sim::Trajectory& trajectory);
-
-// The run (model, inputs, simulation) of a DerivativeCheck or a
-// ParameterSweep as a backend's experiment, so that its runs can go to the
-// ranks of an MPI job: simulated for simulation.duration_s, sampled at
-// simulation.sample_times (empty: the solver's output grid) with
-// simulation.solver, its runs requested every_frame. A backend's run of it
-// calls Simulate with the same options as the thread pool, so it gives the
-// same angles to the bit. `name` stands for the run in messages and in the
-// check that every rank built the same. The experiment refers to model and
-// inputs without owning them: they must outlive it. Throws InputError for
-// options a backend cannot carry over (cancel, a wall time budget).
-Experiment FrameExperiment(const std::string& name, const sim::ArmModel& model,
-                           const sim::CableInputs& inputs,
-                           const sim::SimulationOptions& simulation);
 
 // The residuals of a least-squares cubic in x fitted to each column of y
 // (row k holds the values at x[k]). The fit is made in x mapped to [-1, 1],
