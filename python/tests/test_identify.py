@@ -94,3 +94,37 @@ def test_bad_loop_options(experiment):
     with pytest.raises(ccsrm.InputError) as e:
         ccsrm.loop(experiment, candidates="table_tilt,no_such_effect", free="T_p")
     assert "no_such_effect" in str(e.value)
+
+
+def test_out_goes_through_the_commands_output_policy(experiment, tmp_path):
+    # A folder of the user's is not an earlier fit: refused before any run,
+    # and left as it was (the command line refuses it alike).
+    user = tmp_path / "thesis"
+    user.mkdir()
+    (user / "notes.txt").write_text("mine")
+    with pytest.raises(ccsrm.InputError) as e:
+        ccsrm.identify(experiment, free="T_p", max_iterations=1, out=user)
+    assert str(user) in str(e.value) and "--out" in str(e.value)
+    assert (user / "notes.txt").read_text() == "mine"
+    with pytest.raises(ccsrm.InputError):
+        ccsrm.loop(experiment, free="T_p", max_rounds=1, out=user)
+    assert sorted(p.name for p in user.iterdir()) == ["notes.txt"]
+
+
+def test_resume_needs_a_stopped_fit_and_the_loop_takes_a_config(experiment, tmp_path):
+    # The job's resume: nothing to resume in a folder without a checkpoint.
+    with pytest.raises(ccsrm.InputError) as e:
+        ccsrm.identify(experiment, free="T_p", out=tmp_path / "fresh", resume=True)
+    assert "no checkpoint here" in str(e.value)
+    with pytest.raises(ccsrm.InputError) as e:
+        ccsrm.identify(experiment, free="T_p", resume=True)
+    assert "--resume" in str(e.value)
+    # config= is the command's --config: a file of another arm is refused,
+    # naming the experiment.
+    from conftest import SOURCE_DIR
+    other = SOURCE_DIR / "configs" / "three-segment.yaml"
+    if not other.exists():
+        pytest.skip(f"{other} not found")
+    with pytest.raises(ccsrm.InputError) as e:
+        ccsrm.loop(experiment, free="T_p", config=other, max_rounds=1)
+    assert "describes an arm of" in str(e.value)
