@@ -292,6 +292,7 @@ def identify(
     noise_deg: float | None = None,
     central_throughout: bool = False,
     out: _Path | None = None,
+    resume: bool = False,
     progress: Callable[[dict], object] | None = None,
 ) -> Fit: ...
 class Loop:
@@ -328,11 +329,13 @@ def loop(
     free: str | Sequence[str] | None = None,
     params: _Path | None = None,
     set: Mapping[str, float] | Sequence[str] | None = None,
+    config: _Path | None = None,
     threads: int | None = None,
     max_rounds: int = 3,
     max_iterations: int = 30,
     noise_deg: float | None = None,
     out: _Path | None = None,
+    resume: bool = False,
     progress: Callable[[str], object] | None = None,
 ) -> Loop: ...
 def default_threads() -> int: ...
