@@ -13,6 +13,7 @@
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/name_list.h"
 #include "ccsrm/identify/job.h"
 #include "ccsrm/identify/mpi_backend.h"
 #include "ccsrm/identify/sensitivity.h"
@@ -126,9 +127,9 @@ int RunDerivatives(const DerivativesArgs& a) {
     sweep_options.progress = Progress(a.quiet);
     if (!sweep_options.IsValid(&error)) ThrowOptionError(error);
   } else {
-    if (a.parameters) check.parameters = SplitList(*a.parameters, "--parameters");
+    if (a.parameters) check.parameters = SplitNameList(*a.parameters, "--parameters");
     check.relative_steps.clear();
-    for (const std::string& s : SplitList(a.steps, "--steps")) {
+    for (const std::string& s : SplitNameList(a.steps, "--steps")) {
       check.relative_steps.push_back(ParseNumber(s, "--steps"));
     }
     check.threads = threads;

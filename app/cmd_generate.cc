@@ -221,7 +221,7 @@ int RunGenerate(const GenerateArgs& a) {
   const std::string truth_h5_path = stem + ".truth.h5";
   // Check the output paths before spending minutes on the run.
   const std::vector<std::string> inputs = {a.run.config_path, a.run.params_path, a.effects_path,
-                                           ProtocolFileOf(a.run.protocol_path),
+                                           sim::ProtocolFileOf(a.run.protocol_path),
                                            a.motion.inputs_path};
   CheckOut(a.out, ExperimentFileOutput(), inputs);
   CheckOut(truth_yaml_path, YamlFileOutput("ccsrm-truth/1", "ccsrm truth file"), inputs);
@@ -292,7 +292,7 @@ int RunGenerate(const GenerateArgs& a) {
   // Wall time is the one thing a rerun changes: keep it out of the truth file
   // so that the same seed gives the same files (it is printed below).
   datasets::RunFile truth_run = sim_io::ToRunFile(
-      run.model, result, {case_name, sim::ToYaml(truth), ProtocolYamlOf(run), run.inputs_source});
+      run.model, result, {case_name, sim::ToYaml(truth), sim::ProtocolYamlOf(run), run.inputs_source});
   const double wall_time_s = truth_run.wall_time_s;
   truth_run.wall_time_s = 0.0;
 
@@ -328,7 +328,7 @@ int RunGenerate(const GenerateArgs& a) {
     }
   }
 
-  generated.experiment.protocol_yaml = ProtocolYamlOf(run);
+  generated.experiment.protocol_yaml = sim::ProtocolYamlOf(run);
   generated.experiment.inputs_file = run.inputs_source;
   datasets::WriteExperimentFile(a.out, generated.experiment);
   datasets::WriteRunFile(truth_h5_path, generated.truth);

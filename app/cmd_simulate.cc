@@ -30,7 +30,7 @@ struct SimulateArgs {
 int RunSimulate(const SimulateArgs& a) {
   // Check the output path before spending minutes on the run.
   CheckOut(a.out, RunFileOutput(),
-           {a.run.config_path, a.run.params_path, ProtocolFileOf(a.run.protocol_path),
+           {a.run.config_path, a.run.params_path, sim::ProtocolFileOf(a.run.protocol_path),
             a.motion.inputs_path});
   const sim::PaperRun run = PrepareRun(a.run, a.motion);
   PrintConfigWarnings(run.config);

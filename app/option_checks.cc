@@ -5,14 +5,9 @@
 #include <sstream>
 
 #include "ccsrm/common/error.h"
-#include "ccsrm/common/name_list.h"
 #include "ccsrm/common/number_text.h"
 
 namespace ccsrm::app {
-
-std::vector<std::string> SplitList(const std::string& text, const std::string& option) {
-  return SplitNameList(text, option);
-}
 
 double ParseNumber(const std::string& text, const std::string& option) {
   double value = 0.0;

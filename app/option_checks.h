@@ -10,10 +10,6 @@
 
 namespace ccsrm::app {
 
-// "a, b,c" -> {"a", "b", "c"}; throws InputError naming `option` for an
-// empty item or an empty list.
-std::vector<std::string> SplitList(const std::string& text, const std::string& option);
-
 // A finite number, whole text; throws InputError naming `option` otherwise.
 double ParseNumber(const std::string& text, const std::string& option);
 

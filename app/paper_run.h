@@ -29,22 +29,9 @@ struct MotionArgs {
 };
 void AddMotionOptions(CLI::App* command, sim::PaperRunOptions* options, MotionArgs* motion);
 
-// A protocol given as "file.yaml" or "file.yaml@name=value,name=value" (the
-// file's parameters in its units, deg for names ending in _deg): sets
-// options->protocol_path and protocol_parameters, errors blamed on `where`.
-void ApplyProtocolSpec(const std::string& spec, const std::string& where,
-                       sim::PaperRunOptions* options);
-
-// The file of such a protocol spec (what precedes '@').
-std::string ProtocolFileOf(const std::string& spec);
-
-// sim::PreparePaperRun, with --protocol's spec applied (ApplyProtocolSpec)
+// sim::PreparePaperRun, with --protocol's spec applied (sim::ApplyProtocolSpec)
 // and --inputs read first (sim_io::ReadRecordedInputs).
 sim::PaperRun PrepareRun(sim::PaperRunOptions options, const MotionArgs& motion);
-
-// What a run file or experiment records of the motion that drove it:
-// protocol_yaml (the protocol, its parameters as used) or inputs_file.
-std::string ProtocolYamlOf(const sim::PaperRun& run);
 
 // Prints the configuration's warnings (sim::Config::warnings: values far
 // outside the range of such arms) on stderr, "ccsrm: warning: ..." each.

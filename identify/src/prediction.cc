@@ -11,6 +11,7 @@
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/yaml_document.h"
+#include "ccsrm/identify/fit_file.h"
 #include "ccsrm/sim/effects.h"
 #include "statistics.h"
 
@@ -44,57 +45,14 @@ std::string SchemaOf(const json& j) {
 }
 
 // A fit.json (ccsrm-fit/1): every parameter's value, the free ones, the arm.
-PredictionModel ModelFromFit(const json& fit, const std::string& path) {
+PredictionModel ModelFromFit(const FitFile& fit) {
   PredictionModel model;
-  model.source = path;
+  model.source = fit.path;
   model.kind = kFitSchema;
-  if (!fit.contains("parameters") || !fit["parameters"].is_object() || fit["parameters"].empty()) {
-    ThrowInputError(path, "key 'parameters'", "missing or not a mapping of parameter names");
-  }
-  for (const auto& [name, entry] : fit["parameters"].items()) {
-    const std::string at = "key 'parameters." + name + "'";
-    // FindParameter's message names the known parameters.
-    const sim::ParameterInfo& info = sim::FindParameter(name, path + ": " + at);
-    if (!entry.is_object() || !entry.contains("value") || !entry["value"].is_number()) {
-      ThrowInputError(path, at + ".value", "missing or not a number");
-    }
-    const double value = entry["value"].get<double>();
-    const std::string problem = sim::ParameterValueProblem(info, value);
-    if (!problem.empty()) ThrowInputError(path, at + ".value", problem);
-    model.values[name] = value;
-  }
-  if (fit.contains("free") && fit["free"].is_array()) {
-    for (const json& name : fit["free"]) {
-      if (name.is_string()) model.free.push_back(name.get<std::string>());
-    }
-  }
-  // The arm: recorded by fits since issue 25; before, only the number of
-  // joints of the error table tells it.
-  if (fit.contains("arm") && fit["arm"].is_object()) {
-    const json& arm = fit["arm"];
-    if (!arm.contains("joints") || !arm["joints"].is_number_integer() ||
-        !arm.contains("driving_cables") || !arm["driving_cables"].is_number_integer()) {
-      ThrowInputError(path, "key 'arm'", "expected {joints, driving_cables} (integers)");
-    }
-    model.arm = sim::ArmSize{arm["joints"].get<int>(), arm["driving_cables"].get<int>()};
-  } else if (fit.contains("errors") && fit["errors"].is_object() &&
-             fit["errors"].contains("per_joint") && fit["errors"]["per_joint"].is_array()) {
-    model.arm = sim::ArmSize{static_cast<int>(fit["errors"]["per_joint"].size()), 0};
-  }
+  model.values = fit.values;
+  model.free = fit.free;
+  model.arm = fit.arm;
   return model;
-}
-
-PredictionModel LoadFitJson(const std::string& path) {
-  const std::string text = ReadTextFile(path);
-  const std::optional<json> parsed = ParseJsonFile(path, text);
-  if (!parsed) ThrowInputError(path, "", "is not JSON: expected a fit.json (ccsrm-fit/1)");
-  const std::string schema = SchemaOf(*parsed);
-  if (schema != kFitSchema) {
-    ThrowInputError(path, "key 'schema'",
-                    "is '" + schema + "', expected " + kFitSchema +
-                        " (the fit.json of ccsrm identify, or final/fit.json of ccsrm loop)");
-  }
-  return ModelFromFit(*parsed, path);
 }
 
 }  // namespace
@@ -104,9 +62,9 @@ PredictionModel LoadPredictionModel(const std::string& path) {
   if (fs::is_directory(path, ec)) {
     const fs::path folder(path);
     if (fs::is_regular_file(folder / "fit.json", ec))
-      return LoadFitJson((folder / "fit.json").string());
+      return ModelFromFit(ReadFitFile((folder / "fit.json").string()));
     if (fs::is_regular_file(folder / "loop.json", ec)) {
-      return LoadFitJson((folder / "final" / "fit.json").string());
+      return ModelFromFit(ReadFitFile((folder / "final" / "fit.json").string()));
     }
     ThrowInputError(path, "",
                     "is a folder holding neither fit.json (ccsrm identify) nor loop.json (ccsrm "
@@ -117,13 +75,14 @@ PredictionModel LoadPredictionModel(const std::string& path) {
     const std::string schema = SchemaOf(*parsed);
     if (schema == kLoopSchema) {
       // The loop's final model is the fit folder beside its loop.json.
-      return LoadFitJson((fs::path(path).parent_path() / "final" / "fit.json").string());
+      return ModelFromFit(
+          ReadFitFile((fs::path(path).parent_path() / "final" / "fit.json").string()));
     }
     if (schema != kFitSchema) {
       ThrowInputError(path, "key 'schema'",
                       "is '" + schema + "', expected " + kFitSchema + " or " + kLoopSchema);
     }
-    return ModelFromFit(*parsed, path);
+    return ModelFromFit(FitFileFromJson(*parsed, path));
   }
   // A parameter file, read by the one reader of identify's --params.
   IdentificationOptions read;

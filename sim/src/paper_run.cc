@@ -1,10 +1,12 @@
 #include "ccsrm/sim/paper_run.h"
 
+#include <cmath>
 #include <filesystem>
 #include <system_error>
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/common/number_text.h"
 #include "ccsrm/sim/describe.h"
 
 namespace ccsrm::sim {
@@ -156,6 +158,41 @@ PaperRun PreparePaperRun(const PaperRunOptions& o, Config config, const ArmModel
     run.inputs_note = inputs_note;
   }
   return run;
+}
+
+std::string ProtocolFileOf(const std::string& spec) { return spec.substr(0, spec.find('@')); }
+
+void ApplyProtocolSpec(const std::string& spec, const std::string& where,
+                       PaperRunOptions* options) {
+  const std::size_t at = spec.find('@');
+  options->protocol_path = ProtocolFileOf(spec);
+  options->protocol_parameters_source = where;
+  if (options->protocol_path.empty()) ThrowInputError(where, "", "names no protocol file");
+  if (at == std::string::npos) return;
+  std::size_t start = at + 1;
+  while (true) {
+    const std::size_t end = spec.find(',', start);
+    const std::string assignment = spec.substr(start, end == std::string::npos ? end : end - start);
+    const std::size_t eq = assignment.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      ThrowInputError(where, "", "expected name=value after '@', found '" + assignment + "'");
+    }
+    const std::string name = assignment.substr(0, eq);
+    double value = 0.0;
+    const std::string problem = ParseNumberText(assignment.substr(eq + 1), &value);
+    if (!problem.empty()) ThrowInputError(where, name, problem);
+    // Protocol parameters are given in the file's units (deg for _deg).
+    const bool degrees = name.size() > 4 && name.compare(name.size() - 4, 4, "_deg") == 0;
+    options->protocol_parameters[name] = degrees ? value * M_PI / 180.0 : value;
+    if (end == std::string::npos) return;
+    start = end + 1;
+  }
+}
+
+std::string ProtocolYamlOf(const PaperRun& run) {
+  // The default (the paper protocol of the configuration's protocol:
+  // section) is recorded by config_yaml itself, as in every earlier file.
+  return run.protocol && !run.default_protocol ? run.protocol->ToYaml() : std::string();
 }
 
 }  // namespace ccsrm::sim

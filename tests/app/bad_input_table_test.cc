@@ -350,7 +350,7 @@ const std::vector<BadInput>& Rows() {
       // Experiment design (issue 26): its plans and priors, before any run.
       {"overrides",
        "design --free mu,,T_p --plans {d}/proto.yaml --out {d}/design",
-       {"--free", "empty name"}},
+       {"--free", "empty item"}},
       {"overrides",
        "design --free mu --plans {d}/proto.yaml --resume --out {d}/nodesign",
        {"{d}/nodesign/checkpoint.json", "--resume", "no checkpoint"}},  // issue 29

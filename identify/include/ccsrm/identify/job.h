@@ -1,5 +1,5 @@
 #pragma once
-// The jobs of identification (identify, loop, predict) as every door runs
+// The jobs of identification (identify, loop, design, predict) as every door runs
 // them. The command line and the Python module each parse their options,
 // make one call here and print what it returns, so the two cannot drift
 // (STYLE.md, "A job ... is one library function"). A job:
@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "ccsrm/common/output_policy.h"
+#include "ccsrm/identify/design.h"
 #include "ccsrm/identify/experiment.h"
 #include "ccsrm/identify/identification.h"
 #include "ccsrm/identify/loop.h"
@@ -35,8 +36,9 @@ namespace ccsrm::identify {
 // What a job says while it works. Every field may be empty (Python's
 // default: a job says nothing).
 struct JobReporting {
-  // One line for the user (the commands print it on stdout), without '\n':
-  // what was loaded, where the runs go, the summary, what was written.
+  // Text for the user, whole lines each ending in '\n' (the commands print
+  // it on stdout as it comes): what was loaded, where the runs go, the
+  // summary, what was written.
   std::function<void(const std::string&)> line;
   // A fit's iteration, and each finished run (the commands print both).
   std::function<void(const IterationProgress&)> on_iteration;
@@ -127,6 +129,55 @@ struct LoopJobResult {
 };
 
 LoopJobResult RunLoopJob(const LoopJobOptions& options);
+
+// `ccsrm design` (README, docs/design.md).
+struct DesignJobOptions {
+  // The prior, as a paper run takes it (sim::PaperRunOptions): the arm
+  // (empty: the bundled paper.yaml), a paper case (0: friction as
+  // configured), a parameter file (empty: none) and name=value assignments
+  // after it.
+  std::string config_path;
+  int case_number = 0;
+  std::string params_path;
+  std::vector<std::string> sets;
+  // Candidate plans, each protocol specs (sim::ApplyProtocolSpec) joined by
+  // '+', one experiment each. May be empty with `propose`.
+  std::vector<std::string> plans;
+  // Also search `space` (ProposalCandidates) and write the best proposed
+  // motion.
+  bool propose = false;
+  ProposalSpace space;
+  // What is estimated and how the recordings would be made (the free
+  // parameters, noise, prior box, ...); threads, backend and on_run are the
+  // job's (from `runs` and `reporting`).
+  DesignOptions design;
+  // A fit.json of recordings like those planned (RecordingNoiseOf): its
+  // noise and N_eff / N replace design.noise_deg and
+  // effective_sample_fraction. Empty: none.
+  std::string noise_from;
+  JobRuns runs;
+  std::string out;  // the design folder (required)
+  // Run again over the journal of the design stopped in `out`.
+  bool resume = false;
+  JobReporting reporting;
+};
+
+struct DesignJobResult {
+  bool served = false;  // as IdentifyJobResult's
+  DesignSummary summary;
+  std::vector<std::string> skipped;  // proposed points left out, with why
+  std::vector<std::string> written;
+  std::int64_t simulated = 0, replayed = 0;  // as LoopJobResult's
+};
+
+DesignJobResult RunDesignJob(const DesignJobOptions& options);
+
+// The design folder: design.json (ToJson, with the prior's configuration
+// for the report's page) and, when a proposed motion completed, the best as
+// proposed.yaml and proposed.inputs.csv (PlannedMotionCsv). Replaces `out`
+// as a whole. Returns the files written.
+std::vector<std::string> WriteDesignDirectory(const DesignSummary& summary,
+                                              const sim::Config& prior, const std::string& out);
 
 // `ccsrm predict`.
 struct PredictJobOptions {

@@ -81,6 +81,16 @@ struct PaperRun {
   std::string inputs_note;
 };
 
+// The protocol grammar of the command line and of design plans: a protocol
+// given as "file.yaml" or "file.yaml@name=value,name=value" (the file's
+// parameters in its units, deg for names ending in _deg). Sets
+// options->protocol_path and protocol_parameters; errors name `where` (the
+// option and the spec as given). Throws InputError.
+void ApplyProtocolSpec(const std::string& spec, const std::string& where, PaperRunOptions* options);
+
+// The file of such a protocol spec (what precedes '@').
+std::string ProtocolFileOf(const std::string& spec);
+
 // Reads the configuration and builds the run. Throws InputError for a bad
 // file or value.
 PaperRun PreparePaperRun(const PaperRunOptions& options);
@@ -93,6 +103,12 @@ PaperRun PreparePaperRun(const PaperRunOptions& options);
 // module) and must not read the file or rebuild the model for every run.
 PaperRun PreparePaperRun(const PaperRunOptions& options, Config config,
                          const ArmModel* model = nullptr);
+
+// What a run file or experiment records of the motion that drove the run:
+// the protocol as followed (its parameters as used), or empty for the
+// configuration's paper protocol (config_yaml records it) and for recorded
+// inputs (their file is recorded instead).
+std::string ProtocolYamlOf(const PaperRun& run);
 
 // The run in words for any arm, the lines a command prints above the
 // simulation's summary: the case and the file (the paper's case only on the
