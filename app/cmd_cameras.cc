@@ -425,7 +425,7 @@ void AddReconstruct(CLI::App& cameras) {
     inputs.push_back(args->cameras);
     inputs.push_back(args->config);
     inputs.push_back(args->rigid_bodies);
-    CheckOut(args->out, C3dFileOutput(), inputs);
+    CheckOut(args->out, mocap::C3dFileOutput(), inputs);
     const cameras::CameraRig rig = cameras::LoadCameraRig(args->cameras);
     cameras::ReconstructionOptions options;
     const mocap::MarkerLayout layout =

@@ -57,7 +57,7 @@ void RunAssemble(AssembleArgs a) {
   ParseSync(a.sync, &request);
   request.mocap_edges.threshold = a.trigger_threshold;
   request.mocap_edges.rising = a.trigger_polarity == "rising";
-  CheckOut(a.out, ExperimentFileOutput(),
+  CheckOut(a.out, datasets::ExperimentFileOutput(),
            {request.markers, request.actuators, request.actuator_map, request.config,
             request.rigid_bodies, request.static_trial, request.params});
   const mocap::AssembledRecording assembled = mocap::AssembleLabRecording(request);

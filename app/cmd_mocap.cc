@@ -69,7 +69,7 @@ void RunProcess(const ProcessArgs& a) {
   std::vector<std::string> inputs = {a.in,     a.cameras,      a.rigid_bodies,
                                      a.config, a.static_trial, a.inputs};
   inputs.insert(inputs.end(), a.videos.begin(), a.videos.end());
-  CheckOut(a.out, ExperimentFileOutput(), inputs);  // before any work
+  CheckOut(a.out, datasets::ExperimentFileOutput(), inputs);  // before any work
 
   mocap::RecordingRequest request;
   request.in = a.in;
@@ -134,7 +134,7 @@ void RunExport(const ExportArgs& a) {
   std::string extension = fs::path(a.out).extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (extension != ".c3d") ThrowInputError(a.out, "--out", "unsupported format (expected .c3d)");
-  CheckOut(a.out, C3dFileOutput(), {a.in});
+  CheckOut(a.out, mocap::C3dFileOutput(), {a.in});
   mocap::C3dWriteOptions options;
   options.units = a.units;
   std::string error;

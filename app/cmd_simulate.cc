@@ -29,7 +29,7 @@ struct SimulateArgs {
 
 int RunSimulate(const SimulateArgs& a) {
   // Check the output path before spending minutes on the run.
-  CheckOut(a.out, RunFileOutput(),
+  CheckOut(a.out, datasets::RunFileOutput(),
            {a.run.config_path, a.run.params_path, sim::ProtocolFileOf(a.run.protocol_path),
             a.motion.inputs_path});
   const sim::PaperRun run = PrepareRun(a.run, a.motion);

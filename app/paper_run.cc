@@ -91,7 +91,7 @@ void AddMotionOptions(CLI::App* command, sim::PaperRunOptions* args, MotionArgs*
       ->check(Above(0.0, "s"));
 }
 
-sim::PaperRun PrepareRun(sim::PaperRunOptions options, const MotionArgs& motion) {
+sim::PaperRunOptions WithMotion(sim::PaperRunOptions options, const MotionArgs& motion) {
   if (!options.protocol_path.empty()) {
     const std::string spec = options.protocol_path;
     sim::ApplyProtocolSpec(spec, "--protocol '" + spec + "'", &options);
@@ -102,7 +102,11 @@ sim::PaperRun PrepareRun(sim::PaperRunOptions options, const MotionArgs& motion)
     options.recorded_inputs =
         sim_io::ReadRecordedInputs(motion.inputs_path, options.recorded_input_options);
   }
-  return sim::PreparePaperRun(options);
+  return options;
+}
+
+sim::PaperRun PrepareRun(const sim::PaperRunOptions& options, const MotionArgs& motion) {
+  return sim::PreparePaperRun(WithMotion(options, motion));
 }
 
 void PrintConfigWarnings(const sim::Config& config) {

@@ -29,9 +29,13 @@ struct MotionArgs {
 };
 void AddMotionOptions(CLI::App* command, sim::PaperRunOptions* options, MotionArgs* motion);
 
-// sim::PreparePaperRun, with --protocol's spec applied (sim::ApplyProtocolSpec)
-// and --inputs read first (sim_io::ReadRecordedInputs).
-sim::PaperRun PrepareRun(sim::PaperRunOptions options, const MotionArgs& motion);
+// The options with --protocol's spec applied (sim::ApplyProtocolSpec) and
+// --inputs read (sim_io::ReadRecordedInputs): what sim::PreparePaperRun
+// takes.
+sim::PaperRunOptions WithMotion(sim::PaperRunOptions options, const MotionArgs& motion);
+
+// sim::PreparePaperRun(WithMotion(options, motion)).
+sim::PaperRun PrepareRun(const sim::PaperRunOptions& options, const MotionArgs& motion);
 
 // Prints the configuration's warnings (sim::Config::warnings: values far
 // outside the range of such arms) on stderr, "ccsrm: warning: ..." each.

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -46,6 +47,20 @@ std::vector<std::string> RegisteredTemporaries() {
 
 namespace {
 namespace fs = std::filesystem;
+
+// A line "schema: X" (or "schema: \"X\"", as OpenCV writes it) at the top
+// level of a YAML file, within its first 64 KiB.
+bool YamlHasSchema(const std::string& path, const std::string& schema) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  std::size_t read = 0;
+  while (read < 65536 && std::getline(in, line)) {
+    read += line.size() + 1;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line == "schema: " + schema || line == "schema: \"" + schema + "\"") return true;
+  }
+  return false;
+}
 
 // "report/" and "report" name the same path.
 fs::path Normalised(const std::string& path) {
@@ -173,6 +188,11 @@ void RemoveTemporariesOnInterrupt() {
       ::_exit(128 + signal_number);
     }).detach();
   });
+}
+
+OutputKind YamlFileOutput(const std::string& schema, const std::string& description) {
+  return {description + " (" + schema + ")", false,
+          [schema](const std::string& p) { return YamlHasSchema(p, schema); }};
 }
 
 }  // namespace ccsrm

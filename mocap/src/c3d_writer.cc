@@ -362,4 +362,13 @@ void WriteC3d(const std::string& path, const C3dRecording& recording,
   out.Commit();
 }
 
+OutputKind C3dFileOutput() {
+  return {"C3D file", false, [](const std::string& p) {
+            // Every C3D file's second byte is 0x50 (the header's key word).
+            std::ifstream in(p, std::ios::binary);
+            char header[2] = {0, 0};
+            return static_cast<bool>(in.read(header, 2)) && header[1] == 0x50;
+          }};
+}
+
 }  // namespace ccsrm::mocap

@@ -29,6 +29,7 @@ from ._core import (  # noqa: F401  (the public API)
     bundled_config,
     default_threads,
     effects,
+    generate,
     identify,
     load_config,
     loop,

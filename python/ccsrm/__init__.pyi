@@ -1,7 +1,7 @@
 # Type stubs of the ccsrm package (the _core extension), for editors and
 # type checkers. The docstrings are in the module itself (help(ccsrm.simulate)).
 import os
-from typing import Callable, Iterator, Mapping, Sequence
+from typing import Any, Callable, Iterator, Mapping, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -270,6 +270,21 @@ def simulate(
     output_rate: float | None = None,
     max_input_gap: float = 0.1,
 ) -> Run: ...
+def generate(
+    out: _Path,
+    config: _Path | None = None,
+    *,
+    case: int | None = None,
+    protocol: _Path | None = None,
+    params: Mapping[str, float] = ...,
+    effects: Sequence[str] = ...,
+    duration: float | None = None,
+    amplitude_deg: float | None = None,
+    noise_mm: float = 0.2,
+    resolution_mm: float = 0.0,
+    seed: int = 1,
+    occlusions: bool = True,
+) -> dict[str, Any]: ...
 def read_run_file(path: _Path) -> Run: ...
 def read_dataset(path: _Path) -> Dataset: ...
 def read_markers(path: _Path) -> MarkerTable: ...

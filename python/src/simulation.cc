@@ -5,14 +5,19 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <map>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "bindings.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/datasets/run_file.h"
+#include "ccsrm/mocap/generate.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/effects.h"
 #include "ccsrm/sim/model.h"
@@ -46,7 +51,10 @@ struct Run {
 // step, and is raised once the run has returned.
 class InterruptWatch {
  public:
-  void Attach(sim::SimulationOptions* options) {
+  // `options`: sim::SimulationOptions or mocap::GenerateOptions (their
+  // cancel, progress and progress_interval_s).
+  template <typename Options>
+  void Attach(Options* options) {
     options->cancel = &cancel_;
     options->progress_interval_s = 0.1;  // the longest Ctrl-C waits [s]
     options->progress = [this](const sim::SimulationProgress&) {
@@ -111,7 +119,7 @@ std::shared_ptr<Run> SimulateRun(const Model& model, const py::object& params,
     sim::SetParameter(name, value, "params", &config.parameters);
 
   sim::PaperRunOptions options;
-  if (!protocol.is_none()) options.protocol_path = PathString(protocol);
+  if (!protocol.is_none()) sim::ApplyProtocolSpec(PathString(protocol), "protocol", &options);
   if (duration) options.duration_s = *duration;
   if (amplitude_deg) options.amplitude_deg = *amplitude_deg;
   if (output_rate) options.output_rate_hz = *output_rate;
@@ -163,6 +171,60 @@ std::shared_ptr<Run> SimulateRun(const Model& model, const py::object& params,
   }
   watch.RaiseIfInterrupted();
   return run;
+}
+
+// ccsrm.generate: `ccsrm generate` (mocap::GenerateExperiment), the
+// parameters as values.
+py::dict Generate(const py::object& out, const py::object& config, std::optional<int> case_number,
+                  const py::object& protocol, const std::map<std::string, double>& params,
+                  const std::vector<std::string>& effects, std::optional<double> duration,
+                  std::optional<double> amplitude_deg, double noise_mm, double resolution_mm,
+                  std::uint64_t seed, bool occlusions) {
+  mocap::GenerateOptions options;
+  options.out = PathString(out);
+  options.run.config_path = sim::ConfigPathOrBundled(config.is_none() ? "" : PathString(config));
+  options.run.case_number = case_number.value_or(0);
+  if (!protocol.is_none()) sim::ApplyProtocolSpec(PathString(protocol), "protocol", &options.run);
+  if (duration) options.run.duration_s = *duration;
+  if (amplitude_deg) options.run.amplitude_deg = *amplitude_deg;
+  for (const auto& [name, value] : params) {
+    char text[48];
+    std::snprintf(text, sizeof(text), "=%.17g", value);  // to the last bit
+    options.run.sets.push_back(name + text);
+  }
+  options.effects = effects;
+  options.recording.noise_sigma_m = noise_mm * 1e-3;
+  options.recording.resolution_m = resolution_mm * 1e-3;
+  options.recording.seed = seed;
+  options.recording.occlusions.enabled = occlusions;
+  InterruptWatch watch;
+  watch.Attach(&options);
+  std::optional<mocap::GeneratedExperiment> generated;
+  {
+    py::gil_scoped_release release;
+    generated.emplace(mocap::GenerateExperiment(options));
+  }
+  watch.RaiseIfInterrupted();
+  const mocap::GeneratedExperiment& g = *generated;
+  if (!g.simulation.completed()) {
+    throw std::runtime_error(std::string("simulation ") +
+                             sim::SimulationStatusName(g.simulation.status) + ": " +
+                             g.simulation.message + " (nothing written)");
+  }
+  py::dict result;
+  result["experiment"] = g.experiment_path;
+  result["truth_yaml"] = g.truth_yaml_path;
+  result["truth_h5"] = g.truth_h5_path;
+  result["description"] = sim::DescribeRun(g.run);
+  result["duration_s"] = g.run.simulation.duration_s;
+  result["frames"] = g.frames;
+  result["markers"] = g.markers;
+  result["marker_gaps"] = g.recording.marker_gaps;
+  result["link_losses"] = g.recording.link_losses;
+  result["hidden_fraction"] = g.recording.hidden_fraction;
+  result["effects"] = g.truth.parameters.EnabledEffects();
+  result["wall_time_s"] = g.wall_time_s;
+  return result;
 }
 
 py::list PerCable(const py::object& self, const Run& run,
@@ -365,6 +427,23 @@ void AddSimulation(py::module_& m) {
         "protocol). sample_times: frame times [s] (default every 1 / output_rate). The GIL is "
         "released while the arm is simulated; Ctrl-C cancels the run and raises "
         "KeyboardInterrupt. A diverged run is returned with its status, not raised.");
+
+  m.def("generate", &Generate, py::arg("out"), py::arg("config") = py::none(), py::kw_only(),
+        py::arg("case") = py::none(), py::arg("protocol") = py::none(),
+        py::arg("params") = std::map<std::string, double>(),
+        py::arg("effects") = std::vector<std::string>(), py::arg("duration") = py::none(),
+        py::arg("amplitude_deg") = py::none(), py::arg("noise_mm") = 0.2,
+        py::arg("resolution_mm") = 0.0, py::arg("seed") = 1, py::arg("occlusions") = true,
+        "Generates a virtual experiment as `ccsrm generate --out OUT` does: the arm of `config` "
+        "(default: the bundled paper.yaml) simulated with the truth (case, params by name, "
+        "effects as 'NAME' or 'NAME:param=value,...'), recorded by virtual motion capture, "
+        "written as OUT (a ccsrm-dataset/1 experiment stating the nominal configuration) with "
+        "OUT's stem .truth.yaml and .truth.h5 beside it. protocol: a ccsrm-protocol/1 file, "
+        "optionally 'file.yaml@name=value,...'. The output policy is the command's: an "
+        "existing file that is not an earlier output of its kind is refused. Returns a dict "
+        "of the paths written and the recording's figures. The GIL is released while the arm "
+        "is simulated; Ctrl-C cancels the run (nothing written) and raises KeyboardInterrupt; "
+        "a run that diverges raises RuntimeError (nothing written).");
 
   m.def(
       "read_run_file",

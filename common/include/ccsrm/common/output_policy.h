@@ -26,6 +26,12 @@ struct OutputKind {
   std::function<bool(const std::string& path)> recognises;
 };
 
+// A YAML file whose top level has the line `schema: <schema>` within its
+// first 64 KiB (every YAML output of ccsrm carries one; a user's file of
+// another kind does not): rigid bodies, camera files, generate's truth.
+// `description` names the kind in messages ("ccsrm truth file").
+OutputKind YamlFileOutput(const std::string& schema, const std::string& description);
+
 // Checks the output `path`, given by `option` (e.g. "--out"), against the
 // policy before the command does any work, and removes the temporaries a
 // killed run left beside it. Throws InputError (one line naming the path and

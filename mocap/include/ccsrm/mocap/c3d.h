@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "ccsrm/common/output_policy.h"
 #include "ccsrm/mocap/marker_table.h"
 
 namespace ccsrm::mocap {
@@ -86,6 +87,11 @@ struct C3dWriteOptions {
 
   bool IsValid(std::string* error) const;
 };
+
+// A C3D file as an output of the one output policy (common/output_policy.h):
+// an earlier C3D file (its header's key byte) is replaced, anything else
+// refused. mocap export, cameras reconstruct, ccsrm.write_c3d.
+OutputKind C3dFileOutput();
 
 // Writes the table as an Intel, float-storage C3D file with no analog data:
 // POINT:USED/SCALE/RATE/DATA_START/FRAMES/UNITS/LABELS (LABELS2, ... beyond
