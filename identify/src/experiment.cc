@@ -6,7 +6,6 @@
 #include <limits>
 
 #include "ccsrm/common/error.h"
-#include "ccsrm/identify/experiment.h"
 #include "ccsrm/mocap/recording.h"
 #include "ccsrm/mocap/signal.h"
 #include "ccsrm/sim_io/experiment_check.h"
@@ -59,56 +58,31 @@ bool ExperimentLoadOptions::IsValid(std::string* error) const {
   return true;
 }
 
-Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::string& path,
-                          const ExperimentLoadOptions& options) {
-  std::string error;
-  if (!options.IsValid(&error)) ThrowInputError(path, "noise", error);
-  if (!options.config_yaml.empty()) {
-    // The configuration given replaces the file's, but not for another arm.
-    const sim::Config given = sim::ParseConfig(options.config_yaml, options.config_source);
-    if (!recorded.config_yaml.empty()) {
-      const sim::Config own =
-          sim::ParseConfig(recorded.config_yaml, path + ": attribute 'config_yaml'");
-      const sim::ArmSize a = own.arm.size(), b = given.arm.size();
-      if (a != b) {
-        ThrowInputError(path, "attribute 'config_yaml'",
-                        "describes an arm of " + std::to_string(a.joints) + " joints and " +
-                            std::to_string(a.cables) + " driving cables, " + options.config_source +
-                            " one of " + std::to_string(b.joints) + " and " +
-                            std::to_string(b.cables));
-      }
+namespace {
+
+// The configuration given for every experiment (parsed once per job), as
+// the arm of `recorded`: refused for a file whose own config_yaml describes
+// another arm.
+sim_io::ExperimentArm GivenArm(const datasets::ExperimentFile& recorded, const std::string& path,
+                               const sim::Config& given) {
+  if (!recorded.config_yaml.empty()) {
+    const sim::Config own =
+        sim::ParseConfig(recorded.config_yaml, path + ": attribute 'config_yaml'");
+    const sim::ArmSize a = own.arm.size(), b = given.arm.size();
+    if (a != b) {
+      ThrowInputError(path, "attribute 'config_yaml'",
+                      "describes an arm of " + std::to_string(a.joints) + " joints and " +
+                          std::to_string(a.cables) + " driving cables, " + given.source_name +
+                          " one of " + std::to_string(b.joints) + " and " +
+                          std::to_string(b.cables));
     }
-    datasets::ExperimentFile replaced = recorded;
-    replaced.config_yaml = options.config_yaml;
-    ExperimentLoadOptions rest = options;
-    rest.config_yaml.clear();
-    return MakeExperiment(replaced, path, rest);
   }
-  // The check of every door (config_yaml, cable columns, the measured
-  // angles' shape and range) before any work. Without measured angles the
-  // mocap pipeline runs, with default settings, and its output is checked
-  // too: its angles follow the rigid bodies, which need not cover the arm.
-  std::optional<sim_io::ExperimentArm> arm = sim_io::CheckExperimentAgainstConfig(recorded, path);
-  std::optional<mocap::ProcessedRecording> processed;
-  if (!recorded.measured_joint_angles) {
-    processed = mocap::AddMeasuredJointAngles(recorded, path);
-    arm = sim_io::CheckExperimentAgainstConfig(processed->experiment, path);
-  }
-  const datasets::ExperimentFile& file = processed ? processed->experiment : recorded;
+  return {given, std::make_shared<const sim::ArmModel>(given.arm)};
+}
 
-  Experiment e;
-  e.path = path;
-  e.name = !file.name.empty() ? file.name : std::filesystem::path(path).stem().string();
-  if (!arm) {
-    ThrowInputError(path, "attribute 'config_yaml'",
-                    "is empty: identification needs the arm's nominal configuration");
-  }
-  e.config = std::move(arm->config);
-  std::shared_ptr<const sim::ArmModel> model = std::move(arm->model);
-  e.joints = model->num_joints();
-
-  // Inputs: the arm is simulated from its own recorded inputs (the check
-  // allows none: a recording without an actuator record).
+// The recorded inputs the arm is simulated from (the check allows none: a
+// recording without an actuator record), from the first sample on.
+void SetInputs(const datasets::ExperimentFile& file, const std::string& path, Experiment* e) {
   const std::size_t n = file.input_time.rows();
   const std::size_t cables = file.input_length_change.shape[1];
   if (cables == 0) {
@@ -120,56 +94,57 @@ Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::s
     ThrowInputError(path, "/input/time",
                     "has " + std::to_string(n) + " sample; the inputs need at least 2");
   }
-  e.start_time_s = file.input_time.at(0);
+  e->start_time_s = file.input_time.at(0);
   Eigen::VectorXd time(static_cast<Eigen::Index>(n));
   Eigen::MatrixXd length(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(cables));
   for (std::size_t i = 0; i < n; ++i) {
-    time[static_cast<Eigen::Index>(i)] = file.input_time.at(i) - e.start_time_s;
+    time[static_cast<Eigen::Index>(i)] = file.input_time.at(i) - e->start_time_s;
     for (std::size_t c = 0; c < cables; ++c) {
       length(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(c)) =
           file.input_length_change.at(i, c);
     }
   }
-  e.inputs = std::make_shared<sim::CableInputs>(std::move(time), std::move(length));
-  e.model = std::move(model);
+  e->inputs = std::make_shared<sim::CableInputs>(std::move(time), std::move(length));
+}
 
-  // Frames: those the simulation can reach, from the first input sample on.
+// The measured frames the simulation can reach (from the first input sample
+// on). Returns the index of the first.
+std::size_t SetMeasuredFrames(const datasets::ExperimentFile& file, const std::string& path,
+                              Experiment* e) {
   CCSRM_CHECK(file.measured_joint_angles.has_value());
-  if (processed) {
-    e.angles_from_pipeline = true;
-    e.pipeline_report = processed->result.summary.BriefReport();
-  }
   const datasets::Array& measured = *file.measured_joint_angles;  // F × J × 2 (checked)
   std::size_t first = 0;
-  while (first < file.mocap_time.rows() && file.mocap_time.at(first) < e.start_time_s) ++first;
+  while (first < file.mocap_time.rows() && file.mocap_time.at(first) < e->start_time_s) ++first;
   const std::size_t frames = file.mocap_time.rows() - first;
   if (frames < 2) {
     ThrowInputError(path, "/mocap/time",
                     "has fewer than 2 frames at or after the first input sample (t = " +
-                        std::to_string(e.start_time_s) + " s): nothing to simulate");
+                        std::to_string(e->start_time_s) + " s): nothing to simulate");
   }
-  e.measured_rad.resize(static_cast<Eigen::Index>(frames), 2 * e.joints);
+  const std::size_t joints = static_cast<std::size_t>(e->joints);
+  e->measured_rad.resize(static_cast<Eigen::Index>(frames), 2 * e->joints);
   for (std::size_t f = 0; f < frames; ++f) {
     const double t = file.mocap_time.at(first + f);
-    e.frame_time_s.push_back(t);
-    e.sample_time_s.push_back(t - e.start_time_s);
-    for (int j = 0; j < e.joints; ++j) {
-      for (int a = 0; a < 2; ++a) {
-        const double v = measured.values[((first + f) * static_cast<std::size_t>(e.joints) +
-                                          static_cast<std::size_t>(j)) *
-                                             2 +
-                                         static_cast<std::size_t>(a)];
-        e.measured_rad(static_cast<Eigen::Index>(f), 2 * j + a) = v;
-        if (std::isfinite(v)) ++e.measured_samples;
+    e->frame_time_s.push_back(t);
+    e->sample_time_s.push_back(t - e->start_time_s);
+    for (std::size_t j = 0; j < joints; ++j) {
+      for (std::size_t a = 0; a < 2; ++a) {
+        const double v = measured.values[((first + f) * joints + j) * 2 + a];
+        e->measured_rad(static_cast<Eigen::Index>(f), static_cast<Eigen::Index>(2 * j + a)) = v;
+        if (std::isfinite(v)) ++e->measured_samples;
       }
     }
   }
-  if (e.measured_samples == 0) {
+  if (e->measured_samples == 0) {
     ThrowInputError(path, "/measured/joint_angles",
-                    "has no finite angle after t = " + std::to_string(e.start_time_s) + " s");
+                    "has no finite angle after t = " + std::to_string(e->start_time_s) + " s");
   }
+  return first;
+}
 
-  // The low-pass the pipeline applied, when the file records it.
+// The low-pass the pipeline applied, when the file records it.
+void SetRecordedLowPass(const datasets::ExperimentFile& file, const std::string& path,
+                        Experiment* e) {
   const auto quality = [&file](const char* name) {
     const auto it = file.mocap_quality.find(name);
     return it != file.mocap_quality.end() && it->second.size() == 1
@@ -177,43 +152,98 @@ Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::s
                : std::numeric_limits<double>::quiet_NaN();
   };
   const double cutoff = quality("filter_cutoff_hz");
-  if (std::isfinite(cutoff) && cutoff > 0.0 && frames >= 2) {
-    Experiment::LowPass low_pass;
-    low_pass.cutoff_hz = cutoff;
-    low_pass.order = static_cast<int>(quality("filter_order"));
-    low_pass.min_run_frames = static_cast<int>(quality("filter_min_run_frames"));
-    low_pass.rate_hz =
-        static_cast<double>(frames - 1) / (e.frame_time_s.back() - e.frame_time_s.front());
-    if (low_pass.order < 1 || low_pass.order > 8 || low_pass.min_run_frames < 2 ||
-        !(cutoff < 0.5 * low_pass.rate_hz)) {
-      ThrowInputError(path, "/mocap/quality/filter_*",
-                      "the recorded low-pass is not a valid filter (order 1..8, cutoff below "
-                      "half the frame rate, minimum run >= 2)");
-    }
-    e.low_pass = low_pass;
+  const std::size_t frames = e->frame_time_s.size();
+  if (!(std::isfinite(cutoff) && cutoff > 0.0 && frames >= 2)) return;
+  Experiment::LowPass low_pass;
+  low_pass.cutoff_hz = cutoff;
+  low_pass.order = static_cast<int>(quality("filter_order"));
+  low_pass.min_run_frames = static_cast<int>(quality("filter_min_run_frames"));
+  low_pass.rate_hz =
+      static_cast<double>(frames - 1) / (e->frame_time_s.back() - e->frame_time_s.front());
+  if (low_pass.order < 1 || low_pass.order > 8 || low_pass.min_run_frames < 2 ||
+      !(cutoff < 0.5 * low_pass.rate_hz)) {
+    ThrowInputError(path, "/mocap/quality/filter_*",
+                    "the recorded low-pass is not a valid filter (order 1..8, cutoff below "
+                    "half the frame rate, minimum run >= 2)");
   }
+  e->low_pass = low_pass;
+}
 
-  // Noise: given, else from the twist scatter, else the floor.
-  e.noise_deg.assign(static_cast<std::size_t>(e.joints), kMocapNoiseFloorDeg);
+// The noise of each joint: given, else from the twist scatter from frame
+// `first` on, else the floor.
+void SetNoise(const datasets::ExperimentFile& file, std::size_t first,
+              const ExperimentLoadOptions& options, Experiment* e) {
+  const std::size_t joints = static_cast<std::size_t>(e->joints);
+  e->noise_deg.assign(joints, kMocapNoiseFloorDeg);
   if (options.noise_deg) {
-    e.noise_deg.assign(static_cast<std::size_t>(e.joints), *options.noise_deg);
-    e.noise_source = "given";
+    e->noise_deg.assign(joints, *options.noise_deg);
+    e->noise_source = "given";
   } else if (file.measured_joint_twist && file.measured_joint_twist->rank() == 2 &&
-             file.measured_joint_twist->shape[1] == static_cast<std::size_t>(e.joints)) {
+             file.measured_joint_twist->shape[1] == joints) {
     const std::vector<double> scatter =
-        TwistScatterDeg(*file.measured_joint_twist, first, e.joints);
+        TwistScatterDeg(*file.measured_joint_twist, first, e->joints);
     bool any = false;
-    for (int j = 0; j < e.joints; ++j) {
-      const double s = scatter[static_cast<std::size_t>(j)];
-      if (std::isfinite(s)) {
-        e.noise_deg[static_cast<std::size_t>(j)] = std::max(s, options.min_noise_deg);
+    for (std::size_t j = 0; j < joints; ++j) {
+      if (std::isfinite(scatter[j])) {
+        e->noise_deg[j] = std::max(scatter[j], options.min_noise_deg);
         any = true;
       }
     }
-    e.noise_source = any ? "joint twist scatter" : "default floor 0.03 deg (too few twist frames)";
+    e->noise_source = any ? "joint twist scatter" : "default floor 0.03 deg (too few twist frames)";
   } else {
-    e.noise_source = "default floor 0.03 deg (no /measured/joint_twist)";
+    e->noise_source = "default floor 0.03 deg (no /measured/joint_twist)";
   }
+}
+
+}  // namespace
+
+Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::string& path,
+                          const ExperimentLoadOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) ThrowInputError(path, "noise", error);
+  // The arm's configuration is parsed once: the given one once per job (it
+  // replaces the file's own), else the file's own here, and the parsed arm
+  // passed on to the checks and the mocap pipeline.
+  std::optional<sim_io::ExperimentArm> given;
+  datasets::ExperimentFile replaced;
+  const datasets::ExperimentFile* input = &recorded;
+  if (options.config) {
+    given = GivenArm(recorded, path, *options.config);
+    replaced = recorded;
+    replaced.config_yaml = options.config->source_yaml;
+    input = &replaced;
+  }
+  // The check of every door (config_yaml, cable columns, the measured
+  // angles' shape and range) before any work. Without measured angles the
+  // mocap pipeline runs, with default settings, and its output is checked
+  // too: its angles follow the rigid bodies, which need not cover the arm.
+  std::optional<sim_io::ExperimentArm> arm =
+      sim_io::CheckExperimentAgainstConfig(*input, path, given ? &*given : nullptr);
+  std::optional<mocap::ProcessedRecording> processed;
+  if (!input->measured_joint_angles) {
+    processed = mocap::AddMeasuredJointAngles(*input, path, {}, arm ? arm->model : nullptr);
+    arm = sim_io::CheckExperimentAgainstConfig(processed->experiment, path, arm ? &*arm : nullptr);
+  }
+  const datasets::ExperimentFile& file = processed ? processed->experiment : *input;
+
+  Experiment e;
+  e.path = path;
+  e.name = !file.name.empty() ? file.name : std::filesystem::path(path).stem().string();
+  if (!arm) {
+    ThrowInputError(path, "attribute 'config_yaml'",
+                    "is empty: identification needs the arm's nominal configuration");
+  }
+  e.config = std::move(arm->config);
+  e.model = std::move(arm->model);
+  e.joints = e.model->num_joints();
+  SetInputs(file, path, &e);
+  const std::size_t first = SetMeasuredFrames(file, path, &e);
+  if (processed) {
+    e.angles_from_pipeline = true;
+    e.pipeline_report = processed->result.summary.BriefReport();
+  }
+  SetRecordedLowPass(file, path, &e);
+  SetNoise(file, first, options, &e);
   return e;
 }
 

@@ -72,11 +72,10 @@ std::vector<Experiment> LoadExperiments(const std::vector<std::string>& paths,
                                         const std::function<void(const std::string&)>& line) {
   ExperimentLoadOptions load;
   load.noise_deg = noise_deg;
-  if (!config_path.empty()) {
-    load.config_yaml = ReadTextFile(config_path);
-    load.config_source = config_path;
-    sim::ParseConfig(load.config_yaml, config_path);  // its own errors first, naming it
-  }
+  // The configuration given is parsed here, once for every experiment (its
+  // own errors first, naming it).
+  if (!config_path.empty())
+    load.config = std::make_shared<const sim::Config>(sim::LoadConfig(config_path));
   std::vector<Experiment> experiments;
   for (const std::string& path : paths) {
     experiments.push_back(LoadExperiment(path, load));

@@ -89,23 +89,29 @@ Recording ReadRecording(const RecordingRequest& request) {
 
 struct ResolvedLayout {
   MarkerLayout layout;
-  std::string config_yaml;               // the text of request.config, when given
-  std::unique_ptr<sim::ArmModel> model;  // from config, else the experiment's config_yaml
-  std::optional<JointChain> chain;       // with the model
+  std::string config_yaml;  // the text of request.config, when given
+  // From config, else the experiment's config_yaml (built by the caller, or
+  // here).
+  std::shared_ptr<const sim::ArmModel> model;
+  std::optional<JointChain> chain;  // with the model
   std::optional<StaticTrialRefinement> static_trial;
 };
 
-// RecordingRequest::rigid_bodies documents the order.
-ResolvedLayout ResolveLayout(const RecordingRequest& request, const Recording& recording) {
+// RecordingRequest::rigid_bodies documents the order. `known_arm`: the arm of
+// the experiment's config_yaml when the caller has built it; else null.
+ResolvedLayout ResolveLayout(const RecordingRequest& request, const Recording& recording,
+                             std::shared_ptr<const sim::ArmModel> known_arm) {
   ResolvedLayout out;
   const datasets::ExperimentFile* experiment =
       recording.from_experiment ? &recording.experiment : nullptr;
   if (!request.config.empty()) {
     out.config_yaml = ReadTextFile(request.config);
     out.model =
-        std::make_unique<sim::ArmModel>(sim::ParseConfig(out.config_yaml, request.config).arm);
+        std::make_shared<sim::ArmModel>(sim::ParseConfig(out.config_yaml, request.config).arm);
+  } else if (known_arm) {
+    out.model = std::move(known_arm);
   } else if (experiment != nullptr && !experiment->config_yaml.empty()) {
-    out.model = std::make_unique<sim::ArmModel>(
+    out.model = std::make_shared<sim::ArmModel>(
         sim::ParseConfig(experiment->config_yaml, recording.source + ": attribute 'config_yaml'")
             .arm);
   }
@@ -161,9 +167,10 @@ void CopyInputs(const std::string& path, const sim::ArmModel* model, const std::
 
 // The pipeline on a recording already read (RecordingRequest: `in` or
 // `reconstruct` have been used to make `recording`).
-ProcessedRecording Process(const RecordingRequest& request, Recording recording) {
+ProcessedRecording Process(const RecordingRequest& request, Recording recording,
+                           std::shared_ptr<const sim::ArmModel> known_arm = nullptr) {
   ProcessedRecording out;
-  ResolvedLayout layout = ResolveLayout(request, recording);
+  ResolvedLayout layout = ResolveLayout(request, recording, std::move(known_arm));
   out.static_trial = std::move(layout.static_trial);
   datasets::ExperimentFile& experiment = recording.experiment;
   if (!request.inputs.empty() &&
@@ -252,7 +259,8 @@ ProcessedRecording ProcessRecording(const RecordingRequest& request) {
 
 ProcessedRecording AddMeasuredJointAngles(const datasets::ExperimentFile& experiment,
                                           const std::string& source,
-                                          const ProcessingOptions& options) {
+                                          const ProcessingOptions& options,
+                                          std::shared_ptr<const sim::ArmModel> arm) {
   const std::string name = source.empty() ? "experiment" : source;
   RecordingRequest request;
   request.in = name;  // names the input; nothing is read
@@ -260,7 +268,7 @@ ProcessedRecording AddMeasuredJointAngles(const datasets::ExperimentFile& experi
   std::string error;
   if (!request.IsValid(&error)) ThrowInputError(name, "", error);
   datasets::ValidateExperimentFile(experiment, name);
-  return Process(request, FromExperiment(experiment, name));
+  return Process(request, FromExperiment(experiment, name), std::move(arm));
 }
 
 }  // namespace ccsrm::mocap

@@ -38,8 +38,8 @@ constexpr const char* kValue = "declared.segment2.hole_circle_radius";
 // configuration (Nominal()), as a lab records its arm.
 std::vector<Experiment> Recordings(const sim::Config& built, std::vector<unsigned> seeds) {
   ExperimentLoadOptions load;
-  load.config_yaml = sim::ToYaml(Nominal());
-  load.config_source = "declared.yaml";
+  load.config = std::make_shared<const sim::Config>(
+      sim::ParseConfig(sim::ToYaml(Nominal()), "declared.yaml"));
   std::vector<Experiment> out;
   for (unsigned seed : seeds) {
     out.push_back(MakeExperiment(Record(built.parameters, kNoiseDeg, seed, built),

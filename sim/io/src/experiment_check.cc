@@ -95,11 +95,17 @@ void CheckInputArrays(const datasets::Array& time, const datasets::Array& length
   }
 }
 
-// The arm of a non-empty config_yaml, and the shapes that depend on it.
-ExperimentArm ParseArm(const datasets::ExperimentFile& experiment, const std::string& file) {
+// The arm of a non-empty config_yaml (`known` when the caller parsed it),
+// and the shapes that depend on it.
+ExperimentArm CheckArm(const datasets::ExperimentFile& experiment, const std::string& file,
+                       const ExperimentArm* known) {
   ExperimentArm arm;
-  arm.config = sim::ParseConfig(experiment.config_yaml, file + ": attribute 'config_yaml'");
-  arm.model = std::make_shared<const sim::ArmModel>(arm.config.arm);
+  if (known != nullptr) {
+    arm = *known;
+  } else {
+    arm.config = sim::ParseConfig(experiment.config_yaml, file + ": attribute 'config_yaml'");
+    arm.model = std::make_shared<const sim::ArmModel>(arm.config.arm);
+  }
   const sim::ArmModel& model = *arm.model;
 
   CheckInputs(experiment, file, &model, "its config_yaml");
@@ -122,7 +128,8 @@ ExperimentArm ParseArm(const datasets::ExperimentFile& experiment, const std::st
 }  // namespace
 
 std::optional<ExperimentArm> CheckExperimentAgainstConfig(
-    const datasets::ExperimentFile& experiment, const std::string& file) {
+    const datasets::ExperimentFile& experiment, const std::string& file,
+    const ExperimentArm* known_arm) {
   // Cheap beside reading the file, and it makes every shape below safe to use
   // for an experiment assembled in memory.
   datasets::ValidateExperimentFile(experiment, file);
@@ -140,7 +147,7 @@ std::optional<ExperimentArm> CheckExperimentAgainstConfig(
   }
   std::optional<ExperimentArm> arm;
   if (!experiment.config_yaml.empty()) {
-    arm = ParseArm(experiment, file);
+    arm = CheckArm(experiment, file, known_arm);
   } else {
     CheckInputs(experiment, file, nullptr, "");
   }

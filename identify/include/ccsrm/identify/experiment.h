@@ -34,13 +34,13 @@ struct ExperimentLoadOptions {
   // others'. Default: a tenth of the 0.03 deg floor.
   double min_noise_deg = 0.003;
   // The arm's nominal configuration to use instead of the file's own
-  // config_yaml (`ccsrm predict --config FILE`, as `ccsrm mocap process
-  // --config` stores one): its YAML text, and the file it came from for
-  // messages. Empty (the default): the file's config_yaml. The experiment is
+  // config_yaml (`ccsrm loop --config FILE`, `ccsrm predict --config FILE`,
+  // as `ccsrm mocap process --config` stores one), parsed once by the caller
+  // for every experiment (sim::LoadConfig; its source_name names it in
+  // messages). Null (the default): the file's config_yaml. The experiment is
   // then checked against this arm, and a file whose own config_yaml
   // describes an arm of other joints or driving cables is refused.
-  std::string config_yaml;
-  std::string config_source;
+  std::shared_ptr<const sim::Config> config;
 
   bool IsValid(std::string* error) const;
 };

@@ -6,6 +6,7 @@
 // and printing; identification calls AddMeasuredJointAngles on an experiment
 // it has read. Each input file is read once.
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -109,9 +110,12 @@ ProcessedRecording ProcessRecording(const RecordingRequest& request);
 // experiment in errors. The same as ProcessRecording with `in` = the
 // experiment's file and `processing` = options. Throws InputError when the
 // experiment does not validate, has neither rigid bodies nor config_yaml, or
-// its markers match none of the layout's.
+// its markers match none of the layout's. `arm`: the arm of its config_yaml
+// when the caller has built it (identification parses the configuration
+// once); null: built here.
 ProcessedRecording AddMeasuredJointAngles(const datasets::ExperimentFile& experiment,
                                           const std::string& source,
-                                          const ProcessingOptions& options = {});
+                                          const ProcessingOptions& options = {},
+                                          std::shared_ptr<const sim::ArmModel> arm = nullptr);
 
 }  // namespace ccsrm::mocap

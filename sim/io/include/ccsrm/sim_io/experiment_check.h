@@ -38,9 +38,13 @@ struct ExperimentArm {
 // `file` names the experiment in messages. Returns the arm, or nullopt when
 // config_yaml is empty (nothing to check the shapes against; a caller that
 // needs the arm says so). Throws InputError "<file>: <path>: <problem>" on
-// the first problem.
+// the first problem. `known_arm`: the arm of config_yaml when the caller
+// has already parsed it (identification parses a configuration once per
+// experiment, or once per job for a --config), used instead of parsing it
+// again; null: parsed here.
 std::optional<ExperimentArm> CheckExperimentAgainstConfig(
-    const datasets::ExperimentFile& experiment, const std::string& file);
+    const datasets::ExperimentFile& experiment, const std::string& file,
+    const ExperimentArm* known_arm = nullptr);
 
 // The one check of recorded cable inputs, at every door they come through
 // (CheckExperimentAgainstConfig for an experiment's own; `ccsrm mocap
