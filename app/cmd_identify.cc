@@ -18,23 +18,15 @@ constexpr int kNotConverged = 4;
 constexpr int kFitFailed = 3;
 
 struct IdentifyArgs : JobArgs {
-  int max_iterations = identify::IdentificationOptions().max_iterations;
   double relative_step = identify::IdentificationOptions().relative_step;
   bool central_throughout = false;
 };
 
 int RunIdentify(const IdentifyArgs& a) {
   identify::IdentifyJobOptions job;
-  job.data = a.data;
-  job.parameters = ParseFitParameters(a);
-  job.max_iterations = a.max_iterations;
+  FillFitJob(a, "", &job);
   job.relative_step = a.relative_step;
   job.central_differences_throughout = a.central_throughout;
-  job.noise_deg = NoiseOption(a.noise_deg);
-  job.runs = {a.threads, a.run_timeout_s};
-  job.out = a.out;
-  job.resume = a.resume;
-  job.reporting = TerminalReporting(a.quiet, "");
   const identify::IdentifyJobResult r = identify::RunIdentifyJob(job);
   if (r.served) return 0;
   switch (r.summary.termination) {

@@ -20,23 +20,15 @@ struct LoopArgs : JobArgs {
   std::optional<std::string> candidates;  // unset: every effect
   std::string config;                     // the declared configuration (default: each file's own)
   int max_rounds = identify::LoopOptions().max_rounds;
-  int max_iterations = identify::IdentificationOptions().max_iterations;
 };
 
 int RunLoop(const LoopArgs& a) {
   identify::LoopJobOptions job;
-  job.data = a.data;
+  FillFitJob(a, "    ", &job);
   job.holdout = a.holdout;
-  job.parameters = ParseFitParameters(a);
   if (a.candidates) job.candidates = SplitNameList(*a.candidates, "--candidates");
   job.config_path = a.config;
   job.max_rounds = a.max_rounds;
-  job.max_iterations = a.max_iterations;
-  job.noise_deg = NoiseOption(a.noise_deg);
-  job.runs = {a.threads, a.run_timeout_s};
-  job.out = a.out;
-  job.resume = a.resume;
-  job.reporting = TerminalReporting(a.quiet, "    ");
   const identify::LoopJobResult r = identify::RunLoopJob(job);
   if (!r.served && r.summary.declared.termination == identify::IdentificationTermination::kFailed) {
     std::fprintf(stderr, "ccsrm: the declared model's fit failed: %s (outputs written)\n",

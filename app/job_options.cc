@@ -28,14 +28,19 @@ void AddFitParameterOptions(CLI::App* command, JobArgs* args) {
                       "applied after --params)");
 }
 
-identify::FitParameterChoice ParseFitParameters(const JobArgs& args) {
-  identify::FitParameterChoice choice;
-  if (args.free) choice.free = SplitNameList(*args.free, "--free");
-  choice.params_path = args.params;
+void FillFitJob(const JobArgs& args, const std::string& indent, identify::FitJobOptions* job) {
+  job->data = args.data;
+  if (args.free) job->parameters.free = SplitNameList(*args.free, "--free");
+  job->parameters.params_path = args.params;
   for (const std::string& text : args.set) {
-    choice.values.push_back(sim::ParseParameterAssignment(text, "--set"));
+    job->parameters.values.push_back(sim::ParseParameterAssignment(text, "--set"));
   }
-  return choice;
+  job->max_iterations = args.max_iterations;
+  job->noise_deg = NoiseOption(args.noise_deg);
+  job->runs = {args.threads, args.run_timeout_s};
+  job->out = args.out;
+  job->resume = args.resume;
+  job->reporting = TerminalReporting(args.quiet, indent);
 }
 
 std::optional<double> NoiseOption(double noise_deg) {

@@ -16,6 +16,7 @@ struct JobArgs {
   std::optional<std::string> free;  // unset: the job's default list
   std::string params;
   std::vector<std::string> set;  // name=value
+  int max_iterations = identify::IdentificationOptions().max_iterations;
   int threads = identify::DefaultThreads();
   double noise_deg = 0.0;  // 0: estimated
   std::string out;
@@ -31,9 +32,12 @@ void AddJobOptions(CLI::App* command, JobArgs* args);
 // --params and --set of the fitting jobs.
 void AddFitParameterOptions(CLI::App* command, JobArgs* args);
 
-// --free, --params and --set as the jobs take them (the list split, each
-// assignment read). Throws InputError naming the option.
-identify::FitParameterChoice ParseFitParameters(const JobArgs& args);
+// The options identify and loop take alike, as their jobs take them: --free,
+// --params and --set read (the list split, each assignment parsed; throws
+// InputError naming the option), --noise-deg (unset when not given), the
+// runs, the folder, --resume and the terminal's reporting (iteration lines
+// indented by `indent`).
+void FillFitJob(const JobArgs& args, const std::string& indent, identify::FitJobOptions* job);
 
 // --noise-deg as the jobs take it (unset: estimated).
 std::optional<double> NoiseOption(double noise_deg);

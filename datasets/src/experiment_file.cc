@@ -261,11 +261,9 @@ ExperimentFile ReadExperimentFile(const std::string& path) {
   experiment.source = ParseSource(reader, reader.ReadStringAttribute("source"));
   experiment.created = reader.ReadStringAttribute("created");
   experiment.config_yaml = reader.ReadStringAttribute("config_yaml");
-  // Optional: files written before protocols were recorded have neither.
-  if (reader.HasRootAttribute("protocol_yaml"))
-    experiment.protocol_yaml = reader.ReadStringAttribute("protocol_yaml");
-  if (reader.HasRootAttribute("inputs_file"))
-    experiment.inputs_file = reader.ReadStringAttribute("inputs_file");
+  // Files written before protocols were recorded have neither.
+  experiment.protocol_yaml = reader.ReadOptionalStringAttribute("protocol_yaml");
+  experiment.inputs_file = reader.ReadOptionalStringAttribute("inputs_file");
   if (reader.HasRootAttribute("clock_alignment")) {
     ClockAlignment a;
     a.method = reader.ReadStringAttribute("clock_alignment");

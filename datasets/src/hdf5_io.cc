@@ -560,6 +560,10 @@ Handle FileReader::OpenRootAttribute(const std::string& name) const {
   return attribute;
 }
 
+std::string FileReader::ReadOptionalStringAttribute(const std::string& name) const {
+  return HasRootAttribute(name) ? ReadStringAttribute(name) : std::string();
+}
+
 std::string FileReader::ReadStringAttribute(const std::string& name) const {
   if (!HasRootAttribute(name)) Fail("attribute '" + name + "'", "missing");
   std::string value;

@@ -129,6 +129,9 @@ class FileReader {
   // Scalar attributes of the root group; a missing attribute throws.
   bool HasRootAttribute(const std::string& name) const;
   std::string ReadStringAttribute(const std::string& name) const;
+  // The same, or "" when the file has no such attribute (one a format
+  // gained later: files written before it have none).
+  std::string ReadOptionalStringAttribute(const std::string& name) const;
   double ReadDoubleAttribute(const std::string& name) const;
   std::int64_t ReadInt64Attribute(const std::string& name) const;
 

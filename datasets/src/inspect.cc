@@ -221,7 +221,7 @@ std::string ReadSchemaAttribute(const std::string& path) {
   try {
     internal::Hdf5Session session;
     const internal::FileReader reader(path);
-    return reader.HasRootAttribute("schema") ? reader.ReadStringAttribute("schema") : "";
+    return reader.ReadOptionalStringAttribute("schema");
   } catch (const InputError&) {
     return "";
   }

@@ -198,11 +198,9 @@ RunFile ReadRunFile(const std::string& path) {
   run.status = ParseStatus(reader, reader.ReadStringAttribute("status"));
   run.status_message = reader.ReadStringAttribute("status_message");
   run.config_yaml = reader.ReadStringAttribute("config_yaml");
-  // Optional: files written before protocols were recorded have neither.
-  if (reader.HasRootAttribute("protocol_yaml"))
-    run.protocol_yaml = reader.ReadStringAttribute("protocol_yaml");
-  if (reader.HasRootAttribute("inputs_file"))
-    run.inputs_file = reader.ReadStringAttribute("inputs_file");
+  // Files written before protocols were recorded have neither.
+  run.protocol_yaml = reader.ReadOptionalStringAttribute("protocol_yaml");
+  run.inputs_file = reader.ReadOptionalStringAttribute("inputs_file");
   run.created = reader.ReadStringAttribute("created");
   run.ccsrm_version = reader.ReadStringAttribute("ccsrm_version");
   run.wall_time_s = reader.ReadDoubleAttribute("wall_time_s");

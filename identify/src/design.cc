@@ -12,6 +12,7 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/identify/identification.h"
 #include "ccsrm/sim/parameters.h"
+#include "text.h"
 
 namespace ccsrm::identify {
 namespace {
@@ -50,12 +51,6 @@ Experiment AsExperiment(const PlannedExperiment& planned, const DesignOptions& o
                                      options.low_pass_min_run_frames, options.frame_rate_hz};
   }
   return e;
-}
-
-std::string Format(const char* format, double value) {
-  char text[64];
-  std::snprintf(text, sizeof(text), format, value);
-  return text;
 }
 
 }  // namespace

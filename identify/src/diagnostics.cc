@@ -145,235 +145,296 @@ std::vector<ProtocolPhase> ProtocolPhases(const Experiment& e) {
   return phases;
 }
 
+namespace {
+
+constexpr int kPlotLags = 20;  // ±20 frames for the cross-correlation plots
+
+// What each frame of an experiment is besides its angles: the input rate of
+// the cable that moves most, its protocol phase, and the time from the
+// middle of its hold (NaN outside holds).
+struct FrameContext {
+  std::vector<double> input_rate;
+  std::vector<int> phase_of;
+  std::vector<double> hold_time;
+};
+
+FrameContext FrameContextOf(const Experiment& x, const std::vector<ProtocolPhase>& phases) {
+  const std::vector<double>& t = x.sample_time_s;
+  const std::size_t frames = t.size();
+  int main_cable = 0;
+  double widest = -1.0;
+  for (int c = 0; c < x.inputs->num_cables(); ++c) {
+    const double w =
+        x.inputs->length_change().col(c).maxCoeff() - x.inputs->length_change().col(c).minCoeff();
+    if (w > widest) widest = w, main_cable = c;
+  }
+  FrameContext out;
+  out.input_rate.resize(frames);
+  for (std::size_t f = 0; f < frames; ++f) out.input_rate[f] = InputRate(x, main_cable, t[f]);
+  out.phase_of.assign(frames, 0);
+  out.hold_time.assign(frames, std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t p = 0; p < phases.size(); ++p) {
+    const ProtocolPhase& ph = phases[p];
+    const double mid = 0.5 * (ph.start_s + ph.end_s);
+    for (std::size_t f = 0; f < frames; ++f) {
+      const double te = t[f] + x.start_time_s;
+      if (te >= ph.start_s - 1e-9 && te <= ph.end_s + 1e-9) {
+        out.phase_of[f] = static_cast<int>(p);
+        if (ph.name.rfind("hold", 0) == 0) out.hold_time[f] = te - mid;
+      }
+    }
+  }
+  return out;
+}
+
+// Lag: the shift of the simulated motion that best matches the measured
+// (within ±max_shift frames), and the share of the residual it removes.
+void DiagnoseLag(const Experiment& x, const Eigen::MatrixXd& sim, ExperimentDiagnostics* ed) {
+  const int max_shift = 50;  // ±0.5 s at 100 Hz, in frames
+  const std::vector<double>& t = x.sample_time_s;
+  const std::size_t frames = t.size();
+  double best = std::numeric_limits<double>::infinity(), at_zero = 0.0;
+  int best_shift = 0;
+  for (int s = -max_shift; s <= max_shift; ++s) {
+    double sq = 0.0;
+    std::size_t n = 0;
+    for (std::size_t f = static_cast<std::size_t>(max_shift);
+         f + static_cast<std::size_t>(max_shift) < frames; ++f) {
+      const std::size_t g = static_cast<std::size_t>(static_cast<long>(f) - s);
+      for (Eigen::Index c = 0; c < sim.cols(); ++c) {
+        const double m = x.measured_rad(static_cast<Eigen::Index>(f), c);
+        const double v = sim(static_cast<Eigen::Index>(g), c);
+        if (!std::isfinite(m) || !std::isfinite(v)) continue;
+        sq += (m - v) * (m - v);
+        ++n;
+      }
+    }
+    if (n == 0) continue;
+    if (s == 0) at_zero = sq;
+    if (sq < best) best = sq, best_shift = s;
+  }
+  const double dt = frames > 1 ? (t.back() - t.front()) / static_cast<double>(frames - 1) : 0.0;
+  ed->lag_s = best_shift * dt;
+  ed->lag_explained = at_zero > 0.0 ? 1.0 - best / at_zero : 0.0;
+}
+
+// Joint j's axis a where both the measured and the simulated angle are
+// finite: residual, angle, heading (the angles summed up to the joint) and
+// the frame's context.
+Series ChannelSeries(const Experiment& x, const Eigen::MatrixXd& sim, int j, int a,
+                     const FrameContext& context) {
+  const Eigen::Index col = 2 * j + a;
+  Series s;
+  for (std::size_t f = 0; f < x.sample_time_s.size(); ++f) {
+    const double m = x.measured_rad(static_cast<Eigen::Index>(f), col);
+    const double v = sim(static_cast<Eigen::Index>(f), col);
+    if (!std::isfinite(m) || !std::isfinite(v)) continue;
+    double heading = 0.0;
+    bool ok = true;
+    for (int k = 0; k <= j; ++k) {
+      const double hk = sim(static_cast<Eigen::Index>(f), 2 * k + a);
+      if (!std::isfinite(hk)) ok = false;
+      heading += hk;
+    }
+    s.time.push_back(x.sample_time_s[f]);
+    s.residual_deg.push_back((m - v) * kDeg);
+    s.angle_deg.push_back(v * kDeg);
+    s.heading_deg.push_back(ok ? heading * kDeg : v * kDeg);
+    s.input_rate.push_back(context.input_rate[f]);
+    s.hold_time.push_back(context.hold_time[f]);
+    s.phase.push_back(context.phase_of[f]);
+  }
+  return s;
+}
+
+// The channel's RMS, mean and whiteness (n >= 3 samples). Returns the sum of
+// squared residuals [deg^2].
+double ChannelStatistics(const Series& s, ChannelDiagnostics* ch) {
+  const std::size_t n = s.residual_deg.size();
+  double sq = 0.0;
+  for (double r : s.residual_deg) sq += r * r;
+  ch->rms_deg = std::sqrt(sq / static_cast<double>(n));
+  ch->mean_deg = Mean(s.residual_deg);
+  ch->autocorrelation = Autocorrelation(s.residual_deg, kMaxLag);
+  ch->whiteness_band = kBand / std::sqrt(static_cast<double>(n));
+  int outside = 0;
+  for (double r : ch->autocorrelation) outside += std::abs(r) > ch->whiteness_band ? 1 : 0;
+  ch->lags_outside_band =
+      ch->autocorrelation.empty() ? 0.0 : outside / static_cast<double>(ch->autocorrelation.size());
+  ch->autocorrelation_time = internal::AutocorrelationTime(s.residual_deg);
+  ch->effective_samples = static_cast<double>(n) / ch->autocorrelation_time;
+  return sq;
+}
+
+// The evidence of one named signal that is not a series (constant, hold
+// drift, hysteresis, lag) in the channel.
+SignalEvidence StructureEvidence(const std::string& name, const Series& s,
+                                 const ExperimentDiagnostics& ed, ChannelDiagnostics* ch) {
+  const std::size_t n = s.residual_deg.size();
+  SignalEvidence ev;
+  ev.signal = name;
+  if (name == "constant") {
+    ev.value = ch->rms_deg > 0.0 ? ch->mean_deg / ch->rms_deg : 0.0;
+    // mean / rms against the mean's standard error sd / sqrt(n_eff).
+    ev.band = kBand / std::sqrt(std::max(ch->effective_samples, 1.0));
+  } else if (name == "hold_drift") {
+    std::vector<double> r, h;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (std::isfinite(s.hold_time[i]))
+        r.push_back(s.residual_deg[i]), h.push_back(s.hold_time[i]);
+    }
+    ev = Correlate(name, r, h, Autocorrelation(r, kMaxLag));
+    ev.signal = name;
+    double hh = 0.0, rh = 0.0;
+    const double mr = Mean(r);
+    for (std::size_t i = 0; i < r.size(); ++i) hh += h[i] * h[i], rh += h[i] * (r[i] - mr);
+    ch->hold_drift_degps = hh > 0.0 ? rh / hh : 0.0;
+  } else if (name == "hysteresis") {
+    double area = 0.0, path = 0.0;
+    for (std::size_t i = 1; i < n; ++i) {
+      const double d = s.angle_deg[i] - s.angle_deg[i - 1];
+      area += 0.5 * (s.residual_deg[i] + s.residual_deg[i - 1]) * d;
+      path += std::abs(d);
+    }
+    ch->hysteresis_deg2 = area;
+    // Over the loop, a residual unrelated to the motion's direction
+    // averages out; the band is that of a correlation with a ±1 signal.
+    ev.value = ch->rms_deg > 0.0 && path > 0.0 ? area / (ch->rms_deg * path) : 0.0;
+    ev.band = kBand / std::sqrt(std::max(ch->effective_samples, 1.0));
+  } else if (name == "lag") {
+    ev.value = ed.lag_explained;
+    // A shift explains part of any residual by chance; count it when it
+    // removes more than the noise can (a chi-square of one degree of
+    // freedom over the channel's independent samples).
+    ev.band = 4.0 / std::max(ch->effective_samples, 1.0);
+  }
+  return ev;
+}
+
+// The channel's cross-correlation with each series signal at ±kPlotLags
+// frames, as a correlation weighted by the channel's residual energy `sq`,
+// added to *curves.
+void AddCrossCorrelation(const std::map<std::string, const std::vector<double>*>& signals,
+                         const Series& s, double mean_deg, double sq,
+                         std::map<std::string, std::vector<double>>* curves) {
+  const std::size_t n = s.residual_deg.size();
+  std::vector<double> num(2 * kPlotLags + 1);
+  for (const auto& [name, sig] : signals) {
+    std::fill(num.begin(), num.end(), 0.0);
+    const double ms = Mean(*sig), mr = mean_deg;
+    for (int k = -kPlotLags; k <= kPlotLags; ++k) {
+      for (std::size_t i = 0; i < n; ++i) {
+        const long jdx = static_cast<long>(i) + k;
+        if (jdx < 0 || jdx >= static_cast<long>(n)) continue;
+        num[static_cast<std::size_t>(k + kPlotLags)] +=
+            (s.residual_deg[i] - mr) * ((*sig)[static_cast<std::size_t>(jdx)] - ms);
+      }
+    }
+    double ss = 0.0;
+    for (double v : *sig) ss += (v - ms) * (v - ms);
+    double rr = 0.0;
+    for (double v : s.residual_deg) rr += (v - mr) * (v - mr);
+    const double norm = ss > 0.0 && rr > 0.0 ? sq / std::sqrt(ss * rr) : 0.0;
+    std::vector<double>& weighted = (*curves)[name];
+    weighted.resize(2 * kPlotLags + 1, 0.0);
+    for (std::size_t k = 0; k < weighted.size(); ++k) weighted[k] += num[k] * norm;
+  }
+}
+
+// The channel's RMS in each protocol phase (NaN where it has no sample).
+void PhaseRms(const Series& s, std::size_t phases, ChannelDiagnostics* ch) {
+  ch->phase_rms_deg.assign(phases, std::numeric_limits<double>::quiet_NaN());
+  std::vector<double> psq(phases, 0.0), pn(phases, 0.0);
+  for (std::size_t i = 0; i < s.residual_deg.size(); ++i) {
+    psq[static_cast<std::size_t>(s.phase[i])] += s.residual_deg[i] * s.residual_deg[i];
+    pn[static_cast<std::size_t>(s.phase[i])] += 1.0;
+  }
+  for (std::size_t p = 0; p < phases; ++p) {
+    if (pn[p] > 0) ch->phase_rms_deg[p] = std::sqrt(psq[p] / pn[p]);
+  }
+}
+
+// Pooled sums per signal: Σ value·energy, Σ energy, Σ effective pairs.
+using EvidencePool = std::map<std::string, std::array<double, 3>>;
+
+// One channel of experiment `e`: its statistics and evidence, pooled and
+// cross-correlated. Returns the sum of squared residuals [deg^2] (0 for a
+// channel of fewer than 3 samples, which is listed without statistics).
+double DiagnoseChannel(const Experiment& x, std::size_t e, const Eigen::MatrixXd& sim, int j, int a,
+                       const FrameContext& context, const ExperimentDiagnostics& ed,
+                       EvidencePool* pool, ResidualDiagnostics* out) {
+  Series s = ChannelSeries(x, sim, j, a, context);
+  ChannelDiagnostics ch;
+  ch.experiment = e;
+  ch.joint = j + 1;
+  ch.axis = a;
+  ch.noise_deg = x.noise_deg[static_cast<std::size_t>(j)];
+  ch.samples = s.residual_deg.size();
+  const std::size_t n = ch.samples;
+  if (n < 3) {
+    out->channels.push_back(ch);
+    return 0.0;
+  }
+  s.rate_degps = Rate(s.time, s.angle_deg);
+  const double sq = ChannelStatistics(s, &ch);
+  double rate_top = 0.0;
+  for (double r : s.rate_degps) rate_top = std::max(rate_top, std::abs(r));
+  std::vector<double> rate_sign(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    rate_sign[i] =
+        std::abs(s.rate_degps[i]) > 0.05 * rate_top ? (s.rate_degps[i] > 0 ? 1.0 : -1.0) : 0.0;
+  }
+  const std::map<std::string, const std::vector<double>*> signals = {
+      {"rate_sign", &rate_sign},   {"rate", &s.rate_degps}, {"angle", &s.angle_deg},
+      {"heading", &s.heading_deg}, {"time", &s.time},       {"input_rate", &s.input_rate}};
+  for (const std::string& name : ResidualSignalNames()) {
+    const auto series = signals.find(name);
+    const SignalEvidence ev =
+        series != signals.end()
+            ? Correlate(name, s.residual_deg, *series->second, ch.autocorrelation)
+            : StructureEvidence(name, s, ed, &ch);
+    ch.evidence.push_back(ev);
+    auto& acc = (*pool)[name];
+    acc[0] += ev.value * sq;
+    acc[1] += sq;
+    const double pairs = ev.band > 0.0 ? std::pow(kBand / ev.band, 2) : 0.0;
+    acc[2] += name == "lag" ? ch.effective_samples : pairs;
+  }
+  AddCrossCorrelation(signals, s, ch.mean_deg, sq, &out->cross_correlation);
+  PhaseRms(s, ed.phases.size(), &ch);
+  out->channels.push_back(std::move(ch));
+  return sq;
+}
+
+}  // namespace
+
 ResidualDiagnostics DiagnoseResidual(const std::vector<Experiment>& experiments,
                                      const std::vector<Eigen::MatrixXd>& simulated_rad) {
   ResidualDiagnostics out;
-  const std::vector<std::string>& names = ResidualSignalNames();
-  // Pooled sums per signal: Σ value·energy, Σ energy, Σ effective pairs.
-  std::map<std::string, std::array<double, 3>> pool;
-  const int max_shift = 50;  // ±0.5 s at 100 Hz, in frames; lags_s below follow the frames
-  std::map<std::string, std::vector<double>> xc_num;
-  std::vector<double> xc_rr;
-  constexpr int kPlotLags = 20;  // ±20 frames for the cross-correlation plots
+  EvidencePool pool;
+  double energy = 0.0;  // Σ squared residuals of the channels with statistics
   double total_sq = 0.0, total_n = 0.0;
-
   for (std::size_t e = 0; e < experiments.size(); ++e) {
     const Experiment& x = experiments[e];
-    const Eigen::MatrixXd& sim = simulated_rad[e];
     ExperimentDiagnostics ed;
     ed.name = x.name;
     ed.phases = ProtocolPhases(x);
     const std::vector<double>& t = x.sample_time_s;
-    const std::size_t frames = t.size();
-    if (e == 0 && frames > 1) {
-      const double dt = (t.back() - t.front()) / static_cast<double>(frames - 1);
+    if (e == 0 && t.size() > 1) {
+      const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
       for (int k = -kPlotLags; k <= kPlotLags; ++k) out.lags_s.push_back(k * dt);
     }
-    // Input rate of the cable that moves most.
-    int main_cable = 0;
-    double widest = -1.0;
-    for (int c = 0; c < x.inputs->num_cables(); ++c) {
-      const double w =
-          x.inputs->length_change().col(c).maxCoeff() - x.inputs->length_change().col(c).minCoeff();
-      if (w > widest) widest = w, main_cable = c;
-    }
-    std::vector<double> input_rate(frames);
-    for (std::size_t f = 0; f < frames; ++f) input_rate[f] = InputRate(x, main_cable, t[f]);
-    // Phase of each frame, and time from the middle of its hold.
-    std::vector<int> phase_of(frames, 0);
-    std::vector<double> hold_time(frames, std::numeric_limits<double>::quiet_NaN());
-    for (std::size_t p = 0; p < ed.phases.size(); ++p) {
-      const ProtocolPhase& ph = ed.phases[p];
-      const double mid = 0.5 * (ph.start_s + ph.end_s);
-      for (std::size_t f = 0; f < frames; ++f) {
-        const double te = t[f] + x.start_time_s;
-        if (te >= ph.start_s - 1e-9 && te <= ph.end_s + 1e-9) {
-          phase_of[f] = static_cast<int>(p);
-          if (ph.name.rfind("hold", 0) == 0) hold_time[f] = te - mid;
-        }
-      }
-    }
-
-    // Lag: shift of the simulated motion that best matches the measured.
-    {
-      double best = std::numeric_limits<double>::infinity(), at_zero = 0.0;
-      int best_shift = 0;
-      for (int s = -max_shift; s <= max_shift; ++s) {
-        double sq = 0.0;
-        std::size_t n = 0;
-        for (std::size_t f = static_cast<std::size_t>(max_shift);
-             f + static_cast<std::size_t>(max_shift) < frames; ++f) {
-          const std::size_t g = static_cast<std::size_t>(static_cast<long>(f) - s);
-          for (Eigen::Index c = 0; c < sim.cols(); ++c) {
-            const double m = x.measured_rad(static_cast<Eigen::Index>(f), c);
-            const double v = sim(static_cast<Eigen::Index>(g), c);
-            if (!std::isfinite(m) || !std::isfinite(v)) continue;
-            sq += (m - v) * (m - v);
-            ++n;
-          }
-        }
-        if (n == 0) continue;
-        if (s == 0) at_zero = sq;
-        if (sq < best) best = sq, best_shift = s;
-      }
-      const double dt = frames > 1 ? (t.back() - t.front()) / static_cast<double>(frames - 1) : 0.0;
-      ed.lag_s = best_shift * dt;
-      ed.lag_explained = at_zero > 0.0 ? 1.0 - best / at_zero : 0.0;
-    }
-
+    const FrameContext context = FrameContextOf(x, ed.phases);
+    DiagnoseLag(x, simulated_rad[e], &ed);
     double exp_sq = 0.0, exp_n = 0.0;
-    const int joints = x.joints;
-    for (int j = 0; j < joints; ++j) {
+    for (int j = 0; j < x.joints; ++j) {
       for (int a = 0; a < 2; ++a) {
-        const Eigen::Index col = 2 * j + a;
-        Series s;
-        for (std::size_t f = 0; f < frames; ++f) {
-          const double m = x.measured_rad(static_cast<Eigen::Index>(f), col);
-          const double v = sim(static_cast<Eigen::Index>(f), col);
-          if (!std::isfinite(m) || !std::isfinite(v)) continue;
-          double heading = 0.0;
-          bool ok = true;
-          for (int k = 0; k <= j; ++k) {
-            const double hk = sim(static_cast<Eigen::Index>(f), 2 * k + a);
-            if (!std::isfinite(hk)) ok = false;
-            heading += hk;
-          }
-          s.time.push_back(t[f]);
-          s.residual_deg.push_back((m - v) * kDeg);
-          s.angle_deg.push_back(v * kDeg);
-          s.heading_deg.push_back(ok ? heading * kDeg : v * kDeg);
-          s.input_rate.push_back(input_rate[f]);
-          s.hold_time.push_back(hold_time[f]);
-          s.phase.push_back(phase_of[f]);
-        }
-        ChannelDiagnostics ch;
-        ch.experiment = e;
-        ch.joint = j + 1;
-        ch.axis = a;
-        ch.noise_deg = x.noise_deg[static_cast<std::size_t>(j)];
-        ch.samples = s.residual_deg.size();
-        const std::size_t n = ch.samples;
-        if (n < 3) {
-          out.channels.push_back(ch);
-          continue;
-        }
-        s.rate_degps = Rate(s.time, s.angle_deg);
-        double sq = 0.0;
-        for (double r : s.residual_deg) sq += r * r;
-        ch.rms_deg = std::sqrt(sq / static_cast<double>(n));
-        ch.mean_deg = Mean(s.residual_deg);
+        const double sq = DiagnoseChannel(x, e, simulated_rad[e], j, a, context, ed, &pool, &out);
+        const ChannelDiagnostics& ch = out.channels.back();
+        if (ch.samples < 3) continue;
+        energy += sq;
         exp_sq += sq;
-        exp_n += static_cast<double>(n);
-        ch.autocorrelation = Autocorrelation(s.residual_deg, kMaxLag);
-        ch.whiteness_band = kBand / std::sqrt(static_cast<double>(n));
-        int outside = 0;
-        for (double r : ch.autocorrelation) outside += std::abs(r) > ch.whiteness_band ? 1 : 0;
-        ch.lags_outside_band = ch.autocorrelation.empty()
-                                   ? 0.0
-                                   : outside / static_cast<double>(ch.autocorrelation.size());
-        ch.autocorrelation_time = internal::AutocorrelationTime(s.residual_deg);
-        ch.effective_samples = static_cast<double>(n) / ch.autocorrelation_time;
-
-        // The signals.
-        double rate_top = 0.0;
-        for (double r : s.rate_degps) rate_top = std::max(rate_top, std::abs(r));
-        std::vector<double> rate_sign(n);
-        for (std::size_t i = 0; i < n; ++i) {
-          rate_sign[i] = std::abs(s.rate_degps[i]) > 0.05 * rate_top
-                             ? (s.rate_degps[i] > 0 ? 1.0 : -1.0)
-                             : 0.0;
-        }
-        std::map<std::string, const std::vector<double>*> signal = {
-            {"rate_sign", &rate_sign},   {"rate", &s.rate_degps}, {"angle", &s.angle_deg},
-            {"heading", &s.heading_deg}, {"time", &s.time},       {"input_rate", &s.input_rate}};
-        for (const std::string& name : names) {
-          SignalEvidence ev;
-          if (signal.count(name)) {
-            ev = Correlate(name, s.residual_deg, *signal[name], ch.autocorrelation);
-          } else if (name == "constant") {
-            ev.signal = name;
-            ev.value = ch.rms_deg > 0.0 ? ch.mean_deg / ch.rms_deg : 0.0;
-            // mean / rms against the mean's standard error sd / sqrt(n_eff).
-            ev.band = kBand / std::sqrt(std::max(ch.effective_samples, 1.0));
-          } else if (name == "hold_drift") {
-            std::vector<double> r, h;
-            for (std::size_t i = 0; i < n; ++i) {
-              if (std::isfinite(s.hold_time[i]))
-                r.push_back(s.residual_deg[i]), h.push_back(s.hold_time[i]);
-            }
-            ev = Correlate(name, r, h, Autocorrelation(r, kMaxLag));
-            ev.signal = name;
-            double hh = 0.0, rh = 0.0;
-            const double mr = Mean(r);
-            for (std::size_t i = 0; i < r.size(); ++i) hh += h[i] * h[i], rh += h[i] * (r[i] - mr);
-            ch.hold_drift_degps = hh > 0.0 ? rh / hh : 0.0;
-          } else if (name == "hysteresis") {
-            ev.signal = name;
-            double area = 0.0, path = 0.0;
-            for (std::size_t i = 1; i < n; ++i) {
-              const double d = s.angle_deg[i] - s.angle_deg[i - 1];
-              area += 0.5 * (s.residual_deg[i] + s.residual_deg[i - 1]) * d;
-              path += std::abs(d);
-            }
-            ch.hysteresis_deg2 = area;
-            // Over the loop, a residual unrelated to the motion's direction
-            // averages out; the band is that of a correlation with a ±1 signal.
-            ev.value = ch.rms_deg > 0.0 && path > 0.0 ? area / (ch.rms_deg * path) : 0.0;
-            ev.band = kBand / std::sqrt(std::max(ch.effective_samples, 1.0));
-          } else if (name == "lag") {
-            ev.signal = name;
-            ev.value = ed.lag_explained;
-            // A shift explains part of any residual by chance; count it when
-            // it removes more than the noise can (a chi-square of one degree
-            // of freedom over the channel's independent samples).
-            ev.band = 4.0 / std::max(ch.effective_samples, 1.0);
-          }
-          ch.evidence.push_back(ev);
-          auto& acc = pool[name];
-          acc[0] += ev.value * sq;
-          acc[1] += sq;
-          const double pairs = ev.band > 0.0 ? std::pow(kBand / ev.band, 2) : 0.0;
-          acc[2] += name == "lag" ? ch.effective_samples : pairs;
-        }
-        // Cross-correlation for the plots (frames shifted; sums over channels).
-        for (const auto& [name, sig] : signal) {
-          std::vector<double>& num = xc_num[name];
-          num.resize(2 * kPlotLags + 1, 0.0);
-          const double ms = Mean(*sig), mr = ch.mean_deg;
-          for (int k = -kPlotLags; k <= kPlotLags; ++k) {
-            for (std::size_t i = 0; i < n; ++i) {
-              const long jdx = static_cast<long>(i) + k;
-              if (jdx < 0 || jdx >= static_cast<long>(n)) continue;
-              num[static_cast<std::size_t>(k + kPlotLags)] +=
-                  (s.residual_deg[i] - mr) * ((*sig)[static_cast<std::size_t>(jdx)] - ms);
-            }
-          }
-          double ss = 0.0;
-          for (double v : *sig) ss += (v - ms) * (v - ms);
-          double rr = 0.0;
-          for (double v : s.residual_deg) rr += (v - mr) * (v - mr);
-          // Normalise each channel's contribution as a correlation, weighted
-          // by its residual energy (added below as num / sqrt(ss rr) * sq).
-          const double norm = ss > 0.0 && rr > 0.0 ? sq / std::sqrt(ss * rr) : 0.0;
-          std::vector<double>& weighted = out.cross_correlation[name];
-          weighted.resize(2 * kPlotLags + 1, 0.0);
-          for (std::size_t k = 0; k < weighted.size(); ++k) {
-            weighted[k] += num[k] * norm;
-            num[k] = 0.0;
-          }
-        }
-        xc_rr.push_back(sq);
-        // Per-phase RMS.
-        ch.phase_rms_deg.assign(ed.phases.size(), std::numeric_limits<double>::quiet_NaN());
-        std::vector<double> psq(ed.phases.size(), 0.0), pn(ed.phases.size(), 0.0);
-        for (std::size_t i = 0; i < n; ++i) {
-          psq[static_cast<std::size_t>(s.phase[i])] += s.residual_deg[i] * s.residual_deg[i];
-          pn[static_cast<std::size_t>(s.phase[i])] += 1.0;
-        }
-        for (std::size_t p = 0; p < psq.size(); ++p) {
-          if (pn[p] > 0) ch.phase_rms_deg[p] = std::sqrt(psq[p] / pn[p]);
-        }
-        out.channels.push_back(std::move(ch));
+        exp_n += static_cast<double>(ch.samples);
       }
     }
     ed.rms_deg = exp_n > 0 ? std::sqrt(exp_sq / exp_n) : 0.0;
@@ -381,12 +442,10 @@ ResidualDiagnostics DiagnoseResidual(const std::vector<Experiment>& experiments,
     total_n += exp_n;
     out.experiments.push_back(ed);
   }
-  double energy = 0.0;
-  for (double v : xc_rr) energy += v;
   for (auto& [name, curve] : out.cross_correlation) {
     for (double& v : curve) v = energy > 0.0 ? v / energy : 0.0;
   }
-  for (const std::string& name : names) {
+  for (const std::string& name : ResidualSignalNames()) {
     const auto& acc = pool[name];
     SignalEvidence ev;
     ev.signal = name;

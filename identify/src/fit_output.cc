@@ -11,16 +11,10 @@
 #include "ccsrm/datasets/run_file.h"
 #include "ccsrm/identify/identification.h"
 #include "ccsrm/sim_io/run_file.h"
+#include "text.h"
 
 namespace ccsrm::identify {
 namespace {
-
-std::string Format(const char* format, double value) {
-  if (!std::isfinite(value)) return "-";
-  char text[64];
-  std::snprintf(text, sizeof(text), format, value);
-  return text;
-}
 
 // JSON has no NaN: unknown numbers are null.
 nlohmann::json Number(double value) {
@@ -65,9 +59,9 @@ std::string IdentificationSummary::BriefReport() const {
                 "identification %s after %d iterations (%lld simulations, %d threads, %.1f s): "
                 "RMS %s -> %s deg, fit %s %%",
                 TerminationName(termination), iterations, static_cast<long long>(simulations),
-                threads, wall_time_s, Format("%.4f", start_errors.rms_deg_overall).c_str(),
-                Format("%.4f", errors.rms_deg_overall).c_str(),
-                Format("%.1f", errors.fit_percent_overall).c_str());
+                threads, wall_time_s, Cell("%.4f", start_errors.rms_deg_overall).c_str(),
+                Cell("%.4f", errors.rms_deg_overall).c_str(),
+                Cell("%.1f", errors.fit_percent_overall).c_str());
   return text;
 }
 
@@ -75,10 +69,10 @@ std::string IdentificationSummary::FullReport() const {
   std::ostringstream out;
   out << BriefReport() << "\n";
   out << "  termination: " << TerminationName(termination) << " (" << message << ")\n";
-  out << "  residuals: " << residuals << " (effective " << Format("%.0f", effective_samples)
-      << "), residual variance " << Format("%.3g", residual_variance)
-      << " (1 = at the measurement noise), cost " << Format("%.6g", initial_cost) << " -> "
-      << Format("%.6g", final_cost) << "\n";
+  out << "  residuals: " << residuals << " (effective " << Cell("%.0f", effective_samples)
+      << "), residual variance " << Cell("%.3g", residual_variance)
+      << " (1 = at the measurement noise), cost " << Cell("%.6g", initial_cost) << " -> "
+      << Cell("%.6g", final_cost) << "\n";
   out << "  finite differences: relative step " << relative_step
       << (central_differences_throughout
               ? ", second order (central, or one-sided inside the bounds) throughout\n\n"
@@ -89,26 +83,26 @@ std::string IdentificationSummary::FullReport() const {
   for (const ParameterEstimate& p : parameters) {
     if (!p.free) continue;
     char line[512];
-    const std::string interval = p.identifiable ? "[" + Format("%.6g", p.ci95_lower) + ", " +
-                                                      Format("%.6g", p.ci95_upper) + "]"
-                                                : "not identifiable";
+    const std::string interval =
+        p.identifiable ? "[" + Cell("%.6g", p.ci95_lower) + ", " + Cell("%.6g", p.ci95_upper) + "]"
+                       : "not identifiable";
     std::snprintf(line, sizeof(line), "  %-14s %-14s %-14s %-14s %-30s %s%s\n", p.name.c_str(),
-                  Format("%.6g", p.start).c_str(), Format("%.6g", p.value).c_str(),
-                  p.identifiable ? Format("%.3g", p.std_error).c_str() : "-", interval.c_str(),
+                  Cell("%.6g", p.start).c_str(), Cell("%.6g", p.value).c_str(),
+                  p.identifiable ? Cell("%.3g", p.std_error).c_str() : "-", interval.c_str(),
                   p.units.c_str(), p.at_bound ? "  (at a bound)" : "");
     out << line;
   }
   if (!covariance_available) out << "  no covariance: " << covariance_message << "\n";
   out << "\n  singular values of the scaled Jacobian:";
-  for (double s : singular_values) out << " " << Format("%.3g", s);
+  for (double s : singular_values) out << " " << Cell("%.3g", s);
   out << "\n";
   if (unidentifiable.empty()) {
     out << "  every free parameter is identifiable from these data\n";
   } else {
     for (const UnidentifiableDirection& d : unidentifiable) {
       out << "  not pinned down by the data: " << d.Describe() << " (singular value "
-          << Format("%.3g", d.singular_value) << ", relative std error "
-          << Format("%.3g", d.relative_std_error) << ")\n";
+          << Cell("%.3g", d.singular_value) << ", relative std error "
+          << Cell("%.3g", d.relative_std_error) << ")\n";
     }
   }
   out << "\n  joint   RMS θx [deg]   RMS θy [deg]   motion θx [deg]  motion θy [deg]  fit θx [%]   "
@@ -117,12 +111,12 @@ std::string IdentificationSummary::FullReport() const {
   for (std::size_t j = 0; j < errors.rms_deg.size(); ++j) {
     char line[256];
     std::snprintf(line, sizeof(line), "  %5zu   %-14s %-14s %-16s %-16s %-12s %s\n", j + 1,
-                  Format("%.4f", errors.rms_deg[j][0]).c_str(),
-                  Format("%.4f", errors.rms_deg[j][1]).c_str(),
-                  Format("%.4f", errors.motion_rms_deg[j][0]).c_str(),
-                  Format("%.4f", errors.motion_rms_deg[j][1]).c_str(),
-                  Format("%.1f", errors.fit_percent[j][0]).c_str(),
-                  Format("%.1f", errors.fit_percent[j][1]).c_str());
+                  Cell("%.4f", errors.rms_deg[j][0]).c_str(),
+                  Cell("%.4f", errors.rms_deg[j][1]).c_str(),
+                  Cell("%.4f", errors.motion_rms_deg[j][0]).c_str(),
+                  Cell("%.4f", errors.motion_rms_deg[j][1]).c_str(),
+                  Cell("%.1f", errors.fit_percent[j][0]).c_str(),
+                  Cell("%.1f", errors.fit_percent[j][1]).c_str());
     out << line;
     for (int a = 0; a < 2; ++a)
       barely_moves = barely_moves || !std::isfinite(errors.fit_percent[j][a]);
@@ -138,10 +132,9 @@ std::string IdentificationSummary::FullReport() const {
     double noise = 0.0;
     for (double s : e.noise_deg) noise += s / static_cast<double>(e.noise_deg.size());
     std::snprintf(line, sizeof(line), "  %s: RMS %s -> %s deg, fit %s %%, noise %.4f deg (%s)%s\n",
-                  e.name.c_str(), Format("%.4f", e.start.rms_deg_overall).c_str(),
-                  Format("%.4f", e.fitted.rms_deg_overall).c_str(),
-                  Format("%.1f", e.fitted.fit_percent_overall).c_str(), noise,
-                  e.noise_source.c_str(),
+                  e.name.c_str(), Cell("%.4f", e.start.rms_deg_overall).c_str(),
+                  Cell("%.4f", e.fitted.rms_deg_overall).c_str(),
+                  Cell("%.1f", e.fitted.fit_percent_overall).c_str(), noise, e.noise_source.c_str(),
                   e.angles_from_pipeline ? ", angles from the mocap pipeline" : "");
     out << line;
   }

@@ -759,9 +759,13 @@ const ParameterEstimate* IdentificationSummary::Find(const std::string& name) co
   return nullptr;
 }
 
-IdentificationSummary Identify(const std::vector<Experiment>& experiments,
-                               const IdentificationOptions& options) {
-  const auto clock_start = std::chrono::steady_clock::now();
+namespace {
+
+// The stages of Identify, in order.
+
+// Options valid, experiments given, all of one arm.
+void CheckFitInputs(const std::vector<Experiment>& experiments,
+                    const IdentificationOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError("identification", "options", error);
   if (experiments.empty()) ThrowInputError("identification", "experiments", "none given");
@@ -772,8 +776,11 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
                           std::to_string(experiments.front().joints) + " joints)");
     }
   }
+}
 
-  // Every experiment's parameters: its nominal values with options.values.
+// Every experiment's parameters: its nominal values with options.values.
+std::vector<sim::ArmParameters> BaseParameters(const std::vector<Experiment>& experiments,
+                                               const IdentificationOptions& options) {
   std::vector<sim::ArmParameters> base;
   for (const Experiment& e : experiments) {
     sim::ArmParameters p = e.config.parameters;
@@ -783,8 +790,15 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     }
     base.push_back(p);
   }
-  const sim::ArmSize arm = base.front().arm;
-  // The free parameters: start from the first experiment's value.
+  return base;
+}
+
+// The free parameters, each starting from the first experiment's value,
+// with its bounds and scale.
+std::vector<FreeParameter> FreeParametersOf(const std::vector<Experiment>& experiments,
+                                            const IdentificationOptions& options,
+                                            const sim::ArmParameters& first) {
+  const sim::ArmSize arm = first.arm;
   std::vector<FreeParameter> free;
   for (const std::string& name : options.free_parameters) {
     const sim::ParameterInfo& info =
@@ -797,7 +811,7 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
       f.lower = it->second.first;
       f.upper = it->second.second;
     }
-    f.start = sim::GetParameter(base.front(), name);
+    f.start = sim::GetParameter(first, name);
     if (f.start < f.lower || f.start > f.upper) {
       // Name where the start came from: a value given for the fit (--set,
       // --params), else the first experiment's configuration.
@@ -828,6 +842,331 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     }
     free.push_back(f);
   }
+  return free;
+}
+
+// The start point first: a start that does not run is an answer in itself.
+// A resumed fit has its start's runs in the checkpoint, and goes on from
+// the checkpoint's point (*u set to it).
+Evaluation EvaluateStart(FitProblem& problem, const std::vector<Experiment>& experiments,
+                         const FitCheckpoint* resume, std::vector<double>* u) {
+  if (resume == nullptr) return problem.Evaluate(u->data());
+  if (resume->u.size() != u->size() || resume->start_angles_rad.size() != experiments.size()) {
+    ThrowInputError("identification", "resume",
+                    "the checkpoint is of another fit (free parameters or experiments)");
+  }
+  for (std::size_t e = 0; e < experiments.size(); ++e) {
+    const Eigen::MatrixXd& a = resume->start_angles_rad[e];
+    if (a.rows() != experiments[e].measured_rad.rows() ||
+        a.cols() != experiments[e].measured_rad.cols()) {
+      ThrowInputError("identification", "resume",
+                      "the checkpoint's runs do not match experiment " + experiments[e].name);
+    }
+  }
+  Evaluation start;
+  start.u = *u;
+  start.angles_rad = resume->start_angles_rad;
+  start.summaries.resize(experiments.size());
+  start.residuals = problem.Residuals(start.angles_rad);
+  start.ok = true;
+  *u = resume->u;
+  return start;
+}
+
+// Levenberg-Marquardt from *u (left at the best point accepted): the
+// termination, message, iterations and costs into *summary. Returns the
+// simulations of a resumed fit before it was stopped.
+std::int64_t Minimise(FitProblem& problem, ceres::Problem& ceres_problem,
+                      const SimulatedAnglesCost& cost, const IdentificationOptions& options,
+                      std::chrono::steady_clock::time_point clock_start,
+                      const Evaluation& start_eval, std::vector<double>* u,
+                      IdentificationSummary* summary) {
+  const FitCheckpoint* resume = options.resume.get();
+  ceres::Solver::Options solver;
+  solver.minimizer_type = ceres::TRUST_REGION;
+  solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = options.function_tolerance;
+  solver.parameter_tolerance = options.parameter_tolerance;
+  solver.gradient_tolerance = options.gradient_tolerance;
+  solver.initial_trust_region_radius = options.initial_trust_region_radius;
+  // The damping floor, from the start's Jacobian (which iteration 0 then
+  // finds cached). Without Jacobi scaling Ceres damps by the squared
+  // column norms clipped to [min_lm_diagonal, max_lm_diagonal]: with
+  // scaling on, the same norms of unit columns.
+  Eigen::MatrixXd start_jacobian;
+  std::string ignored;  // a failed run stops the minimiser at iteration 0
+  if (resume != nullptr) {
+    solver.initial_trust_region_radius = resume->trust_region_radius;
+    solver.jacobi_scaling = resume->jacobi_scaling;
+    solver.min_lm_diagonal = resume->min_lm_diagonal;
+    solver.max_num_iterations = std::max(options.max_iterations - resume->iterations, 0);
+  } else if (options.min_relative_damping > 0.0 &&
+             problem.Jacobian(u->data(), &start_jacobian, &ignored)) {
+    solver.jacobi_scaling = false;
+    solver.min_lm_diagonal =
+        std::max(options.min_relative_damping * start_jacobian.colwise().squaredNorm().maxCoeff(),
+                 solver.min_lm_diagonal);
+  }
+  FitCheckpoint checkpoint;
+  if (resume != nullptr) {
+    checkpoint = *resume;
+    summary->cost_history = resume->cost_history;
+  } else {
+    checkpoint.start_angles_rad = start_eval.angles_rad;
+    checkpoint.min_lm_diagonal = solver.min_lm_diagonal;
+    checkpoint.jacobi_scaling = solver.jacobi_scaling;
+  }
+  solver.num_threads = 1;  // the parallelism is in the backend
+  solver.logging_type = ceres::SILENT;
+  solver.update_state_every_iteration = true;
+  // Steps are projected onto the bounds, without Ceres' projected line
+  // search: its every trial point asks for a gradient, i.e. a whole
+  // finite-difference Jacobian, and one bound-hugging fit spent 50
+  // simulations there for no gain.
+  solver.max_num_line_search_step_size_iterations = 0;
+  IterationReporter progress(&problem, u->data(), options, clock_start, &summary->cost_history,
+                             std::move(checkpoint));
+  solver.callbacks.push_back(&progress);
+  ceres::Solver::Summary ceres_summary;
+  ceres::Solve(solver, &ceres_problem, &ceres_summary);
+  summary->termination = FromCeres(ceres_summary.termination_type);
+  summary->message =
+      progress.stop_reason().empty() ? ceres_summary.message : progress.stop_reason();
+  if (summary->termination == IdentificationTermination::kFailed && !cost.last_failure().empty()) {
+    summary->message += " (" + cost.last_failure() + ")";
+  }
+  summary->iterations =
+      progress.iterations_before() + static_cast<int>(ceres_summary.iterations.size()) - 1;
+  // Ceres counts only the iterations since the resume in its message.
+  const std::string counted = "Number of iterations: ";
+  if (const std::size_t at = summary->message.find(counted);
+      resume != nullptr && at != std::string::npos) {
+    summary->message =
+        summary->message.substr(0, at) + counted + std::to_string(summary->iterations) + ".";
+  }
+  summary->initial_cost = ceres_summary.initial_cost;
+  summary->final_cost = ceres_summary.final_cost;
+  return progress.simulations_before();
+}
+
+// What the fit's final point says of its parameters' uncertainty.
+struct Uncertainty {
+  Eigen::MatrixXd covariance_u;  // free × free, scaled space, times σ_res²
+  std::vector<bool> identifiable;
+};
+
+// The residual statistics, singular values, unidentifiable directions and
+// covariance at the final point `u` (values p_final) into *summary.
+Uncertainty UncertaintyAt(FitProblem& problem, ceres::Problem& ceres_problem,
+                          const std::vector<FreeParameter>& free,
+                          const std::vector<double>& p_final, const Evaluation& final_eval,
+                          const IdentificationOptions& options, std::vector<double>* u,
+                          IdentificationSummary* summary) {
+  const std::size_t p_count = free.size();
+  Uncertainty out;
+  out.identifiable.assign(p_count, true);
+  if (!final_eval.ok) {
+    summary->covariance_message = "the run at the final point did not complete";
+    return out;
+  }
+  Eigen::MatrixXd& covariance_u = out.covariance_u;
+  std::vector<bool>& identifiable = out.identifiable;
+  summary->effective_samples = problem.EffectiveSamples(final_eval.residuals);
+  const double n = static_cast<double>(summary->residuals);
+  summary->residual_variance = n > static_cast<double>(p_count)
+                                   ? 2.0 * summary->final_cost / (n - static_cast<double>(p_count))
+                                   : kNaN;
+  const double inflation = summary->effective_samples > 0.0 ? n / summary->effective_samples : 1.0;
+  const double variance_factor = summary->residual_variance * inflation;
+
+  // Singular values of the scaled Jacobian, and what the data cannot pin
+  // down: a second-order Jacobian from here on.
+  problem.UseSecondOrder();
+  Eigen::MatrixXd jacobian;
+  std::string failure;
+  if (problem.Jacobian(u->data(), &jacobian, &failure)) {
+    summary->jacobian = jacobian;
+    summary->weighted_residuals = final_eval.residuals;
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian, Eigen::ComputeThinV);
+    const Eigen::VectorXd sv = svd.singularValues();
+    const Eigen::MatrixXd v = svd.matrixV();
+    summary->singular_values.assign(sv.data(), sv.data() + sv.size());
+    const double sigma_res = std::sqrt(variance_factor);
+    const double tiny = sv.size() > 0 ? sv[0] * 1e-8 : 0.0;
+    int null_rank = 0;
+    Eigen::VectorXd direction_error(sv.size());
+    for (Eigen::Index d = 0; d < sv.size(); ++d) {
+      direction_error[d] =
+          sv[d] > tiny ? sigma_res / sv[d] : std::numeric_limits<double>::infinity();
+      if (!(sv[d] > tiny)) ++null_rank;
+    }
+    // Errors relative to the estimate (u is in units of the start's
+    // magnitude), with a floor of a tenth of that magnitude, so that an
+    // estimate the data pin near zero is not called undetermined for
+    // being small.
+    std::vector<double> relative_scale(p_count);
+    for (std::size_t i = 0; i < p_count; ++i) {
+      relative_scale[i] = free[i].scale / std::max(std::abs(p_final[i]), 0.1 * free[i].scale);
+    }
+    constexpr double kComponentFloor = 0.2;  // smaller shares are left out of a name
+    const internal::Identifiability assessed = internal::AssessIdentifiability(
+        v, direction_error, relative_scale, options.max_relative_standard_error, kComponentFloor);
+    identifiable = assessed.identifiable;
+    for (const internal::Identifiability::Direction& named : assessed.named) {
+      const int d = named.column;
+      UnidentifiableDirection dir;
+      dir.singular_value = sv[d];
+      dir.relative_std_error = assessed.direction_worst[static_cast<std::size_t>(d)];
+      std::vector<std::pair<std::string, double>> parts;
+      for (const int i : named.members) {
+        parts.emplace_back(free[static_cast<std::size_t>(i)].name, v(i, d));
+      }
+      std::sort(parts.begin(), parts.end(), [](const auto& a, const auto& b) {
+        return std::abs(a.second) > std::abs(b.second);
+      });
+      dir.components = std::move(parts);
+      summary->unidentifiable.push_back(std::move(dir));
+    }
+
+    // Covariance by Ceres, exact null directions dropped.
+    ceres::Covariance::Options cov_options;
+    cov_options.algorithm_type = ceres::DENSE_SVD;
+    cov_options.null_space_rank = null_rank;
+    cov_options.min_reciprocal_condition_number = 1e-16;
+    cov_options.apply_loss_function = false;
+    cov_options.num_threads = 1;
+    ceres::Covariance ceres_covariance(cov_options);
+    std::vector<std::pair<const double*, const double*>> blocks = {{u->data(), u->data()}};
+    if (ceres_covariance.Compute(blocks, &ceres_problem)) {
+      covariance_u.resize(static_cast<Eigen::Index>(p_count), static_cast<Eigen::Index>(p_count));
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> c(
+          static_cast<Eigen::Index>(p_count), static_cast<Eigen::Index>(p_count));
+      ceres_covariance.GetCovarianceBlock(u->data(), u->data(), c.data());
+      covariance_u = c * variance_factor;
+      summary->covariance_available = true;
+    } else {
+      summary->covariance_message = "ceres::Covariance failed at the final point";
+    }
+  } else {
+    summary->covariance_message = "the Jacobian at the final point failed: " + failure;
+  }
+  return out;
+}
+
+// The parameter table, free ones first (estimates, errors, 95 % intervals)
+// then every other named parameter of `first` (effects only when on), and
+// the free parameters' correlations.
+void TabulateParameters(const std::vector<FreeParameter>& free, const std::vector<double>& p_final,
+                        const Uncertainty& uncertainty, const sim::ArmParameters& first,
+                        IdentificationSummary* summary) {
+  const sim::ArmSize arm = first.arm;
+  const std::size_t p_count = free.size();
+  const Eigen::MatrixXd& covariance_u = uncertainty.covariance_u;
+  const std::vector<bool>& identifiable = uncertainty.identifiable;
+  const double t975 =
+      internal::StudentT975(summary->effective_samples - static_cast<double>(p_count));
+  for (std::size_t i = 0; i < p_count; ++i) {
+    const sim::ParameterInfo& info = sim::FindParameter(free[i].name, "--free", arm);
+    ParameterEstimate est;
+    est.name = free[i].name;
+    est.units = info.units;
+    est.free = true;
+    est.start = free[i].start;
+    est.value = p_final[i];
+    est.lower = free[i].lower;
+    est.upper = free[i].upper;
+    est.scale = free[i].scale;
+    const double span = free[i].upper - free[i].lower;
+    est.at_bound = std::abs(est.value - est.lower) <= 1e-9 * span ||
+                   std::abs(est.value - est.upper) <= 1e-9 * span;
+    est.identifiable = summary->covariance_available && identifiable[i];
+    if (est.identifiable) {
+      est.std_error =
+          std::sqrt(std::max(
+              covariance_u(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)), 0.0)) *
+          free[i].scale;
+      est.ci95_lower = std::max(est.value - t975 * est.std_error, est.lower);
+      est.ci95_upper = std::min(est.value + t975 * est.std_error, est.upper);
+    }
+    summary->parameters.push_back(est);
+  }
+  // Fixed: every model parameter, and the parameters of the effects that are on.
+  for (const sim::ParameterInfo& info_entry : sim::AllParameters(arm)) {
+    const std::string& name = info_entry.name;
+    if (std::find(summary->free_names.begin(), summary->free_names.end(), name) !=
+        summary->free_names.end()) {
+      continue;
+    }
+    const std::size_t dot = name.find('.');
+    if (dot != std::string::npos && !first.EffectOn(name.substr(0, dot))) continue;
+    const sim::ParameterInfo& info = sim::FindParameter(name, "parameters", arm);
+    ParameterEstimate est;
+    est.name = name;
+    est.units = info.units;
+    est.free = false;
+    est.start = est.value = sim::GetParameter(first, name);
+    est.lower = info.lower;
+    est.upper = info.upper;
+    est.identifiable = false;
+    summary->parameters.push_back(est);
+  }
+  summary->correlation = Eigen::MatrixXd::Constant(static_cast<Eigen::Index>(p_count),
+                                                   static_cast<Eigen::Index>(p_count), kNaN);
+  if (summary->covariance_available) {
+    for (std::size_t i = 0; i < p_count; ++i) {
+      for (std::size_t j = 0; j < p_count; ++j) {
+        if (!identifiable[i] || !identifiable[j]) continue;
+        const Eigen::Index a = static_cast<Eigen::Index>(i), b = static_cast<Eigen::Index>(j);
+        const double d = std::sqrt(covariance_u(a, a) * covariance_u(b, b));
+        summary->correlation(a, b) = d > 0.0 ? covariance_u(a, b) / d : kNaN;
+      }
+    }
+  }
+}
+
+// Errors per experiment and overall, at the start and at the end, with the
+// fitted runs.
+void TabulateErrors(const std::vector<Experiment>& experiments, const FitProblem& problem,
+                    const Evaluation& start_eval, const Evaluation& final_eval,
+                    const std::vector<double>& p_final, std::vector<sim::Trajectory> trajectories,
+                    IdentificationSummary* summary) {
+  std::vector<const Experiment*> all;
+  std::vector<const Eigen::MatrixXd*> start_angles, final_angles;
+  for (std::size_t e = 0; e < experiments.size(); ++e) {
+    ExperimentFit fit;
+    fit.name = experiments[e].name;
+    fit.path = experiments[e].path;
+    fit.angles_from_pipeline = experiments[e].angles_from_pipeline;
+    fit.noise_deg = experiments[e].noise_deg;
+    fit.noise_source = experiments[e].noise_source;
+    if (start_eval.ok || !start_eval.angles_rad.empty()) {
+      fit.start = AngleErrors({&experiments[e]}, {&start_eval.angles_rad[e]});
+    }
+    fit.fitted = AngleErrors({&experiments[e]}, {&final_eval.angles_rad[e]});
+    fit.run.summary = final_eval.summaries[e];
+    if (e < trajectories.size()) fit.run.trajectory = std::move(trajectories[e]);
+    fit.parameters = problem.ParametersAt(e, p_final);
+    fit.simulated_rad = final_eval.angles_rad[e];
+    summary->experiments.push_back(std::move(fit));
+    all.push_back(&experiments[e]);
+    start_angles.push_back(&start_eval.angles_rad[e]);
+    final_angles.push_back(&final_eval.angles_rad[e]);
+  }
+  summary->start_errors = AngleErrors(all, start_angles);
+  summary->errors = AngleErrors(all, final_angles);
+}
+
+}  // namespace
+
+IdentificationSummary Identify(const std::vector<Experiment>& experiments,
+                               const IdentificationOptions& options) {
+  const auto clock_start = std::chrono::steady_clock::now();
+  CheckFitInputs(experiments, options);
+  const std::vector<sim::ArmParameters> base = BaseParameters(experiments, options);
+  const std::vector<FreeParameter> free = FreeParametersOf(experiments, options, base.front());
+  std::string error;
   for (const sim::ArmParameters& p : base) {
     if (!p.IsValid(&error)) ThrowInputError("identification", "parameters", error);
   }
@@ -849,36 +1188,7 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
 
   std::vector<double> u(free.size());
   for (std::size_t i = 0; i < free.size(); ++i) u[i] = free[i].start / free[i].scale;
-
-  // The start point first: a start that does not run is an answer in itself.
-  // A resumed fit has its start's runs in the checkpoint, and goes on from
-  // the checkpoint's point.
-  const FitCheckpoint* resume = options.resume.get();
-  if (resume != nullptr) {
-    if (resume->u.size() != free.size() || resume->start_angles_rad.size() != experiments.size()) {
-      ThrowInputError("identification", "resume",
-                      "the checkpoint is of another fit (free parameters or experiments)");
-    }
-    for (std::size_t e = 0; e < experiments.size(); ++e) {
-      const Eigen::MatrixXd& a = resume->start_angles_rad[e];
-      if (a.rows() != experiments[e].measured_rad.rows() ||
-          a.cols() != experiments[e].measured_rad.cols()) {
-        ThrowInputError("identification", "resume",
-                        "the checkpoint's runs do not match experiment " + experiments[e].name);
-      }
-    }
-  }
-  Evaluation start_eval;
-  if (resume == nullptr) {
-    start_eval = problem.Evaluate(u.data());
-  } else {
-    start_eval.u = u;
-    start_eval.angles_rad = resume->start_angles_rad;
-    start_eval.summaries.resize(experiments.size());
-    start_eval.residuals = problem.Residuals(start_eval.angles_rad);
-    start_eval.ok = true;
-    u = resume->u;
-  }
+  const Evaluation start_eval = EvaluateStart(problem, experiments, options.resume.get(), &u);
 
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -891,80 +1201,13 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     ceres_problem.SetParameterUpperBound(u.data(), static_cast<int>(i),
                                          free[i].upper / free[i].scale);
   }
-
   std::int64_t simulations_before = 0;  // a resumed fit's, before it was stopped
   if (!start_eval.ok) {
     summary.termination = IdentificationTermination::kFailed;
     summary.message = "the run at the start values did not complete: " + start_eval.failure;
   } else {
-    ceres::Solver::Options solver;
-    solver.minimizer_type = ceres::TRUST_REGION;
-    solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-    solver.linear_solver_type = ceres::DENSE_QR;
-    solver.max_num_iterations = options.max_iterations;
-    solver.function_tolerance = options.function_tolerance;
-    solver.parameter_tolerance = options.parameter_tolerance;
-    solver.gradient_tolerance = options.gradient_tolerance;
-    solver.initial_trust_region_radius = options.initial_trust_region_radius;
-    // The damping floor, from the start's Jacobian (which iteration 0 then
-    // finds cached). Without Jacobi scaling Ceres damps by the squared
-    // column norms clipped to [min_lm_diagonal, max_lm_diagonal]: with
-    // scaling on, the same norms of unit columns.
-    Eigen::MatrixXd start_jacobian;
-    std::string ignored;  // a failed run stops the minimiser at iteration 0
-    if (resume != nullptr) {
-      solver.initial_trust_region_radius = resume->trust_region_radius;
-      solver.jacobi_scaling = resume->jacobi_scaling;
-      solver.min_lm_diagonal = resume->min_lm_diagonal;
-      solver.max_num_iterations = std::max(options.max_iterations - resume->iterations, 0);
-    } else if (options.min_relative_damping > 0.0 &&
-               problem.Jacobian(u.data(), &start_jacobian, &ignored)) {
-      solver.jacobi_scaling = false;
-      solver.min_lm_diagonal =
-          std::max(options.min_relative_damping * start_jacobian.colwise().squaredNorm().maxCoeff(),
-                   solver.min_lm_diagonal);
-    }
-    FitCheckpoint checkpoint;
-    if (resume != nullptr) {
-      checkpoint = *resume;
-      summary.cost_history = resume->cost_history;
-    } else {
-      checkpoint.start_angles_rad = start_eval.angles_rad;
-      checkpoint.min_lm_diagonal = solver.min_lm_diagonal;
-      checkpoint.jacobi_scaling = solver.jacobi_scaling;
-    }
-    solver.num_threads = 1;  // the parallelism is in the backend
-    solver.logging_type = ceres::SILENT;
-    solver.update_state_every_iteration = true;
-    // Steps are projected onto the bounds, without Ceres' projected line
-    // search: its every trial point asks for a gradient, i.e. a whole
-    // finite-difference Jacobian, and one bound-hugging fit spent 50
-    // simulations there for no gain.
-    solver.max_num_line_search_step_size_iterations = 0;
-    IterationReporter progress(&problem, u.data(), options, clock_start, &summary.cost_history,
-                               std::move(checkpoint));
-    solver.callbacks.push_back(&progress);
-    ceres::Solver::Summary ceres_summary;
-    ceres::Solve(solver, &ceres_problem, &ceres_summary);
-    summary.termination = FromCeres(ceres_summary.termination_type);
-    summary.message =
-        progress.stop_reason().empty() ? ceres_summary.message : progress.stop_reason();
-    if (summary.termination == IdentificationTermination::kFailed && !cost.last_failure().empty()) {
-      summary.message += " (" + cost.last_failure() + ")";
-    }
-    summary.iterations =
-        progress.iterations_before() + static_cast<int>(ceres_summary.iterations.size()) - 1;
-    // Ceres counts only the iterations since the resume in its message.
-    const std::string counted = "Number of iterations: ";
-    if (const std::size_t at = summary.message.find(counted);
-        resume != nullptr && at != std::string::npos) {
-      summary.message =
-          summary.message.substr(0, at) + counted + std::to_string(summary.iterations) + ".";
-    }
-    simulations_before = progress.simulations_before();
-    summary.initial_cost = ceres_summary.initial_cost;
-    summary.final_cost = ceres_summary.final_cost;
-    // Ceres leaves u at the best point it accepted.
+    simulations_before =
+        Minimise(problem, ceres_problem, cost, options, clock_start, start_eval, &u, &summary);
   }
 
   // The final point: runs with their trajectories, residual statistics.
@@ -977,180 +1220,11 @@ IdentificationSummary Identify(const std::vector<Experiment>& experiments,
     summary.final_cost = 0.5 * final_eval.residuals.squaredNorm();
     summary.initial_cost = 0.5 * start_eval.residuals.squaredNorm();
   }
-
-  const std::size_t p_count = free.size();
-  Eigen::MatrixXd covariance_u;  // free × free, scaled space, times σ_res²
-  std::vector<bool> identifiable(p_count, true);
-  if (final_eval.ok) {
-    summary.effective_samples = problem.EffectiveSamples(final_eval.residuals);
-    const double n = static_cast<double>(summary.residuals);
-    summary.residual_variance = n > static_cast<double>(p_count)
-                                    ? 2.0 * summary.final_cost / (n - static_cast<double>(p_count))
-                                    : kNaN;
-    const double inflation = summary.effective_samples > 0.0 ? n / summary.effective_samples : 1.0;
-    const double variance_factor = summary.residual_variance * inflation;
-
-    // Singular values of the scaled Jacobian, and what the data cannot pin
-    // down: a second-order Jacobian from here on.
-    problem.UseSecondOrder();
-    Eigen::MatrixXd jacobian;
-    std::string failure;
-    if (problem.Jacobian(u.data(), &jacobian, &failure)) {
-      summary.jacobian = jacobian;
-      summary.weighted_residuals = final_eval.residuals;
-      const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian, Eigen::ComputeThinV);
-      const Eigen::VectorXd sv = svd.singularValues();
-      const Eigen::MatrixXd v = svd.matrixV();
-      summary.singular_values.assign(sv.data(), sv.data() + sv.size());
-      const double sigma_res = std::sqrt(variance_factor);
-      const double tiny = sv.size() > 0 ? sv[0] * 1e-8 : 0.0;
-      int null_rank = 0;
-      Eigen::VectorXd direction_error(sv.size());
-      for (Eigen::Index d = 0; d < sv.size(); ++d) {
-        direction_error[d] =
-            sv[d] > tiny ? sigma_res / sv[d] : std::numeric_limits<double>::infinity();
-        if (!(sv[d] > tiny)) ++null_rank;
-      }
-      // Errors relative to the estimate (u is in units of the start's
-      // magnitude), with a floor of a tenth of that magnitude, so that an
-      // estimate the data pin near zero is not called undetermined for
-      // being small.
-      std::vector<double> relative_scale(p_count);
-      for (std::size_t i = 0; i < p_count; ++i) {
-        relative_scale[i] = free[i].scale / std::max(std::abs(p_final[i]), 0.1 * free[i].scale);
-      }
-      constexpr double kComponentFloor = 0.2;  // smaller shares are left out of a name
-      const internal::Identifiability assessed = internal::AssessIdentifiability(
-          v, direction_error, relative_scale, options.max_relative_standard_error, kComponentFloor);
-      identifiable = assessed.identifiable;
-      for (const internal::Identifiability::Direction& named : assessed.named) {
-        const int d = named.column;
-        UnidentifiableDirection dir;
-        dir.singular_value = sv[d];
-        dir.relative_std_error = assessed.direction_worst[static_cast<std::size_t>(d)];
-        std::vector<std::pair<std::string, double>> parts;
-        for (const int i : named.members) {
-          parts.emplace_back(free[static_cast<std::size_t>(i)].name, v(i, d));
-        }
-        std::sort(parts.begin(), parts.end(), [](const auto& a, const auto& b) {
-          return std::abs(a.second) > std::abs(b.second);
-        });
-        dir.components = std::move(parts);
-        summary.unidentifiable.push_back(std::move(dir));
-      }
-
-      // Covariance by Ceres, exact null directions dropped.
-      ceres::Covariance::Options cov_options;
-      cov_options.algorithm_type = ceres::DENSE_SVD;
-      cov_options.null_space_rank = null_rank;
-      cov_options.min_reciprocal_condition_number = 1e-16;
-      cov_options.apply_loss_function = false;
-      cov_options.num_threads = 1;
-      ceres::Covariance ceres_covariance(cov_options);
-      std::vector<std::pair<const double*, const double*>> blocks = {{u.data(), u.data()}};
-      if (ceres_covariance.Compute(blocks, &ceres_problem)) {
-        covariance_u.resize(static_cast<Eigen::Index>(p_count), static_cast<Eigen::Index>(p_count));
-        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> c(
-            static_cast<Eigen::Index>(p_count), static_cast<Eigen::Index>(p_count));
-        ceres_covariance.GetCovarianceBlock(u.data(), u.data(), c.data());
-        covariance_u = c * variance_factor;
-        summary.covariance_available = true;
-      } else {
-        summary.covariance_message = "ceres::Covariance failed at the final point";
-      }
-    } else {
-      summary.covariance_message = "the Jacobian at the final point failed: " + failure;
-    }
-  } else {
-    summary.covariance_message = "the run at the final point did not complete";
-  }
-
-  // Parameter table: free ones first, then every other named parameter.
-  const double t975 =
-      internal::StudentT975(summary.effective_samples - static_cast<double>(p_count));
-  for (std::size_t i = 0; i < p_count; ++i) {
-    const sim::ParameterInfo& info = sim::FindParameter(free[i].name, "--free", arm);
-    ParameterEstimate est;
-    est.name = free[i].name;
-    est.units = info.units;
-    est.free = true;
-    est.start = free[i].start;
-    est.value = p_final[i];
-    est.lower = free[i].lower;
-    est.upper = free[i].upper;
-    est.scale = free[i].scale;
-    const double span = free[i].upper - free[i].lower;
-    est.at_bound = std::abs(est.value - est.lower) <= 1e-9 * span ||
-                   std::abs(est.value - est.upper) <= 1e-9 * span;
-    est.identifiable = summary.covariance_available && identifiable[i];
-    if (est.identifiable) {
-      est.std_error =
-          std::sqrt(std::max(
-              covariance_u(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)), 0.0)) *
-          free[i].scale;
-      est.ci95_lower = std::max(est.value - t975 * est.std_error, est.lower);
-      est.ci95_upper = std::min(est.value + t975 * est.std_error, est.upper);
-    }
-    summary.parameters.push_back(est);
-  }
-  // Fixed: every model parameter, and the parameters of the effects that are on.
-  for (const sim::ParameterInfo& info_entry : sim::AllParameters(arm)) {
-    const std::string& name = info_entry.name;
-    if (std::find(summary.free_names.begin(), summary.free_names.end(), name) !=
-        summary.free_names.end()) {
-      continue;
-    }
-    const std::size_t dot = name.find('.');
-    if (dot != std::string::npos && !base.front().EffectOn(name.substr(0, dot))) continue;
-    const sim::ParameterInfo& info = sim::FindParameter(name, "parameters", arm);
-    ParameterEstimate est;
-    est.name = name;
-    est.units = info.units;
-    est.free = false;
-    est.start = est.value = sim::GetParameter(base.front(), name);
-    est.lower = info.lower;
-    est.upper = info.upper;
-    est.identifiable = false;
-    summary.parameters.push_back(est);
-  }
-  summary.correlation = Eigen::MatrixXd::Constant(static_cast<Eigen::Index>(p_count),
-                                                  static_cast<Eigen::Index>(p_count), kNaN);
-  if (summary.covariance_available) {
-    for (std::size_t i = 0; i < p_count; ++i) {
-      for (std::size_t j = 0; j < p_count; ++j) {
-        if (!identifiable[i] || !identifiable[j]) continue;
-        const Eigen::Index a = static_cast<Eigen::Index>(i), b = static_cast<Eigen::Index>(j);
-        const double d = std::sqrt(covariance_u(a, a) * covariance_u(b, b));
-        summary.correlation(a, b) = d > 0.0 ? covariance_u(a, b) / d : kNaN;
-      }
-    }
-  }
-
-  // Errors per experiment and overall, at the start and at the end.
-  std::vector<const Experiment*> all;
-  std::vector<const Eigen::MatrixXd*> start_angles, final_angles;
-  for (std::size_t e = 0; e < experiments.size(); ++e) {
-    ExperimentFit fit;
-    fit.name = experiments[e].name;
-    fit.path = experiments[e].path;
-    fit.angles_from_pipeline = experiments[e].angles_from_pipeline;
-    fit.noise_deg = experiments[e].noise_deg;
-    fit.noise_source = experiments[e].noise_source;
-    if (start_eval.ok || !start_eval.angles_rad.empty()) {
-      fit.start = AngleErrors({&experiments[e]}, {&start_eval.angles_rad[e]});
-    }
-    fit.fitted = AngleErrors({&experiments[e]}, {&final_eval.angles_rad[e]});
-    fit.run.summary = final_eval.summaries[e];
-    if (e < trajectories.size()) fit.run.trajectory = std::move(trajectories[e]);
-    fit.parameters = problem.ParametersAt(e, p_final);
-    fit.simulated_rad = final_eval.angles_rad[e];
-    summary.experiments.push_back(std::move(fit));
-    all.push_back(&experiments[e]);
-    start_angles.push_back(&start_eval.angles_rad[e]);
-    final_angles.push_back(&final_eval.angles_rad[e]);
-  }
-  summary.start_errors = AngleErrors(all, start_angles);
-  summary.errors = AngleErrors(all, final_angles);
+  const Uncertainty uncertainty =
+      UncertaintyAt(problem, ceres_problem, free, p_final, final_eval, options, &u, &summary);
+  TabulateParameters(free, p_final, uncertainty, base.front(), &summary);
+  TabulateErrors(experiments, problem, start_eval, final_eval, p_final, std::move(trajectories),
+                 &summary);
   summary.simulations = simulations_before + problem.simulations();
   summary.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();

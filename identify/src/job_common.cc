@@ -10,7 +10,8 @@
 #include "ccsrm/common/version.h"
 #include "ccsrm/identify/job.h"
 #include "ccsrm/sim/config.h"
-#include "job_text.h"
+#include "job_stages.h"
+#include "text.h"
 
 namespace ccsrm::identify {
 
@@ -60,11 +61,17 @@ OutputKind DesignFolderOutput() {
                    "ccsrm-design/1", true);
 }
 
-std::string JoinNames(const std::vector<std::string>& names) {
-  std::string text;
-  for (const std::string& n : names) text += (text.empty() ? "" : ", ") + n;
-  return text;
+namespace internal {
+
+void ApplyFitJob(const FitJobOptions& job, IdentificationOptions* fit) {
+  if (job.data.empty()) ThrowInputError("--data", "", "give at least one experiment file");
+  fit->threads = job.runs.threads;
+  fit->max_iterations = job.max_iterations;
+  const FitParameterChoice& p = job.parameters;
+  ApplyFitParameters(p.free ? &*p.free : nullptr, p.params_path, p.values, fit);
 }
+
+}  // namespace internal
 
 std::vector<Experiment> LoadExperiments(const std::vector<std::string>& paths,
                                         std::optional<double> noise_deg, const char* role,

@@ -8,7 +8,8 @@
 #include "ccsrm/identify/job.h"
 #include "ccsrm/identify/run_journal.h"
 #include "ccsrm/sim/paper_run.h"
-#include "job_text.h"
+#include "job_stages.h"
+#include "text.h"
 
 namespace ccsrm::identify {
 namespace {
@@ -125,9 +126,7 @@ std::vector<std::string> WriteDesignDirectory(const DesignSummary& summary,
 }
 
 DesignJobResult RunDesignJob(const DesignJobOptions& job) {
-  const auto say = [&job](const std::string& text) {
-    if (job.reporting.line) job.reporting.line(text);
-  };
+  const auto say = [&job](const std::string& text) { internal::Say(job.reporting, text); };
   DesignOptions options = CheckedOptions(job);
   std::vector<std::string> inputs = {job.config_path, job.params_path, job.noise_from};
   std::vector<DesignCandidate> candidates;

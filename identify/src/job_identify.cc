@@ -1,7 +1,8 @@
 // RunIdentifyJob: `ccsrm identify` and ccsrm.identify.
 #include "ccsrm/common/error.h"
 #include "ccsrm/identify/job.h"
-#include "job_text.h"
+#include "job_stages.h"
+#include "text.h"
 
 namespace ccsrm::identify {
 
@@ -21,19 +22,14 @@ std::string ResultOptions(const IdentifyJobOptions& o) {
 }  // namespace
 
 IdentifyJobResult RunIdentifyJob(const IdentifyJobOptions& job) {
-  const auto say = [&job](const std::string& text) {
-    if (job.reporting.line) job.reporting.line(text);
-  };
-  if (job.data.empty()) ThrowInputError("--data", "", "give at least one experiment file");
+  const auto say = [&job](const std::string& text) { internal::Say(job.reporting, text); };
   // Everything is checked before the first simulation: options, output path,
   // every experiment file.
   IdentificationOptions options;
-  options.threads = job.runs.threads;
-  options.max_iterations = job.max_iterations;
   options.relative_step = job.relative_step;
   options.central_differences_throughout = job.central_differences_throughout;
+  internal::ApplyFitJob(job, &options);
   const FitParameterChoice& p = job.parameters;
-  ApplyFitParameters(p.free ? &*p.free : nullptr, p.params_path, p.values, &options);
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError("identify", "", error);
   std::vector<std::string> inputs = job.data;
@@ -60,8 +56,8 @@ IdentifyJobResult RunIdentifyJob(const IdentifyJobOptions& job) {
     return result;
   }
   options.backend = backends.front();
-  say(Format("fitting %s on %d thread%s\n", JoinNames(options.free_parameters).c_str(),
-             options.threads, Plural(static_cast<std::size_t>(options.threads))));
+  say(Format("fitting %s on %d thread%s\n", Join(options.free_parameters).c_str(), options.threads,
+             Plural(static_cast<std::size_t>(options.threads))));
   options.on_iteration = job.reporting.on_iteration;
   options.on_run = job.reporting.on_run;
   result.summary = Identify(result.experiments, options);

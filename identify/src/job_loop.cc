@@ -4,7 +4,8 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/identify/job.h"
 #include "ccsrm/identify/run_journal.h"
-#include "job_text.h"
+#include "job_stages.h"
+#include "text.h"
 
 namespace ccsrm::identify {
 
@@ -30,16 +31,11 @@ std::string JournalPath(const std::string& out) {
 }  // namespace
 
 LoopJobResult RunLoopJob(const LoopJobOptions& job) {
-  const auto say = [&job](const std::string& text) {
-    if (job.reporting.line) job.reporting.line(text);
-  };
-  if (job.data.empty()) ThrowInputError("--data", "", "give at least one experiment file");
+  const auto say = [&job](const std::string& text) { internal::Say(job.reporting, text); };
   LoopOptions options;
-  options.fit.threads = job.runs.threads;
-  options.fit.max_iterations = job.max_iterations;
   options.max_rounds = job.max_rounds;
+  internal::ApplyFitJob(job, &options.fit);
   const FitParameterChoice& p = job.parameters;
-  ApplyFitParameters(p.free ? &*p.free : nullptr, p.params_path, p.values, &options.fit);
   if (job.candidates) options.candidates = *job.candidates;
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError("loop", "", error);
@@ -81,7 +77,7 @@ LoopJobResult RunLoopJob(const LoopJobOptions& job) {
   }
 
   say(Format("declared model: %s free; %zu training, %zu held-out experiment%s; %d thread%s\n",
-             JoinNames(options.fit.free_parameters).c_str(), result.training.size(),
+             Join(options.fit.free_parameters).c_str(), result.training.size(),
              result.holdout.size(), Plural(result.holdout.size()), options.fit.threads,
              Plural(static_cast<std::size_t>(options.fit.threads))));
   options.fit.on_iteration = job.reporting.on_iteration;

@@ -2,14 +2,13 @@
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/identify/job.h"
-#include "job_text.h"
+#include "job_stages.h"
+#include "text.h"
 
 namespace ccsrm::identify {
 
 PredictJobResult RunPredictJob(const PredictJobOptions& job) {
-  const auto say = [&job](const std::string& text) {
-    if (job.reporting.line) job.reporting.line(text);
-  };
+  const auto say = [&job](const std::string& text) { internal::Say(job.reporting, text); };
   if (job.data.empty()) ThrowInputError("--data", "", "give at least one recording");
   // Everything is checked before the first simulation: options, output
   // path, the model, every recording against it.

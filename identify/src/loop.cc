@@ -9,7 +9,6 @@
 
 namespace ccsrm::identify {
 
-using internal::Format;
 using internal::kTermsCandidate;
 using internal::kTermsEffect;
 

@@ -84,10 +84,8 @@ bool AcceptWinner(LoopState* s, RoundState* rs) {
                                : std::string()) +
       ".";
   if (!lr.tie.empty()) {
-    std::string names;
-    for (const std::string& t : lr.tie) names += (names.empty() ? "" : ", ") + t;
-    lr.decision += " Tie (ΔBIC within " + Format("%g", options.tie_delta_bic) + "): " + names +
-                   "; the one with the fewest parameters is kept.";
+    lr.decision += " Tie (ΔBIC within " + Format("%g", options.tie_delta_bic) +
+                   "): " + Join(lr.tie) + "; the one with the fewest parameters is kept.";
   }
   for (const std::string& q : winner->parameters) free.push_back(q);
   effects_on.push_back(lr.winner);

@@ -7,6 +7,7 @@
 #include "angles_table.h"
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/identify/loop.h"
+#include "text.h"
 
 namespace ccsrm::identify {
 namespace {
@@ -19,13 +20,6 @@ nlohmann::json Number(double value) {
 
 nlohmann::json Optional(const std::optional<double>& value) {
   return value ? Number(*value) : nlohmann::json(nullptr);
-}
-
-std::string Format(const char* format, double value) {
-  if (!std::isfinite(value)) return "-";
-  char text[96];
-  std::snprintf(text, sizeof(text), format, value);
-  return text;
 }
 
 nlohmann::json PerJoint(const ChannelErrors& e) {
@@ -61,7 +55,7 @@ nlohmann::json Evidence(const std::vector<SignalEvidence>& evidence) {
 std::string WithUnit(double value, const std::string& key) {
   const bool angle = key.find("_deg") != std::string::npos;
   const std::string unit = key.substr(key.rfind('_') + 1);
-  return Format("%.4g", angle ? value * kDeg : value) + " " + unit;
+  return Cell("%.4g", angle ? value * kDeg : value) + " " + unit;
 }
 
 // The backward step's check of an earlier addition (loop.json rounds[].backward).
@@ -90,14 +84,114 @@ std::string DeclaredCorrection::Sentence() const {
   } else {
     out += " (its error not identifiable)";
   }
-  out += " (" + Format("%+.2f", 100.0 * relative) + " %)";
+  out += " (" + Cell("%+.2f", 100.0 * relative) + " %)";
   if (!indistinguishable.empty()) {
-    std::string names;
-    for (const std::string& n : indistinguishable) names += (names.empty() ? "" : ", ") + n;
-    out += ", or a combination with " + names + " that the data cannot tell apart";
+    out +=
+        ", or a combination with " + Join(indistinguishable) + " that the data cannot tell apart";
   }
   return out;
 }
+
+namespace {
+
+nlohmann::json CandidateJson(const CandidateResult& c) {
+  using nlohmann::json;
+  json est = json::object();
+  for (const auto& [name, e] : c.estimates) est[name] = Estimate(e);
+  json path = json::array();
+  for (const CandidateResult::TermSupport& t : c.term_path) {
+    path.push_back({{"parameters", t.parameters},
+                    {"delta_chi2_eff", Number(t.delta_chi2_eff)},
+                    {"delta_bic", Number(t.delta_bic)}});
+  }
+  json out = {{"name", c.name},
+              {"kind", c.kind},
+              {"indistinguishable", c.indistinguishable},
+              {"excess_share", c.refitted ? Number(c.excess_share) : json(nullptr)},
+              {"mean_square_after", c.refitted ? Number(c.mean_square_after) : json(nullptr)},
+              {"partial", c.partial},
+              {"score", Number(c.score)},
+              {"p_value", Number(c.p_value)},
+              {"significant", c.significant},
+              {"parameters", c.parameters},
+              {"linearised", c.linearised},
+              {"evidence", Evidence(c.evidence)},
+              {"refitted", c.refitted},
+              {"cost_without", c.refitted ? Number(c.cost_without) : json(nullptr)},
+              {"delta_bic", c.refitted ? Number(c.delta_bic) : json(nullptr)},
+              {"holdout_rms_without_deg", Optional(c.holdout_rms_without_deg)},
+              {"rms_deg", c.refitted ? Number(c.rms_deg) : json(nullptr)},
+              {"holdout_rms_deg", Optional(c.holdout_rms_deg)},
+              {"holdout_improved", c.holdout_improved},
+              {"size_significant", c.size_significant},
+              {"termination", c.termination},
+              {"estimates", est},
+              {"simulations", c.simulations},
+              {"accepted", c.accepted},
+              {"reason", c.reason}};
+  if (!c.term_path.empty()) out["term_path"] = path;
+  return out;
+}
+
+nlohmann::json RoundJson(const LoopRound& r) {
+  using nlohmann::json;
+  json cands = json::array();
+  for (const CandidateResult& c : r.candidates) cands.push_back(CandidateJson(c));
+  json out = {{"round", r.index},
+              {"effects_on", r.effects_on},
+              {"rms_deg", Number(r.rms_deg)},
+              {"holdout_rms_deg", Optional(r.holdout_rms_deg)},
+              {"evidence", ToJson(r.evidence)},
+              {"candidates", cands},
+              {"winner", r.winner.empty() ? json(nullptr) : json(r.winner)},
+              {"tie", r.tie},
+              {"decision", r.decision}};
+  if (!r.discovery.empty()) out["discovery"] = r.discovery;
+  // The backward step (issue 28): every earlier addition checked, and the
+  // one taken back (null: none).
+  json backward = json::array();
+  json taken = nullptr;
+  for (const BackwardCheck& b : r.backward) {
+    backward.push_back(Backward(b, r.index));
+    if (b.taken_back) taken = backward.back();
+  }
+  out["backward"] = backward;
+  out["taken_back"] = taken;
+  return out;
+}
+
+nlohmann::json CorrectionJson(const DeclaredCorrection& d) {
+  return {{"parameter", d.parameter},
+          {"config_key", d.config_key},
+          {"declared", Number(d.declared)},
+          {"corrected", Number(d.corrected())},
+          {"delta", Number(d.delta())},
+          {"relative", Number(d.relative)},
+          {"relative_std_error", Number(d.relative_std_error)},
+          {"relative_ci95", {Number(d.relative_ci95_lower), Number(d.relative_ci95_upper)}},
+          {"identifiable", d.identifiable},
+          {"indistinguishable", d.indistinguishable},
+          {"sentence", d.Sentence()}};
+}
+
+nlohmann::json DiscoveredJson(const DiscoveredMoment& m) {
+  using nlohmann::json;
+  json terms = json::array();
+  for (const DiscoveredMoment::Term& t : m.terms) {
+    terms.push_back({{"term", t.name},
+                     {"formula", t.formula},
+                     {"parameter", t.estimate.name},
+                     {"units", t.units},
+                     {"estimate", Estimate(t.estimate)}});
+  }
+  return {{"segment", m.segment},
+          {"joints", {m.first_joint, m.last_joint}},
+          {"axis", m.axis == 0 ? "x" : "y"},
+          {"terms", terms},
+          {"formula", m.Formula()}};
+}
+
+}  // namespace
 
 nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& training,
                       const std::vector<Experiment>& holdout) {
@@ -124,66 +218,7 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
                    {"tie_delta_bic", o.tie_delta_bic},
                    {"unexplained_noise_ratio", o.unexplained_noise_ratio}};
   json rounds = json::array();
-  for (const LoopRound& r : s.rounds) {
-    json cands = json::array();
-    for (const CandidateResult& c : r.candidates) {
-      json est = json::object();
-      for (const auto& [name, e] : c.estimates) est[name] = Estimate(e);
-      json path = json::array();
-      for (const CandidateResult::TermSupport& t : c.term_path) {
-        path.push_back({{"parameters", t.parameters},
-                        {"delta_chi2_eff", Number(t.delta_chi2_eff)},
-                        {"delta_bic", Number(t.delta_bic)}});
-      }
-      cands.push_back(
-          {{"name", c.name},
-           {"kind", c.kind},
-           {"indistinguishable", c.indistinguishable},
-           {"excess_share", c.refitted ? Number(c.excess_share) : json(nullptr)},
-           {"mean_square_after", c.refitted ? Number(c.mean_square_after) : json(nullptr)},
-           {"partial", c.partial},
-           {"score", Number(c.score)},
-           {"p_value", Number(c.p_value)},
-           {"significant", c.significant},
-           {"parameters", c.parameters},
-           {"linearised", c.linearised},
-           {"evidence", Evidence(c.evidence)},
-           {"refitted", c.refitted},
-           {"cost_without", c.refitted ? Number(c.cost_without) : json(nullptr)},
-           {"delta_bic", c.refitted ? Number(c.delta_bic) : json(nullptr)},
-           {"holdout_rms_without_deg", Optional(c.holdout_rms_without_deg)},
-           {"rms_deg", c.refitted ? Number(c.rms_deg) : json(nullptr)},
-           {"holdout_rms_deg", Optional(c.holdout_rms_deg)},
-           {"holdout_improved", c.holdout_improved},
-           {"size_significant", c.size_significant},
-           {"termination", c.termination},
-           {"estimates", est},
-           {"simulations", c.simulations},
-           {"accepted", c.accepted},
-           {"reason", c.reason}});
-      if (!c.term_path.empty()) cands.back()["term_path"] = path;
-    }
-    rounds.push_back({{"round", r.index},
-                      {"effects_on", r.effects_on},
-                      {"rms_deg", Number(r.rms_deg)},
-                      {"holdout_rms_deg", Optional(r.holdout_rms_deg)},
-                      {"evidence", ToJson(r.evidence)},
-                      {"candidates", cands},
-                      {"winner", r.winner.empty() ? json(nullptr) : json(r.winner)},
-                      {"tie", r.tie},
-                      {"decision", r.decision}});
-    if (!r.discovery.empty()) rounds.back()["discovery"] = r.discovery;
-    // The backward step (issue 28): every earlier addition checked, and the
-    // one taken back (null: none).
-    json backward = json::array();
-    json taken = nullptr;
-    for (const BackwardCheck& b : r.backward) {
-      backward.push_back(Backward(b, r.index));
-      if (b.taken_back) taken = backward.back();
-    }
-    rounds.back()["backward"] = backward;
-    rounds.back()["taken_back"] = taken;
-  }
+  for (const LoopRound& r : s.rounds) rounds.push_back(RoundJson(r));
   j["rounds"] = rounds;
   j["added_effects"] = s.added_effects;
   json taken_back = json::array();
@@ -194,37 +229,11 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
   }
   j["taken_back"] = taken_back;
   json corrections = json::array();
-  for (const DeclaredCorrection& d : s.declared_corrections) {
-    corrections.push_back(
-        {{"parameter", d.parameter},
-         {"config_key", d.config_key},
-         {"declared", Number(d.declared)},
-         {"corrected", Number(d.corrected())},
-         {"delta", Number(d.delta())},
-         {"relative", Number(d.relative)},
-         {"relative_std_error", Number(d.relative_std_error)},
-         {"relative_ci95", {Number(d.relative_ci95_lower), Number(d.relative_ci95_upper)}},
-         {"identifiable", d.identifiable},
-         {"indistinguishable", d.indistinguishable},
-         {"sentence", d.Sentence()}});
-  }
+  for (const DeclaredCorrection& d : s.declared_corrections)
+    corrections.push_back(CorrectionJson(d));
   j["declared_corrections"] = corrections;
   json discovered = json::array();
-  for (const DiscoveredMoment& m : s.discovered_terms) {
-    json terms = json::array();
-    for (const DiscoveredMoment::Term& t : m.terms) {
-      terms.push_back({{"term", t.name},
-                       {"formula", t.formula},
-                       {"parameter", t.estimate.name},
-                       {"units", t.units},
-                       {"estimate", Estimate(t.estimate)}});
-    }
-    discovered.push_back({{"segment", m.segment},
-                          {"joints", {m.first_joint, m.last_joint}},
-                          {"axis", m.axis == 0 ? "x" : "y"},
-                          {"terms", terms},
-                          {"formula", m.Formula()}});
-  }
+  for (const DiscoveredMoment& m : s.discovered_terms) discovered.push_back(DiscoveredJson(m));
   j["discovered_terms"] = discovered;
   json params = json::object();
   for (const ParameterEstimate& p : s.final_fit.parameters) {
@@ -273,22 +282,21 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
 
 std::string LoopSummary::FullReport() const {
   std::ostringstream out;
-  out << "Declared model: training RMS " << Format("%.4f", rms_before_deg) << " deg";
-  if (holdout_rms_before_deg) out << ", held out " << Format("%.4f", *holdout_rms_before_deg);
+  out << "Declared model: training RMS " << Cell("%.4f", rms_before_deg) << " deg";
+  if (holdout_rms_before_deg) out << ", held out " << Cell("%.4f", *holdout_rms_before_deg);
   out << "\n";
   for (const LoopRound& r : rounds) {
-    out << "\nRound " << r.index << " (training RMS " << Format("%.4f", r.rms_deg) << " deg)\n";
+    out << "\nRound " << r.index << " (training RMS " << Cell("%.4f", r.rms_deg) << " deg)\n";
     out << "  candidate                                  score     p        refit  dBIC     RMS    "
            "  "
            "held-out  accepted\n";
     for (const CandidateResult& c : r.candidates) {
       char line[256];
       std::snprintf(line, sizeof(line), "  %-41s %9s %8s  %-5s %8s %8s %9s  %s\n", c.name.c_str(),
-                    Format("%.1f", c.score).c_str(), Format("%.2g", c.p_value).c_str(),
-                    c.refitted ? "yes" : "no",
-                    c.refitted ? Format("%.1f", c.delta_bic).c_str() : "-",
-                    c.refitted ? Format("%.4f", c.rms_deg).c_str() : "-",
-                    c.holdout_rms_deg ? Format("%.4f", *c.holdout_rms_deg).c_str() : "-",
+                    Cell("%.1f", c.score).c_str(), Cell("%.2g", c.p_value).c_str(),
+                    c.refitted ? "yes" : "no", c.refitted ? Cell("%.1f", c.delta_bic).c_str() : "-",
+                    c.refitted ? Cell("%.4f", c.rms_deg).c_str() : "-",
+                    c.holdout_rms_deg ? Cell("%.4f", *c.holdout_rms_deg).c_str() : "-",
                     c.accepted ? "yes" : "no");
       out << line;
     }
@@ -300,10 +308,10 @@ std::string LoopSummary::FullReport() const {
   out << "\nParameters of the final model:\n";
   for (const ParameterEstimate& p : final_fit.parameters) {
     if (!p.free) continue;
-    out << "  " << p.name << " = " << Format("%.6g", p.value);
+    out << "  " << p.name << " = " << Cell("%.6g", p.value);
     if (p.identifiable) {
-      out << " ± " << Format("%.2g", p.std_error) << " " << p.units << "  (95 % ["
-          << Format("%.6g", p.ci95_lower) << ", " << Format("%.6g", p.ci95_upper) << "])";
+      out << " ± " << Cell("%.2g", p.std_error) << " " << p.units << "  (95 % ["
+          << Cell("%.6g", p.ci95_lower) << ", " << Cell("%.6g", p.ci95_upper) << "])";
     } else {
       out << " " << p.units << "  (not identifiable)";
     }
@@ -318,24 +326,24 @@ std::string LoopSummary::FullReport() const {
     for (const DiscoveredMoment& m : discovered_terms) out << "  " << m.Formula() << "\n";
   }
   out << "\nRMS error [deg]      before    after\n";
-  out << "  training          " << Format("%.4f", rms_before_deg) << "   "
-      << Format("%.4f", rms_after_deg) << "\n";
+  out << "  training          " << Cell("%.4f", rms_before_deg) << "   "
+      << Cell("%.4f", rms_after_deg) << "\n";
   if (holdout_rms_before_deg && holdout_rms_after_deg) {
-    out << "  held out          " << Format("%.4f", *holdout_rms_before_deg) << "   "
-        << Format("%.4f", *holdout_rms_after_deg) << "\n";
+    out << "  held out          " << Cell("%.4f", *holdout_rms_before_deg) << "   "
+        << Cell("%.4f", *holdout_rms_after_deg) << "\n";
   }
   if (!unexplained.empty()) {
     out << "\nUnexplained (RMS above the noise):\n";
     for (std::size_t k = 0; k < unexplained.size() && k < 12; ++k) {
       const UnexplainedChannel& u = unexplained[k];
       out << "  " << u.experiment << " joint " << u.joint << (u.axis == 0 ? " θx " : " θy ")
-          << Format("%.4f", u.rms_deg) << " deg (noise " << Format("%.4f", u.noise_deg)
+          << Cell("%.4f", u.rms_deg) << " deg (noise " << Cell("%.4f", u.noise_deg)
           << "), worst in " << u.worst_phase << "\n";
     }
     if (unexplained.size() > 12) out << "  ... and " << unexplained.size() - 12 << " more\n";
   }
   out << "\n" << conclusion << "\n";
-  out << simulations << " simulations, " << Format("%.0f", wall_time_s) << " s wall on " << threads
+  out << simulations << " simulations, " << Cell("%.0f", wall_time_s) << " s wall on " << threads
       << " threads\n";
   return out.str();
 }

@@ -9,6 +9,7 @@
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/sim/effects.h"
+#include "text.h"
 
 namespace ccsrm::identify::internal {
 
@@ -30,12 +31,6 @@ std::vector<std::string> SizeParameters(const std::string& effect, const sim::Ar
 }
 
 }  // namespace
-
-std::string Format(const char* format, double value) {
-  char text[96];
-  std::snprintf(text, sizeof(text), format, value);
-  return text;
-}
 
 // The secant step of a size parameter in the score test: its realistic
 // magnitude, which is inside its bounds and large enough to rise above the
@@ -102,12 +97,6 @@ std::map<std::string, double> ValuesOf(const IdentificationSummary& fit,
     if (p.free) values[p.name] = p.value;
   }
   return values;
-}
-
-std::string Join(const std::vector<std::string>& names) {
-  std::string out;
-  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
-  return out;
 }
 
 void LoopState::Progress(int round, const std::string& stage, const std::string& candidate,

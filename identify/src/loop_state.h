@@ -24,6 +24,7 @@
 
 #include "ccsrm/identify/loop.h"
 #include "declared_values.h"
+#include "text.h"
 
 namespace ccsrm::identify::internal {
 
@@ -33,12 +34,6 @@ inline constexpr double kDeg = 180.0 / M_PI;
 // that carries them (sim/effects.h).
 inline constexpr const char* kTermsCandidate = "terms";
 inline constexpr const char* kTermsEffect = "joint_moment";
-
-// printf of one number into a string.
-std::string Format(const char* format, double value);
-
-// "a, b, c".
-std::string Join(const std::vector<std::string>& names);
 
 // The held-out experiments at a fit's values.
 struct HoldoutResult {

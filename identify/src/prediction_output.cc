@@ -10,16 +10,10 @@
 #include "ccsrm/datasets/run_file.h"
 #include "ccsrm/identify/prediction.h"
 #include "ccsrm/sim_io/run_file.h"
+#include "text.h"
 
 namespace ccsrm::identify {
 namespace {
-
-std::string Format(const char* format, double value) {
-  if (!std::isfinite(value)) return "-";
-  char text[64];
-  std::snprintf(text, sizeof(text), format, value);
-  return text;
-}
 
 // JSON has no NaN: unknown numbers are null.
 nlohmann::json Number(double value) {
@@ -52,9 +46,7 @@ nlohmann::json ErrorsJson(const PredictionErrors& e) {
 }
 
 std::string EffectList(const std::vector<std::string>& effects) {
-  std::string out;
-  for (const std::string& e : effects) out += (out.empty() ? "" : ", ") + e;
-  return out.empty() ? "none" : out;
+  return effects.empty() ? "none" : Join(effects);
 }
 
 }  // namespace
@@ -65,10 +57,9 @@ std::string PredictionSummary::BriefReport() const {
                 "prediction of %zu recording%s with %s (effects: %s): RMS %s deg, max %s deg, "
                 "weighted RMS %s (1 = the noise floor); %zu of %zu channels above the noise%s",
                 recordings.size(), recordings.size() == 1 ? "" : "s", model.source.c_str(),
-                EffectList(effects).c_str(),
-                Format("%.4f", errors.channels.rms_deg_overall).c_str(),
-                Format("%.4f", errors.max_abs_deg_overall).c_str(),
-                Format("%.3f", errors.weighted_rms).c_str(), above_noise.size(), channels,
+                EffectList(effects).c_str(), Cell("%.4f", errors.channels.rms_deg_overall).c_str(),
+                Cell("%.4f", errors.max_abs_deg_overall).c_str(),
+                Cell("%.3f", errors.weighted_rms).c_str(), above_noise.size(), channels,
                 completed ? "" : (" (a run did not complete: " + message + ")").c_str());
   return text;
 }
@@ -84,29 +75,28 @@ std::string PredictionSummary::FullReport() const {
   }
   for (const PredictionModel::Effects& e : model.effects) out << "; effects from " << e.file;
   out << "\n  " << simulations << " simulations on " << threads << " thread"
-      << (threads == 1 ? "" : "s") << ", " << Format("%.1f", wall_time_s) << " s\n\n";
+      << (threads == 1 ? "" : "s") << ", " << Cell("%.1f", wall_time_s) << " s\n\n";
   out << "  joint   RMS θx [deg]   RMS θy [deg]   max θx [deg]   max θy [deg]   noise [deg]   "
          "RMS/noise θx  RMS/noise θy\n";
   const PredictionErrors& e = errors;
   for (std::size_t j = 0; j < e.channels.rms_deg.size(); ++j) {
     char line[256];
     std::snprintf(line, sizeof(line), "  %5zu   %-14s %-14s %-14s %-14s %-13s %-13s %s\n", j + 1,
-                  Format("%.4f", e.channels.rms_deg[j][0]).c_str(),
-                  Format("%.4f", e.channels.rms_deg[j][1]).c_str(),
-                  Format("%.4f", e.max_abs_deg[j][0]).c_str(),
-                  Format("%.4f", e.max_abs_deg[j][1]).c_str(),
-                  Format("%.4f", e.noise_deg[j]).c_str(),
-                  Format("%.2f", e.channels.rms_deg[j][0] / e.noise_deg[j]).c_str(),
-                  Format("%.2f", e.channels.rms_deg[j][1] / e.noise_deg[j]).c_str());
+                  Cell("%.4f", e.channels.rms_deg[j][0]).c_str(),
+                  Cell("%.4f", e.channels.rms_deg[j][1]).c_str(),
+                  Cell("%.4f", e.max_abs_deg[j][0]).c_str(),
+                  Cell("%.4f", e.max_abs_deg[j][1]).c_str(), Cell("%.4f", e.noise_deg[j]).c_str(),
+                  Cell("%.2f", e.channels.rms_deg[j][0] / e.noise_deg[j]).c_str(),
+                  Cell("%.2f", e.channels.rms_deg[j][1] / e.noise_deg[j]).c_str());
     out << line;
   }
   out << "\n";
   for (const RecordingPrediction& r : recordings) {
     double noise = 0.0;
     for (double s : r.errors.noise_deg) noise += s / static_cast<double>(r.errors.noise_deg.size());
-    out << "  " << r.name << ": RMS " << Format("%.4f", r.errors.channels.rms_deg_overall)
-        << " deg, max " << Format("%.4f", r.errors.max_abs_deg_overall) << " deg, weighted RMS "
-        << Format("%.3f", r.errors.weighted_rms) << ", noise " << Format("%.4f", noise) << " deg ("
+    out << "  " << r.name << ": RMS " << Cell("%.4f", r.errors.channels.rms_deg_overall)
+        << " deg, max " << Cell("%.4f", r.errors.max_abs_deg_overall) << " deg, weighted RMS "
+        << Cell("%.3f", r.errors.weighted_rms) << ", noise " << Cell("%.4f", noise) << " deg ("
         << r.noise_source << ")"
         << (r.angles_from_pipeline ? ", angles from the mocap pipeline" : "")
         << (r.run.summary.completed() ? "" : ", run: " + r.run.summary.message) << "\n";
@@ -127,8 +117,8 @@ std::string PredictionSummary::FullReport() const {
         break;
       }
       out << (k == 0 ? " " : "; ") << c.recording << " joint " << c.joint
-          << (c.axis == 0 ? " θx " : " θy ") << Format("%.4f", c.rms_deg) << " deg ("
-          << Format("%.1f", c.rms_deg / c.noise_deg) << "x)";
+          << (c.axis == 0 ? " θx " : " θy ") << Cell("%.4f", c.rms_deg) << " deg ("
+          << Cell("%.1f", c.rms_deg / c.noise_deg) << "x)";
     }
     out << "\n";
   }

@@ -13,17 +13,12 @@
 #include "ccsrm/common/error.h"
 #include "finite_difference.h"
 #include "run_pool.h"
+#include "text.h"
 
 namespace ccsrm::identify {
 namespace {
 
 using internal::Rms;
-
-std::string Format(const char* format, double value) {
-  char text[64];
-  std::snprintf(text, sizeof(text), format, value);
-  return text;
-}
 
 // ||a - b|| / max(||a||, ||b||); 0 when both are exactly zero.
 double Disagreement(const std::vector<double>& a, const std::vector<double>& b) {

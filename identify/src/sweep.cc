@@ -11,15 +11,10 @@
 #include "ccsrm/identify/sensitivity.h"
 #include "finite_difference.h"
 #include "run_pool.h"
+#include "text.h"
 
 namespace ccsrm::identify {
 namespace {
-
-std::string Format(const char* format, double value) {
-  char text[64];
-  std::snprintf(text, sizeof(text), format, value);
-  return text;
-}
 
 double RowRms(const Eigen::MatrixXd& m, Eigen::Index row) {
   return m.cols() == 0 ? 0.0 : std::sqrt(m.row(row).squaredNorm() / static_cast<double>(m.cols()));

@@ -123,6 +123,20 @@ std::vector<std::string> Paths(const py::object& data) {
   return paths;
 }
 
+// The arguments identify and loop take alike, as their jobs take them.
+void FillFitJob(const py::object& data, const py::object& free, const py::object& params,
+                const py::object& set, std::optional<int> threads, int max_iterations,
+                std::optional<double> noise_deg, const py::object& out, bool resume,
+                identify::FitJobOptions* job) {
+  job->data = Paths(data);
+  job->parameters = Parameters(free, params, set);
+  if (threads) job->runs.threads = *threads;
+  job->max_iterations = max_iterations;
+  job->noise_deg = noise_deg;
+  job->out = OptionalPath(out);
+  job->resume = resume;
+}
+
 std::shared_ptr<Loop> RunLoop(const py::object& data, const py::object& holdout,
                               const py::object& candidates, const py::object& free,
                               const py::object& params, const py::object& set,
@@ -130,17 +144,11 @@ std::shared_ptr<Loop> RunLoop(const py::object& data, const py::object& holdout,
                               int max_iterations, std::optional<double> noise_deg,
                               const py::object& out, bool resume, const py::object& progress) {
   identify::LoopJobOptions job;
-  job.data = Paths(data);
+  FillFitJob(data, free, params, set, threads, max_iterations, noise_deg, out, resume, &job);
   job.holdout = Paths(holdout);
   if (!candidates.is_none()) job.candidates = Names(candidates, "--candidates");
-  job.parameters = Parameters(free, params, set);
   job.config_path = OptionalPath(config);
-  if (threads) job.runs.threads = *threads;
   job.max_rounds = max_rounds;
-  job.max_iterations = max_iterations;
-  job.noise_deg = noise_deg;
-  job.out = OptionalPath(out);
-  job.resume = resume;
   ProgressRelay relay(progress);
   if (relay.active()) {
     job.reporting.on_loop_progress = [&relay](const identify::LoopProgress& p) {
@@ -166,15 +174,9 @@ std::shared_ptr<Fit> RunIdentify(const py::object& data, const py::object& free,
                                  bool central_throughout, const py::object& out, bool resume,
                                  const py::object& progress) {
   identify::IdentifyJobOptions job;
-  job.data = Paths(data);
-  job.parameters = Parameters(free, params, set);
-  if (threads) job.runs.threads = *threads;
-  job.max_iterations = max_iterations;
+  FillFitJob(data, free, params, set, threads, max_iterations, noise_deg, out, resume, &job);
   job.relative_step = relative_step;
-  job.noise_deg = noise_deg;
   job.central_differences_throughout = central_throughout;
-  job.out = OptionalPath(out);
-  job.resume = resume;
   ProgressRelay relay(progress);
   if (relay.active()) {
     job.reporting.on_iteration = [&relay](const identify::IterationProgress& p) {

@@ -588,15 +588,12 @@ Section ExperimentSection(const FitFolder& fit) {
       "fit.json 'experiments': the file fitted, where its measured angles came from, how the "
       "noise that weights its residuals was found, its errors at the start and fitted, and the "
       "status of its run with the fitted parameters (the run and angles files in this folder).";
-  table.columns = {{"experiment", "experiment", "", kRms},
-                   {"file", "file", "", kRms},
-                   {"angles", "measured angles", "", kRms},
-                   {"noise_source", "noise from", "", kRms},
-                   {"rms_start_deg", "RMS start", "deg", kRms},
-                   {"rms_fitted_deg", "RMS fitted", "deg", kRms},
-                   {"fit_start_percent", "fit start", "%", kPercent},
-                   {"fit_fitted_percent", "fit fitted", "%", kPercent},
-                   {"fitted_run", "fitted run", "", kRms}};
+  table.columns = internal::RecordingColumns("experiment");
+  table.columns.insert(table.columns.end(), {{"rms_start_deg", "RMS start", "deg", kRms},
+                                             {"rms_fitted_deg", "RMS fitted", "deg", kRms},
+                                             {"fit_start_percent", "fit start", "%", kPercent},
+                                             {"fit_fitted_percent", "fit fitted", "%", kPercent},
+                                             {"fitted_run", "fitted run", "", kRms}});
   Table noise;
   noise.id = "noise";
   noise.title = "Measurement noise per joint";
@@ -605,12 +602,12 @@ Section ExperimentSection(const FitFolder& fit) {
   noise.columns = {{"joint", "joint", "", NumberFormat::Integer()}};
   std::set<std::string> keys = {"joint"};
   for (const FitExperiment& e : fit.experiments) {
-    table.AddRow({Cell::Text(e.name), Cell::Text(e.path),
-                  Cell::Text(e.angles_from_pipeline ? "from the mocap pipeline"
-                                                    : "stored in the experiment"),
-                  Cell::Text(e.noise_source), Cell::Number(e.start.rms_deg),
-                  Cell::Number(e.fitted.rms_deg), Cell::Number(e.start.fit_percent),
-                  Cell::Number(e.fitted.fit_percent), Cell::Text(e.run_status)});
+    std::vector<Cell> row = internal::RecordingCells("experiment", e.name, e.path,
+                                                     e.angles_from_pipeline, e.noise_source);
+    row.insert(row.end(), {Cell::Number(e.start.rms_deg), Cell::Number(e.fitted.rms_deg),
+                           Cell::Number(e.start.fit_percent), Cell::Number(e.fitted.fit_percent),
+                           Cell::Text(e.run_status)});
+    table.AddRow(std::move(row));
     std::string key = "noise_deg_" + Key(e.name);
     while (!keys.insert(key).second) key += "_";
     noise.columns.push_back({key, e.name, "deg", NumberFormat::Fixed(4)});

@@ -153,6 +153,22 @@ std::string Plural(double n, const std::string& noun) {
   return Show(n, NumberFormat::Integer()) + " " + noun + (n == 1.0 ? "" : "s");
 }
 
+std::vector<Column> RecordingColumns(const std::string& noun) {
+  const NumberFormat text = NumberFormat::Fixed(4);  // the format of a text column is not used
+  return {{noun, noun, "", text},
+          {"file", "file", "", text},
+          {"angles", "measured angles", "", text},
+          {"noise_source", "noise from", "", text}};
+}
+
+std::vector<Cell> RecordingCells(const std::string& noun, const std::string& name,
+                                 const std::string& path, bool angles_from_pipeline,
+                                 const std::string& noise_source) {
+  return {Cell::Text(name), Cell::Text(path),
+          Cell::Text(angles_from_pipeline ? "from the mocap pipeline" : "stored in the " + noun),
+          Cell::Text(noise_source)};
+}
+
 std::string ListNames(const std::vector<std::string>& names) {
   std::string out;
   for (std::size_t i = 0; i < names.size(); ++i) {

@@ -82,6 +82,15 @@ void AddText(Table* table, const std::string& quantity, const std::string& text)
 std::string Show(double value, NumberFormat format);
 // "3 iterations", "1 thread".
 std::string Plural(double n, const std::string& noun);
+// The columns a page's table of recordings begins with: what was fitted or
+// predicted (`noun`: "experiment", "recording"), its file, where its
+// measured angles came from and how the noise weighting its residuals was
+// found; and a row's cells for them.
+std::vector<Column> RecordingColumns(const std::string& noun);
+std::vector<Cell> RecordingCells(const std::string& noun, const std::string& name,
+                                 const std::string& path, bool angles_from_pipeline,
+                                 const std::string& noise_source);
+
 // "a", "a and b", "a, b and c".
 std::string ListNames(const std::vector<std::string>& names);
 // " N" after a value, or nothing for a pure number (units "" or "1").

@@ -331,21 +331,17 @@ Section RecordingsSection(const PredictionFolder& p) {
       "pred.json 'recordings': the file predicted, where its measured angles came from, how its "
       "noise was found, its errors and the status of its predicted run (the run and angles "
       "files in this folder).";
-  table.columns = {{"recording", "recording", "", kRms},
-                   {"file", "file", "", kRms},
-                   {"angles", "measured angles", "", kRms},
-                   {"noise_source", "noise from", "", kRms},
-                   {"rms_deg", "RMS", "deg", kRms},
-                   {"max_deg", "largest", "deg", kRms},
-                   {"weighted_rms", "weighted RMS", "", kRatio},
-                   {"run", "predicted run", "", kRms}};
+  table.columns = internal::RecordingColumns("recording");
+  table.columns.insert(table.columns.end(), {{"rms_deg", "RMS", "deg", kRms},
+                                             {"max_deg", "largest", "deg", kRms},
+                                             {"weighted_rms", "weighted RMS", "", kRatio},
+                                             {"run", "predicted run", "", kRms}});
   for (const PredictionRecording& r : p.recordings) {
-    table.AddRow(
-        {Cell::Text(r.name), Cell::Text(r.path),
-         Cell::Text(r.angles_from_pipeline ? "from the mocap pipeline" : "stored in the recording"),
-         Cell::Text(r.noise_source), Cell::Number(r.errors.rms_deg),
-         Cell::Number(r.errors.max_abs_deg), Cell::Number(r.errors.weighted_rms),
-         Cell::Text(r.run_status)});
+    std::vector<Cell> row = internal::RecordingCells("recording", r.name, r.path,
+                                                     r.angles_from_pipeline, r.noise_source);
+    row.insert(row.end(), {Cell::Number(r.errors.rms_deg), Cell::Number(r.errors.max_abs_deg),
+                           Cell::Number(r.errors.weighted_rms), Cell::Text(r.run_status)});
+    table.AddRow(std::move(row));
   }
   section.blocks.push_back(std::move(table));
   return section;

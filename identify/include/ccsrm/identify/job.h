@@ -69,22 +69,29 @@ struct JobRuns {
   double run_timeout_s = MpiOptions().run_timeout_s;
 };
 
-// `ccsrm identify` (README, docs/cluster.md for --resume).
-struct IdentifyJobOptions {
-  std::vector<std::string> data;  // experiment files (ccsrm-dataset/1), one or more
+// What the fitting jobs (identify, loop) take alike.
+struct FitJobOptions {
+  // Experiment files (ccsrm-dataset/1), one or more: the fitted (training)
+  // data.
+  std::vector<std::string> data;
   FitParameterChoice parameters;
-  int max_iterations = IdentificationOptions().max_iterations;
-  double relative_step = IdentificationOptions().relative_step;
-  bool central_differences_throughout = false;
+  int max_iterations = IdentificationOptions().max_iterations;  // per fit
   // Measurement noise of the joint angles [deg]; unset: estimated per joint.
   std::optional<double> noise_deg;
   JobRuns runs;
-  // The fit folder (fit.json, the fitted runs); empty: not written (then no
-  // checkpoint either).
+  // The job's folder; empty: not written (then no checkpoint or journal
+  // either).
   std::string out;
-  // Continue the fit stopped in `out` from its checkpoint.json.
+  // Continue the job stopped in `out` (identify: from its checkpoint.json;
+  // loop: running again over the journal of its runs).
   bool resume = false;
   JobReporting reporting;
+};
+
+// `ccsrm identify` (README, docs/cluster.md for --resume).
+struct IdentifyJobOptions : FitJobOptions {
+  double relative_step = IdentificationOptions().relative_step;
+  bool central_differences_throughout = false;
 };
 
 // What a job returns. On a rank other than 0 of an MPI job, `served` is
@@ -98,25 +105,15 @@ struct IdentifyJobResult {
 
 IdentifyJobResult RunIdentifyJob(const IdentifyJobOptions& options);
 
-// `ccsrm loop` (docs/loop.md).
-struct LoopJobOptions {
-  std::vector<std::string> data;     // training experiments, one or more
+// `ccsrm loop` (docs/loop.md). `parameters` are the declared model's.
+struct LoopJobOptions : FitJobOptions {
   std::vector<std::string> holdout;  // held-out experiments (may be none)
   // Candidate effects ('declared', 'terms' among them); unset: every one.
   std::optional<std::vector<std::string>> candidates;
-  FitParameterChoice parameters;  // of the declared model
   // The declared arm configuration instead of each recording's own; empty:
   // each file's config_yaml.
   std::string config_path;
   int max_rounds = LoopOptions().max_rounds;
-  int max_iterations = IdentificationOptions().max_iterations;
-  std::optional<double> noise_deg;  // unset: estimated per joint
-  JobRuns runs;
-  // The loop folder; empty: not written (then no journal either).
-  std::string out;
-  // Run again over the journal of the loop stopped in `out`.
-  bool resume = false;
-  JobReporting reporting;
 };
 
 struct LoopJobResult {
@@ -243,8 +240,5 @@ nlohmann::json ReadCheckpoint(const std::string& out, const CheckpointKey& key);
 // job's outputs are written.
 void WriteCheckpoint(const std::string& out, const CheckpointKey& key, const nlohmann::json& state);
 void RemoveCheckpoint(const std::string& out);
-
-// "a, b, c": names for a line of text.
-std::string JoinNames(const std::vector<std::string>& names);
 
 }  // namespace ccsrm::identify

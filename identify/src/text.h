@@ -1,5 +1,7 @@
 #pragma once
-// Text the jobs (job.h) report and digest.
+// Text identify/ prints, writes and digests: one printf into a string, one
+// table cell, one list joiner.
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <string>
@@ -20,6 +22,19 @@ inline std::string Format(const char* format, ...) {
   std::string text(n > 0 ? static_cast<std::size_t>(n) : 0, '\0');
   if (n > 0) std::vsnprintf(text.data(), text.size() + 1, format, again);
   va_end(again);
+  return text;
+}
+
+// A table cell: the number as `format` prints it, "-" when it is not finite
+// (a value that was not computed).
+inline std::string Cell(const char* format, double value) {
+  return std::isfinite(value) ? Format(format, value) : std::string("-");
+}
+
+// "a, b, c": names for a line of text.
+inline std::string Join(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& n : names) text += (text.empty() ? "" : ", ") + n;
   return text;
 }
 
