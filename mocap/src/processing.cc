@@ -299,9 +299,25 @@ void FitChain(std::vector<ChainLink>* links) {
 
 }  // namespace internal
 
-ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<double>& time,
-                                const MarkerLayout& layout, const ProcessingOptions& options,
-                                const std::string& source, const JointChain* chain) {
+namespace {
+
+// The pipeline's markers and what every stage needs of the layout.
+struct PipelineMarkers {
+  PipelineMarkers(std::size_t frames, std::size_t markers)
+      : F(frames), K(markers), raw(frames, markers), work(frames, markers) {}
+  std::size_t F, K;                  // frames, layout markers
+  std::size_t B = 0, L = 0;          // bodies, links
+  std::vector<std::size_t> offset;   // first marker of each body
+  std::vector<std::size_t> body_of;  // body of each marker
+  // whole_loss[b][f]: no marker of body b seen in frame f.
+  std::vector<std::vector<bool>> whole_loss;
+  MarkerFrames raw;   // as recorded (in W once the ground is fitted)
+  MarkerFrames work;  // gaps filled
+};
+
+// Options, layout and table fit for processing. Returns the number of links.
+std::size_t CheckProcessingInputs(const MarkerTable& table, const MarkerLayout& layout,
+                                  const ProcessingOptions& options, const std::string& source) {
   std::string error;
   if (!options.IsValid(&error)) ThrowInputError(source, "processing options", error);
   ValidateMarkerLayout(layout, source);
@@ -320,7 +336,356 @@ ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<doub
                     "has no finite sample (every position NaN or infinite): no marker was ever "
                     "seen, so there is no pose to fit");
   }
+  int num_links = 0;
+  for (const RigidBody& body : layout.bodies) num_links = std::max(num_links, body.link);
+  return static_cast<std::size_t>(num_links);
+}
 
+// Raw markers in layout order, whole-body losses, and each marker's
+// visibility and gaps before filling.
+void ReadRawMarkers(const MarkerTable& table, const MarkerLayout& layout,
+                    const std::vector<std::optional<std::size_t>>& column,
+                    const std::vector<std::string>& names, PipelineMarkers* m,
+                    ProcessingSummary* summary) {
+  const std::size_t F = m->F, K = m->K, B = m->B;
+  for (std::size_t k = 0; k < K; ++k) {
+    if (!column[k]) continue;
+    for (std::size_t f = 0; f < F; ++f) {
+      if (table.is_valid(f, *column[k])) m->raw.set(f, k, table.position(f, *column[k]));
+    }
+  }
+  m->whole_loss.assign(B, std::vector<bool>(F, true));
+  for (std::size_t b = 0; b < B; ++b) {
+    for (std::size_t f = 0; f < F; ++f) {
+      for (std::size_t i = 0; i < layout.bodies[b].marker_names.size(); ++i) {
+        if (m->raw.finite(f, m->offset[b] + i)) {
+          m->whole_loss[b][f] = false;
+          break;
+        }
+      }
+    }
+  }
+  summary->markers.resize(K);
+  m->body_of.assign(K, 0);
+  for (std::size_t b = 0; b < B; ++b) {
+    for (std::size_t i = 0; i < layout.bodies[b].marker_names.size(); ++i) {
+      const std::size_t k = m->offset[b] + i;
+      m->body_of[k] = b;
+      MarkerQuality& q = summary->markers[k];
+      q.name = names[k];
+      q.body = layout.bodies[b].name;
+      q.in_file = column[k].has_value();
+      std::size_t seen = 0;
+      for (std::size_t f = 0; f < F; ++f) seen += m->raw.finite(f, k);
+      q.visibility = static_cast<double>(seen) / static_cast<double>(F);
+      const std::vector<Gap> gaps = FindGaps(m->raw.column(k, 0), F, m->raw.stride());
+      q.gaps_before_fill = gaps.size();
+      q.longest_gap_before_fill = LongestGap(gaps);
+    }
+  }
+}
+
+// Gaps filled by splines (never across a whole-body loss), then from the
+// body's other markers (rigid fill), and each marker's gaps after.
+void FillGaps(const MarkerLayout& layout, const ProcessingOptions& options, PipelineMarkers* m,
+              ProcessingSummary* summary) {
+  const std::size_t F = m->F, K = m->K, B = m->B;
+  MarkerFrames& work = m->work;
+  work = m->raw;
+  for (std::size_t k = 0; k < K; ++k) {
+    const std::vector<bool>& lost = m->whole_loss[m->body_of[k]];
+    for (const Gap& gap : FindGaps(work.column(k, 0), F, work.stride())) {
+      if (gap.length > static_cast<std::size_t>(options.max_spline_gap_frames)) continue;
+      // Never across a whole-body loss: nothing of the body was seen there.
+      if (std::any_of(lost.begin() + static_cast<std::ptrdiff_t>(gap.first),
+                      lost.begin() + static_cast<std::ptrdiff_t>(gap.first + gap.length),
+                      [](bool l) { return l; })) {
+        continue;
+      }
+      bool filled = true;
+      for (int axis = 0; axis < 3; ++axis) {
+        filled = FillGapBySpline(work.column(k, axis), F, gap,
+                                 static_cast<std::size_t>(options.spline_context_frames),
+                                 work.stride()) &&
+                 filled;
+      }
+      if (filled) summary->markers[k].spline_filled_frames += gap.length;
+    }
+  }
+  if (options.rigid_fill) {
+    std::vector<Eigen::Vector3d> from, to;
+    for (std::size_t b = 0; b < B; ++b) {
+      const RigidBody& body = layout.bodies[b];
+      const std::size_t n = body.marker_names.size();
+      const std::size_t first = m->offset[b];
+      for (std::size_t f = 0; f < F; ++f) {
+        from.clear();
+        to.clear();
+        for (std::size_t i = 0; i < n; ++i) {
+          if (work.finite(f, first + i)) {
+            from.push_back(body.p_BM[i]);
+            to.push_back(work.get(f, first + i));
+          }
+        }
+        if (from.size() < 3 || from.size() == n) continue;
+        const Eigen::Isometry3d X = FitRigidTransform(from, to);
+        for (std::size_t i = 0; i < n; ++i) {
+          if (!work.finite(f, first + i)) {
+            work.set(f, first + i, X * body.p_BM[i]);
+            ++summary->markers[first + i].rigid_filled_frames;
+          }
+        }
+      }
+    }
+  }
+  for (std::size_t k = 0; k < K; ++k) {
+    const std::vector<Gap> gaps = FindGaps(work.column(k, 0), F, work.stride());
+    summary->markers[k].gaps_after_fill = gaps.size();
+    summary->markers[k].longest_gap_after_fill = LongestGap(gaps);
+  }
+}
+
+// World frame from the ground cluster: the ground does not move, so one
+// transform from the markers' mean positions over the whole trial averages
+// their noise away. Every marker is moved into W.
+void AlignToGround(const MarkerLayout& layout, PipelineMarkers* m, ProcessingSummary* summary) {
+  const std::size_t F = m->F, K = m->K;
+  Eigen::Isometry3d X_WF = Eigen::Isometry3d::Identity();
+  for (std::size_t b = 0; b < m->B; ++b) {
+    const RigidBody& body = layout.bodies[b];
+    if (body.link != 0) continue;
+    std::vector<Eigen::Vector3d> mean_F, p_W;
+    for (std::size_t i = 0; i < body.marker_names.size(); ++i) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      std::size_t count = 0;
+      for (std::size_t f = 0; f < F; ++f) {
+        if (m->work.finite(f, m->offset[b] + i)) {
+          sum += m->work.get(f, m->offset[b] + i);
+          ++count;
+        }
+      }
+      if (count > 0) {
+        mean_F.push_back(sum / static_cast<double>(count));
+        p_W.push_back(body.p_BM[i]);
+      }
+    }
+    if (mean_F.size() >= 3) {
+      X_WF = FitRigidTransform(mean_F, p_W);
+      summary->world_from_ground = true;
+      double sum_sq = 0.0;
+      for (std::size_t i = 0; i < mean_F.size(); ++i)
+        sum_sq += (X_WF * mean_F[i] - p_W[i]).squaredNorm();
+      summary->ground_fit_rms_m = std::sqrt(sum_sq / static_cast<double>(mean_F.size()));
+    } else {
+      summary->warnings.push_back("ground markers seen fewer than 3: the file frame is taken as W");
+    }
+  }
+  for (MarkerFrames* frames : {&m->raw, &m->work}) {
+    for (std::size_t f = 0; f < F; ++f) {
+      for (std::size_t k = 0; k < K; ++k) {
+        if (frames->finite(f, k)) frames->set(f, k, X_WF * frames->get(f, k));
+      }
+    }
+  }
+}
+
+// X_WB[b][f]: every body's pose in every frame where it has at least 3
+// markers, refined by the joint-constrained fit over runs of consecutive
+// posed links when `chain` is given and asked for.
+using BodyPoses = std::vector<std::vector<std::optional<Eigen::Isometry3d>>>;
+BodyPoses FitBodies(const MarkerLayout& layout, const ProcessingOptions& options,
+                    const JointChain* chain, const std::string& source, const PipelineMarkers& m,
+                    ProcessingSummary* summary) {
+  const std::size_t F = m.F, B = m.B, L = m.L;
+  if (chain != nullptr && options.joint_constrained_fit &&
+      (chain->p_BJ_proximal.size() < L || chain->p_BJ_distal.size() < L)) {
+    ThrowInputError(source, "joint chain",
+                    "has " + std::to_string(chain->p_BJ_proximal.size()) +
+                        " links, the rigid bodies need " + std::to_string(L));
+  }
+  BodyPoses X_WB(B, std::vector<std::optional<Eigen::Isometry3d>>(F));
+  std::vector<std::ptrdiff_t> body_of_link(L + 1, -1);
+  std::vector<Eigen::Vector3d> from, to;
+  for (std::size_t b = 0; b < B; ++b) {
+    const RigidBody& body = layout.bodies[b];
+    body_of_link[static_cast<std::size_t>(body.link)] = static_cast<std::ptrdiff_t>(b);
+    for (std::size_t f = 0; f < F; ++f) {
+      from.clear();
+      to.clear();
+      for (std::size_t i = 0; i < body.marker_names.size(); ++i) {
+        if (m.work.finite(f, m.offset[b] + i)) {
+          from.push_back(body.p_BM[i]);
+          to.push_back(m.work.get(f, m.offset[b] + i));
+        }
+      }
+      if (from.size() >= 3) X_WB[b][f] = FitRigidTransform(from, to);
+    }
+  }
+  if (chain == nullptr || !options.joint_constrained_fit) return X_WB;
+  summary->joint_constrained = true;
+  std::vector<internal::ChainLink> segment;
+  for (std::size_t f = 0; f < F; ++f) {
+    // Runs of consecutive links that all have a pose in this frame.
+    std::size_t link = 1;
+    while (link <= L) {
+      segment.clear();
+      while (link <= L && body_of_link[link] >= 0 &&
+             X_WB[static_cast<std::size_t>(body_of_link[link])][f]) {
+        const std::size_t b = static_cast<std::size_t>(body_of_link[link]);
+        internal::ChainLink c;
+        c.p_BJ_proximal = chain->p_BJ_proximal[link - 1];
+        c.p_BJ_distal = chain->p_BJ_distal[link - 1];
+        c.X_WB = &*X_WB[b][f];
+        for (std::size_t i = 0; i < layout.bodies[b].marker_names.size(); ++i) {
+          if (m.work.finite(f, m.offset[b] + i)) {
+            c.p_BM.push_back(layout.bodies[b].p_BM[i]);
+            c.p_WM.push_back(m.work.get(f, m.offset[b] + i));
+          }
+        }
+        segment.push_back(std::move(c));
+        ++link;
+      }
+      if (segment.size() >= 2) internal::FitChain(&segment);
+      if (segment.empty()) ++link;
+    }
+  }
+  return X_WB;
+}
+
+// The link poses and marker residuals of the fitted bodies, each body's and
+// marker's fit quality; returns R_WB of every link in every frame (identity
+// for the ground, link 0), set where fitted.
+using LinkRotations = std::vector<std::vector<std::optional<Eigen::Matrix3d>>>;
+LinkRotations StoreLinkPoses(const MarkerLayout& layout, const BodyPoses& X_WB,
+                             const PipelineMarkers& m, ProcessingResult* result) {
+  const std::size_t F = m.F, K = m.K, L = m.L;
+  ProcessingSummary& summary = result->summary;
+  result->link_pose = datasets::Array({F, L, 7}, kNaN);
+  result->marker_residual = datasets::Array({F, K}, kNaN);
+  LinkRotations R_WB(L + 1, std::vector<std::optional<Eigen::Matrix3d>>(F));
+  for (std::size_t f = 0; f < F; ++f) R_WB[0][f] = Eigen::Matrix3d::Identity();
+  summary.bodies.resize(m.B);
+  std::vector<double> marker_sum_sq(K, 0.0);
+  std::vector<std::size_t> marker_count(K, 0);
+  for (std::size_t b = 0; b < m.B; ++b) {
+    const RigidBody& body = layout.bodies[b];
+    BodyQuality& q = summary.bodies[b];
+    q.name = body.name;
+    q.link = body.link;
+    double sum_sq = 0.0;
+    std::size_t count = 0;
+    for (std::size_t f = 0; f < F; ++f) {
+      if (m.whole_loss[b][f]) {
+        ++q.whole_loss_frames;
+        if (f == 0 || !m.whole_loss[b][f - 1]) ++q.whole_loss_runs;
+      }
+      if (!X_WB[b][f]) {
+        ++q.frames_lost;
+        continue;
+      }
+      const Eigen::Isometry3d& X = *X_WB[b][f];
+      for (std::size_t i = 0; i < body.marker_names.size(); ++i) {
+        const std::size_t k = m.offset[b] + i;
+        if (!m.work.finite(f, k)) continue;
+        const double residual = (X * body.p_BM[i] - m.work.get(f, k)).norm();
+        result->marker_residual.at(f, k) = residual;
+        if (m.raw.finite(f, k)) {  // only seen samples: filled ones fit by construction
+          sum_sq += residual * residual;
+          ++count;
+          marker_sum_sq[k] += residual * residual;
+          ++marker_count[k];
+        }
+      }
+      if (body.link == 0) continue;  // the ground's frame is W by construction
+      const std::size_t l = static_cast<std::size_t>(body.link - 1);
+      R_WB[l + 1][f] = X.rotation();
+      const Eigen::Vector3d p_WB = X.translation();
+      for (int axis = 0; axis < 3; ++axis) result->link_pose.at(f, l, axis) = p_WB[axis];
+      StoreQuaternion(X.rotation(), &result->link_pose.values[(f * L + l) * 7 + 3]);
+    }
+    q.fit_rms_m = count > 0 ? std::sqrt(sum_sq / static_cast<double>(count)) : kNaN;
+  }
+  for (std::size_t k = 0; k < K; ++k) {
+    summary.markers[k].fit_rms_m =
+        marker_count[k] > 0 ? std::sqrt(marker_sum_sq[k] / static_cast<double>(marker_count[k]))
+                            : kNaN;
+  }
+  return R_WB;
+}
+
+// Every joint's X–Y Cardan angles and twist from its two links' rotations.
+void StoreJointAngles(const LinkRotations& R_WB, std::size_t F, std::size_t L,
+                      ProcessingResult* result) {
+  ProcessingSummary& summary = result->summary;
+  result->joint_angles = datasets::Array({F, L, 2}, kNaN);
+  result->joint_twist = datasets::Array({F, L}, kNaN);
+  summary.joints.resize(L);
+  for (std::size_t j = 0; j < L; ++j) {
+    summary.joints[j].joint = static_cast<int>(j + 1);
+    for (std::size_t f = 0; f < F; ++f) {
+      const auto& parent = R_WB[j][f];
+      const auto& child = R_WB[j + 1][f];
+      if (!parent || !child) {
+        ++summary.joints[j].frames_lost;
+        continue;
+      }
+      const Eigen::Vector3d angles = sim::CardanXyzAngles(parent->transpose() * *child);
+      result->joint_angles.at(f, j, 0) = angles[0];
+      result->joint_angles.at(f, j, 1) = angles[1];
+      result->joint_twist.at(f, j) = angles[2];
+    }
+  }
+}
+
+// Zero-lag low-pass of the fitted motion. After the fit, not before:
+// smoothing the markers of a swinging link pulls them inside their arcs,
+// which a rigid (and joint-constrained) fit can only absorb by turning the
+// link. The joint angles stay small, so filtering them is filtering the
+// markers' information linearly.
+void LowPassFittedMotion(const ProcessingOptions& options, double rate_hz, std::size_t F,
+                         std::size_t L, ProcessingResult* result) {
+  const std::vector<BiquadSection> sections =
+      DesignButterworthLowPass(options.filter_order, options.cutoff_hz, rate_hz);
+  const auto min_run = static_cast<std::size_t>(options.min_filter_run_frames);
+  auto filter_columns = [&](datasets::Array* array) {
+    const std::size_t columns = array->size() / F;
+    for (std::size_t c = 0; c < columns; ++c) {
+      ZeroLagLowPass(sections, options.cutoff_hz, rate_hz, array->values.data() + c, F, columns,
+                     min_run);
+    }
+  };
+  filter_columns(&result->joint_angles);
+  filter_columns(&result->joint_twist);
+  // Poses: positions, and quaternion components (one hemisphere along time,
+  // renormalised after), which is exact to first order for smooth motion.
+  datasets::Array& pose = result->link_pose;
+  for (std::size_t l = 0; l < L; ++l) {
+    for (std::size_t f = 1; f < F; ++f) {
+      double* q = &pose.values[(f * L + l) * 7 + 3];
+      const double* previous = q - L * 7;
+      if (!std::isfinite(q[0]) || !std::isfinite(previous[0])) continue;
+      if (q[0] * previous[0] + q[1] * previous[1] + q[2] * previous[2] + q[3] * previous[3] < 0) {
+        for (int i = 0; i < 4; ++i) q[i] = -q[i];
+      }
+    }
+  }
+  filter_columns(&pose);
+  for (std::size_t f = 0; f < F; ++f) {
+    for (std::size_t l = 0; l < L; ++l) {
+      double* q = &pose.values[(f * L + l) * 7 + 3];
+      const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+      for (int i = 0; i < 4; ++i) q[i] /= norm;
+    }
+  }
+}
+
+}  // namespace
+
+ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<double>& time,
+                                const MarkerLayout& layout, const ProcessingOptions& options,
+                                const std::string& source, const JointChain* chain) {
+  const std::size_t num_links = CheckProcessingInputs(table, layout, options, source);
+  const std::size_t F = table.frames();
   ProcessingResult result;
   ProcessingSummary& summary = result.summary;
   // What the reader noticed (a recording cut short, a missing unit) stays in
@@ -341,333 +706,34 @@ ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<doub
   }
 
   const std::vector<std::string> names = layout.MarkerNames();
-  const std::size_t K = names.size();
   result.marker_names = names;
   const std::vector<std::optional<std::size_t>> column =
       MatchMarkerLabels(names, table, &summary.warnings);
   if (std::none_of(column.begin(), column.end(), [](const auto& c) { return c.has_value(); })) {
     ThrowInputError(source, "labels", "no marker of the rigid bodies is in the file");
   }
-  {
-    std::vector<bool> used(table.markers(), false);
-    for (const auto& c : column) {
-      if (c) used[*c] = true;
-    }
-    summary.input_labels_unused =
-        static_cast<std::size_t>(std::count(used.begin(), used.end(), false));
+  std::vector<bool> used(table.markers(), false);
+  for (const auto& c : column) {
+    if (c) used[*c] = true;
   }
-  int num_links = 0;
-  for (const RigidBody& body : layout.bodies) num_links = std::max(num_links, body.link);
-  if (num_links == 0)
+  summary.input_labels_unused =
+      static_cast<std::size_t>(std::count(used.begin(), used.end(), false));
+  if (num_links == 0) {
     ThrowInputError(source, "bodies", "the rigid bodies hold no link (only the ground)");
-  const std::vector<std::size_t> offset = BodyOffsets(layout);
-  const std::size_t B = layout.bodies.size();
+  }
+  PipelineMarkers m(F, names.size());
+  m.offset = BodyOffsets(layout);
+  m.B = layout.bodies.size();
+  m.L = num_links;
 
-  // ---- Raw markers, visibility, whole-body losses --------------------------
-  MarkerFrames raw(F, K);
-  for (std::size_t k = 0; k < K; ++k) {
-    if (!column[k]) continue;
-    for (std::size_t f = 0; f < F; ++f) {
-      if (table.is_valid(f, *column[k])) raw.set(f, k, table.position(f, *column[k]));
-    }
-  }
-  // whole_loss[b][f]: no marker of body b seen in frame f.
-  std::vector<std::vector<bool>> whole_loss(B, std::vector<bool>(F, true));
-  for (std::size_t b = 0; b < B; ++b) {
-    for (std::size_t f = 0; f < F; ++f) {
-      for (std::size_t m = 0; m < layout.bodies[b].marker_names.size(); ++m) {
-        if (raw.finite(f, offset[b] + m)) {
-          whole_loss[b][f] = false;
-          break;
-        }
-      }
-    }
-  }
-  summary.markers.resize(K);
-  std::vector<std::size_t> body_of(K);
-  for (std::size_t b = 0; b < B; ++b) {
-    for (std::size_t m = 0; m < layout.bodies[b].marker_names.size(); ++m) {
-      const std::size_t k = offset[b] + m;
-      body_of[k] = b;
-      MarkerQuality& q = summary.markers[k];
-      q.name = names[k];
-      q.body = layout.bodies[b].name;
-      q.in_file = column[k].has_value();
-      std::size_t seen = 0;
-      for (std::size_t f = 0; f < F; ++f) seen += raw.finite(f, k);
-      q.visibility = static_cast<double>(seen) / static_cast<double>(F);
-      const std::vector<Gap> gaps = FindGaps(raw.column(k, 0), F, raw.stride());
-      q.gaps_before_fill = gaps.size();
-      q.longest_gap_before_fill = LongestGap(gaps);
-    }
-  }
-
-  // ---- Gap filling ------------------------------------------------------------
-  MarkerFrames work = raw;
-  for (std::size_t k = 0; k < K; ++k) {
-    const std::vector<bool>& lost = whole_loss[body_of[k]];
-    for (const Gap& gap : FindGaps(work.column(k, 0), F, work.stride())) {
-      if (gap.length > static_cast<std::size_t>(options.max_spline_gap_frames)) continue;
-      // Never across a whole-body loss: nothing of the body was seen there.
-      if (std::any_of(lost.begin() + static_cast<std::ptrdiff_t>(gap.first),
-                      lost.begin() + static_cast<std::ptrdiff_t>(gap.first + gap.length),
-                      [](bool l) { return l; })) {
-        continue;
-      }
-      bool filled = true;
-      for (int axis = 0; axis < 3; ++axis) {
-        filled = FillGapBySpline(work.column(k, axis), F, gap,
-                                 static_cast<std::size_t>(options.spline_context_frames),
-                                 work.stride()) &&
-                 filled;
-      }
-      if (filled) summary.markers[k].spline_filled_frames += gap.length;
-    }
-  }
-  if (options.rigid_fill) {
-    std::vector<Eigen::Vector3d> from, to;
-    for (std::size_t b = 0; b < B; ++b) {
-      const RigidBody& body = layout.bodies[b];
-      const std::size_t n = body.marker_names.size();
-      for (std::size_t f = 0; f < F; ++f) {
-        from.clear();
-        to.clear();
-        for (std::size_t m = 0; m < n; ++m) {
-          if (work.finite(f, offset[b] + m)) {
-            from.push_back(body.p_BM[m]);
-            to.push_back(work.get(f, offset[b] + m));
-          }
-        }
-        if (from.size() < 3 || from.size() == n) continue;
-        const Eigen::Isometry3d X = FitRigidTransform(from, to);
-        for (std::size_t m = 0; m < n; ++m) {
-          if (!work.finite(f, offset[b] + m)) {
-            work.set(f, offset[b] + m, X * body.p_BM[m]);
-            ++summary.markers[offset[b] + m].rigid_filled_frames;
-          }
-        }
-      }
-    }
-  }
-  for (std::size_t k = 0; k < K; ++k) {
-    const std::vector<Gap> gaps = FindGaps(work.column(k, 0), F, work.stride());
-    summary.markers[k].gaps_after_fill = gaps.size();
-    summary.markers[k].longest_gap_after_fill = LongestGap(gaps);
-  }
-
-  // ---- World frame from the ground cluster --------------------------------------
-  // The ground does not move: one transform from the markers' mean positions
-  // over the whole trial averages their noise away.
-  Eigen::Isometry3d X_WF = Eigen::Isometry3d::Identity();
-  for (std::size_t b = 0; b < B; ++b) {
-    const RigidBody& body = layout.bodies[b];
-    if (body.link != 0) continue;
-    std::vector<Eigen::Vector3d> mean_F, p_W;
-    for (std::size_t m = 0; m < body.marker_names.size(); ++m) {
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      std::size_t count = 0;
-      for (std::size_t f = 0; f < F; ++f) {
-        if (work.finite(f, offset[b] + m)) {
-          sum += work.get(f, offset[b] + m);
-          ++count;
-        }
-      }
-      if (count > 0) {
-        mean_F.push_back(sum / static_cast<double>(count));
-        p_W.push_back(body.p_BM[m]);
-      }
-    }
-    if (mean_F.size() >= 3) {
-      X_WF = FitRigidTransform(mean_F, p_W);
-      summary.world_from_ground = true;
-      double sum_sq = 0.0;
-      for (std::size_t i = 0; i < mean_F.size(); ++i)
-        sum_sq += (X_WF * mean_F[i] - p_W[i]).squaredNorm();
-      summary.ground_fit_rms_m = std::sqrt(sum_sq / static_cast<double>(mean_F.size()));
-    } else {
-      summary.warnings.push_back("ground markers seen fewer than 3: the file frame is taken as W");
-    }
-  }
-  for (MarkerFrames* frames : {&raw, &work}) {
-    for (std::size_t f = 0; f < F; ++f) {
-      for (std::size_t k = 0; k < K; ++k) {
-        if (frames->finite(f, k)) frames->set(f, k, X_WF * frames->get(f, k));
-      }
-    }
-  }
-
-  // ---- Rigid fit of every body in every frame -------------------------------------
-  const std::size_t L = static_cast<std::size_t>(num_links);
-  if (chain != nullptr && options.joint_constrained_fit &&
-      (chain->p_BJ_proximal.size() < L || chain->p_BJ_distal.size() < L)) {
-    ThrowInputError(source, "joint chain",
-                    "has " + std::to_string(chain->p_BJ_proximal.size()) +
-                        " links, the rigid bodies need " + std::to_string(L));
-  }
-  // X_WB of every body in every frame where it has at least 3 markers.
-  std::vector<std::vector<std::optional<Eigen::Isometry3d>>> X_WB(
-      B, std::vector<std::optional<Eigen::Isometry3d>>(F));
-  std::vector<std::ptrdiff_t> body_of_link(L + 1, -1);
-  {
-    std::vector<Eigen::Vector3d> from, to;
-    for (std::size_t b = 0; b < B; ++b) {
-      const RigidBody& body = layout.bodies[b];
-      body_of_link[static_cast<std::size_t>(body.link)] = static_cast<std::ptrdiff_t>(b);
-      for (std::size_t f = 0; f < F; ++f) {
-        from.clear();
-        to.clear();
-        for (std::size_t m = 0; m < body.marker_names.size(); ++m) {
-          if (work.finite(f, offset[b] + m)) {
-            from.push_back(body.p_BM[m]);
-            to.push_back(work.get(f, offset[b] + m));
-          }
-        }
-        if (from.size() >= 3) X_WB[b][f] = FitRigidTransform(from, to);
-      }
-    }
-  }
-  if (chain != nullptr && options.joint_constrained_fit) {
-    summary.joint_constrained = true;
-    std::vector<internal::ChainLink> segment;
-    for (std::size_t f = 0; f < F; ++f) {
-      // Runs of consecutive links that all have a pose in this frame.
-      std::size_t link = 1;
-      while (link <= L) {
-        segment.clear();
-        while (link <= L && body_of_link[link] >= 0 &&
-               X_WB[static_cast<std::size_t>(body_of_link[link])][f]) {
-          const std::size_t b = static_cast<std::size_t>(body_of_link[link]);
-          internal::ChainLink c;
-          c.p_BJ_proximal = chain->p_BJ_proximal[link - 1];
-          c.p_BJ_distal = chain->p_BJ_distal[link - 1];
-          c.X_WB = &*X_WB[b][f];
-          for (std::size_t m = 0; m < layout.bodies[b].marker_names.size(); ++m) {
-            if (work.finite(f, offset[b] + m)) {
-              c.p_BM.push_back(layout.bodies[b].p_BM[m]);
-              c.p_WM.push_back(work.get(f, offset[b] + m));
-            }
-          }
-          segment.push_back(std::move(c));
-          ++link;
-        }
-        if (segment.size() >= 2) internal::FitChain(&segment);
-        if (segment.empty()) ++link;
-      }
-    }
-  }
-  result.link_pose = datasets::Array({F, L, 7}, kNaN);
-  result.marker_residual = datasets::Array({F, K}, kNaN);
-  // R_WB of every link in every frame (identity for the ground, link 0), valid where fitted.
-  std::vector<std::vector<std::optional<Eigen::Matrix3d>>> R_WB(
-      L + 1, std::vector<std::optional<Eigen::Matrix3d>>(F));
-  for (std::size_t f = 0; f < F; ++f) R_WB[0][f] = Eigen::Matrix3d::Identity();
-  summary.bodies.resize(B);
-  std::vector<double> marker_sum_sq(K, 0.0);
-  std::vector<std::size_t> marker_count(K, 0);
-  for (std::size_t b = 0; b < B; ++b) {
-    const RigidBody& body = layout.bodies[b];
-    BodyQuality& q = summary.bodies[b];
-    q.name = body.name;
-    q.link = body.link;
-    double sum_sq = 0.0;
-    std::size_t count = 0;
-    for (std::size_t f = 0; f < F; ++f) {
-      if (whole_loss[b][f]) {
-        ++q.whole_loss_frames;
-        if (f == 0 || !whole_loss[b][f - 1]) ++q.whole_loss_runs;
-      }
-      if (!X_WB[b][f]) {
-        ++q.frames_lost;
-        continue;
-      }
-      const Eigen::Isometry3d& X = *X_WB[b][f];
-      for (std::size_t m = 0; m < body.marker_names.size(); ++m) {
-        const std::size_t k = offset[b] + m;
-        if (!work.finite(f, k)) continue;
-        const double residual = (X * body.p_BM[m] - work.get(f, k)).norm();
-        result.marker_residual.at(f, k) = residual;
-        if (raw.finite(f, k)) {  // only seen samples: filled ones fit by construction
-          sum_sq += residual * residual;
-          ++count;
-          marker_sum_sq[k] += residual * residual;
-          ++marker_count[k];
-        }
-      }
-      if (body.link == 0) continue;  // the ground's frame is W by construction
-      const std::size_t l = static_cast<std::size_t>(body.link - 1);
-      R_WB[l + 1][f] = X.rotation();
-      const Eigen::Vector3d p_WB = X.translation();
-      for (int axis = 0; axis < 3; ++axis) result.link_pose.at(f, l, axis) = p_WB[axis];
-      StoreQuaternion(X.rotation(), &result.link_pose.values[(f * L + l) * 7 + 3]);
-    }
-    q.fit_rms_m = count > 0 ? std::sqrt(sum_sq / static_cast<double>(count)) : kNaN;
-  }
-  for (std::size_t k = 0; k < K; ++k) {
-    summary.markers[k].fit_rms_m =
-        marker_count[k] > 0 ? std::sqrt(marker_sum_sq[k] / static_cast<double>(marker_count[k]))
-                            : kNaN;
-  }
-
-  // ---- Joint angles ---------------------------------------------------------------
-  result.joint_angles = datasets::Array({F, L, 2}, kNaN);
-  result.joint_twist = datasets::Array({F, L}, kNaN);
-  summary.joints.resize(L);
-  for (std::size_t j = 0; j < L; ++j) {
-    summary.joints[j].joint = static_cast<int>(j + 1);
-    for (std::size_t f = 0; f < F; ++f) {
-      const auto& parent = R_WB[j][f];
-      const auto& child = R_WB[j + 1][f];
-      if (!parent || !child) {
-        ++summary.joints[j].frames_lost;
-        continue;
-      }
-      const Eigen::Vector3d angles = sim::CardanXyzAngles(parent->transpose() * *child);
-      result.joint_angles.at(f, j, 0) = angles[0];
-      result.joint_angles.at(f, j, 1) = angles[1];
-      result.joint_twist.at(f, j) = angles[2];
-    }
-  }
-
-  // ---- Zero-lag low-pass of the fitted motion ------------------------------------
-  // After the fit, not before: smoothing the markers of a swinging link pulls
-  // them inside their arcs, which a rigid (and joint-constrained) fit can
-  // only absorb by turning the link. The joint angles stay small, so
-  // filtering them is filtering the markers' information linearly.
-  if (options.cutoff_hz > 0.0) {
-    const std::vector<BiquadSection> sections =
-        DesignButterworthLowPass(options.filter_order, options.cutoff_hz, rate_hz);
-    const auto min_run = static_cast<std::size_t>(options.min_filter_run_frames);
-    auto filter_columns = [&](datasets::Array* array) {
-      const std::size_t columns = array->size() / F;
-      for (std::size_t c = 0; c < columns; ++c) {
-        ZeroLagLowPass(sections, options.cutoff_hz, rate_hz, array->values.data() + c, F, columns,
-                       min_run);
-      }
-    };
-    filter_columns(&result.joint_angles);
-    filter_columns(&result.joint_twist);
-    // Poses: positions, and quaternion components (one hemisphere along time,
-    // renormalised after), which is exact to first order for smooth motion.
-    for (std::size_t l = 0; l < L; ++l) {
-      for (std::size_t f = 1; f < F; ++f) {
-        double* q = &result.link_pose.values[(f * L + l) * 7 + 3];
-        const double* previous = q - L * 7;
-        if (!std::isfinite(q[0]) || !std::isfinite(previous[0])) continue;
-        if (q[0] * previous[0] + q[1] * previous[1] + q[2] * previous[2] + q[3] * previous[3] < 0) {
-          for (int i = 0; i < 4; ++i) q[i] = -q[i];
-        }
-      }
-    }
-    filter_columns(&result.link_pose);
-    for (std::size_t f = 0; f < F; ++f) {
-      for (std::size_t l = 0; l < L; ++l) {
-        double* q = &result.link_pose.values[(f * L + l) * 7 + 3];
-        const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-        for (int i = 0; i < 4; ++i) q[i] /= norm;
-      }
-    }
-  }
-  for (std::size_t j = 0; j < L; ++j) {
+  ReadRawMarkers(table, layout, column, names, &m, &summary);
+  FillGaps(layout, options, &m, &summary);
+  AlignToGround(layout, &m, &summary);
+  const BodyPoses X_WB = FitBodies(layout, options, chain, source, m, &summary);
+  const LinkRotations R_WB = StoreLinkPoses(layout, X_WB, m, &result);
+  StoreJointAngles(R_WB, F, m.L, &result);
+  if (options.cutoff_hz > 0.0) LowPassFittedMotion(options, rate_hz, F, m.L, &result);
+  for (std::size_t j = 0; j < m.L; ++j) {
     double max_twist = kNaN;
     for (std::size_t f = 0; f < F; ++f) {
       const double twist = std::abs(result.joint_twist.at(f, j));
@@ -676,11 +742,10 @@ ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<doub
     }
     summary.joints[j].max_abs_twist_rad = max_twist;
   }
-
-  result.markers = datasets::Array({F, K, 3});
-  result.markers.values = std::move(work.values());
-  result.raw_markers = datasets::Array({F, K, 3});
-  result.raw_markers.values = std::move(raw.values());
+  result.markers = datasets::Array({F, m.K, 3});
+  result.markers.values = std::move(m.work.values());
+  result.raw_markers = datasets::Array({F, m.K, 3});
+  result.raw_markers.values = std::move(m.raw.values());
   return result;
 }
 
