@@ -36,6 +36,7 @@ constexpr int kDerivativesDisagree = 4;
 // status 2 and one line naming its option, like every other bad input.
 struct DerivativesArgs {
   sim::PaperRunOptions run;
+  MotionArgs motion;                      // --protocol or --inputs instead of the paper protocol
   std::optional<std::string> parameters;  // unset: every parameter
   std::string steps = "1e-2,3e-3";
   std::string threads = std::to_string(identify::DefaultThreads());
@@ -83,13 +84,22 @@ identify::ProgressCallback Progress(bool quiet) {
   };
 }
 
+// The motion in words: the paper protocol's amplitude, a protocol file's
+// name, or the recorded inputs' file.
+std::string MotionOf(const sim::PaperRun& run) {
+  if (run.protocol && !run.default_protocol) return "protocol '" + run.protocol->name + "'";
+  if (!run.inputs_source.empty()) return "inputs " + run.inputs_source;
+  char text[32];
+  std::snprintf(text, sizeof(text), "%+.3g deg", run.config.protocol.amplitude_rad * 180.0 / M_PI);
+  return text;
+}
+
 std::string Describe(const DerivativesArgs& a, const sim::PaperRun& run) {
   std::string text = "ccsrm derivatives: " + a.run.config_path + ", case " +
                      (run.case_number != 0 ? std::to_string(run.case_number) : "as configured");
-  char figures[128];
-  std::snprintf(figures, sizeof(figures), ", %+.3g deg, %.4g s simulated",
-                run.config.protocol.amplitude_rad * 180.0 / M_PI, run.simulation.duration_s);
-  text += figures;
+  char figures[64];
+  std::snprintf(figures, sizeof(figures), ", %.4g s simulated", run.simulation.duration_s);
+  text += ", " + MotionOf(run) + figures;
   if (!a.run.params_path.empty()) text += ", --params " + a.run.params_path;
   for (const std::string& s : a.run.sets) text += ", --set " + s;
   return text;
@@ -100,6 +110,8 @@ nlohmann::json RunJson(const DerivativesArgs& a, const sim::PaperRun& run) {
           {"case", run.case_number},
           {"amplitude_deg", run.config.protocol.amplitude_rad * 180.0 / M_PI},
           {"duration_s", run.simulation.duration_s},
+          {"protocol_yaml", sim::ProtocolYamlOf(run)},
+          {"inputs_file", run.inputs_source},
           {"params", a.run.params_path},
           {"sets", a.run.sets}};
 }
@@ -141,10 +153,11 @@ int RunDerivatives(const DerivativesArgs& a) {
   }
   if (!a.json.empty()) {
     CheckOutputPath(a.json, "--json", DerivativesJsonOutput(),
-                    {a.run.config_path, a.run.params_path});
+                    {a.run.config_path, a.run.params_path, sim::ProtocolFileOf(a.run.protocol_path),
+                     a.motion.inputs_path});
   }
 
-  const sim::PaperRun run = sim::PreparePaperRun(a.run);
+  const sim::PaperRun run = PrepareRun(a.run, a.motion);
   PrintConfigWarnings(run.config);
   // A parameter at 0 (the friction a case switches off) is stepped relative
   // to its value in the configuration file as written.
@@ -210,6 +223,7 @@ void AddDerivativesCommand(CLI::App& root) {
   auto a = std::make_shared<DerivativesArgs>();
   AddPaperRunOptions(cmd, &a->run);
   AddParameterOptions(cmd, &a->run);
+  AddMotionOptions(cmd, &a->run, &a->motion);
   cmd->add_option("--parameters", a->parameters,
                   "Parameters to differentiate, comma-separated (default: all of them)");
   cmd->add_option("--steps", a->steps, "Relative steps, comma-separated, at least two")

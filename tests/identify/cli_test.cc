@@ -61,6 +61,29 @@ TEST(DerivativesCommand, SweepsOneParameter) {
   EXPECT_THAT(o.out, HasSubstr("residual to the cubics"));
 }
 
+// The fast motions that pin kinetic friction are protocol files (issue 43):
+// the command follows one, with its parameters after '@', and records it.
+TEST(DerivativesCommand, FollowsAProtocolFileAndRecordsIt) {
+  const fs::path dir = ScratchDirectory("identify_cli_protocol");
+  const std::string json_path = (dir / "d.json").string();
+  const std::string protocol =
+      std::string(CCSRM_SOURCE_DIR) + "/configs/protocols/paper.yaml@amplitude_deg=-4";
+  const Outcome o =
+      RunCcsrm("derivatives --config " + Paper() + " --case 3 --protocol " + protocol +
+               " --duration 0.05 --parameters T_p --threads 2 --quiet --json " + json_path);
+  ASSERT_TRUE(o.status == 0 || o.status == 4) << o.all();
+  EXPECT_THAT(o.out, HasSubstr("protocol 'paper'"));
+  const nlohmann::json json = nlohmann::json::parse(ccsrm::ReadTextFile(json_path));
+  // The protocol as followed: its amplitude parameter as set after '@' [rad].
+  EXPECT_THAT(json["run"]["protocol_yaml"].get<std::string>(), HasSubstr("amplitude_deg"));
+  EXPECT_EQ(json["run"]["duration_s"], 0.05);
+  const Outcome bad = RunCcsrm("derivatives --config " + Paper() + " --protocol " + protocol +
+                               ",speed_deg=3 --duration 0.05 --parameters T_p");
+  EXPECT_EQ(bad.status, 2) << bad.all();
+  EXPECT_EQ(CountLines(bad.err), 1) << bad.err;
+  EXPECT_THAT(bad.err, HasSubstr("speed_deg"));
+}
+
 TEST(DerivativesCommand, BadOptionsExitWithOneLineNamingTheOption) {
   const std::string run = "derivatives --config " + Paper() + " --case 2 --duration 0.05 ";
   const struct {
