@@ -53,11 +53,13 @@ sim::PaperRunOptions PriorRun(const DesignJobOptions& job) {
   return run;
 }
 
-// One experiment of a plan: "file.yaml" or "file.yaml@name=value,...".
-PlannedExperiment PlanFromSpec(const std::string& spec, const DesignJobOptions& job) {
+// One experiment of a plan: "file.yaml" or "file.yaml@name=value,...", on
+// the arm of `config` (the job's, parsed once).
+PlannedExperiment PlanFromSpec(const std::string& spec, const DesignJobOptions& job,
+                               const sim::Config& config) {
   sim::PaperRunOptions run = PriorRun(job);
   sim::ApplyProtocolSpec(spec, "--plans '" + spec + "'", &run);
-  sim::PaperRun prepared = sim::PreparePaperRun(run);
+  sim::PaperRun prepared = sim::PreparePaperRun(run, config);
   PlannedExperiment e;
   e.name = spec;
   e.duration_s = prepared.simulation.duration_s;
@@ -128,6 +130,8 @@ std::vector<std::string> WriteDesignDirectory(const DesignSummary& summary,
 DesignJobResult RunDesignJob(const DesignJobOptions& job) {
   const auto say = [&job](const std::string& text) { internal::Say(job.reporting, text); };
   DesignOptions options = CheckedOptions(job);
+  // The configuration is parsed here once, for the prior and every plan.
+  const sim::Config config = sim::LoadConfig(sim::ConfigPathOrBundled(job.config_path));
   std::vector<std::string> inputs = {job.config_path, job.params_path, job.noise_from};
   std::vector<DesignCandidate> candidates;
   for (const std::string& plan : job.plans) {
@@ -137,7 +141,7 @@ DesignJobResult RunDesignJob(const DesignJobOptions& job) {
     while (true) {  // the plan's experiments, joined by '+'
       const std::size_t end = plan.find('+', start);
       const std::string spec = plan.substr(start, end == std::string::npos ? end : end - start);
-      candidate.experiments.push_back(PlanFromSpec(spec, job));
+      candidate.experiments.push_back(PlanFromSpec(spec, job, config));
       inputs.push_back(sim::ProtocolFileOf(spec));
       if (end == std::string::npos) break;
       start = end + 1;
@@ -151,7 +155,7 @@ DesignJobResult RunDesignJob(const DesignJobOptions& job) {
   const CheckpointKey key = MakeCheckpointKey("design", ResultOptions(job, options), inputs);
   if (job.resume) ReadCheckpoint(job.out, key);  // refuses other data, options or version
   DesignJobResult result;
-  const sim::Config prior = sim::PreparePaperRun(PriorRun(job)).config;
+  const sim::Config prior = sim::PreparePaperRun(PriorRun(job), config).config;
   // Under mpirun every rank builds the candidates itself from the same
   // options and files rather than receiving them from rank 0: building them
   // is a function of those alone and takes milliseconds, and a run request

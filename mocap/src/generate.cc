@@ -115,8 +115,7 @@ std::string MotionWords(const sim::PaperRun& run, const sim::Config& truth) {
 // The configuration the experiment states: the one given, with the paper
 // case (which cables have friction is part of the arm as built) and without
 // effects it switches on (the experiment states the nominal model only).
-std::string NominalConfigYaml(const GenerateOptions& o, const sim::PaperRun& run) {
-  sim::Config nominal = sim::ParseConfig(run.config_text, o.run.config_path);
+std::string NominalConfigYaml(const GenerateOptions& o, sim::Config nominal) {
   bool changed = false;
   if (nominal.parameters.AnyEffectOn()) {
     for (const std::string& effect : nominal.parameters.EnabledEffects()) {
@@ -128,7 +127,7 @@ std::string NominalConfigYaml(const GenerateOptions& o, const sim::PaperRun& run
     sim::ApplyPaperCase(o.run.case_number, &nominal.parameters);
     changed = true;
   }
-  return changed ? sim::ToYaml(nominal) : run.config_text;
+  return changed ? sim::ToYaml(nominal) : nominal.source_yaml;
 }
 
 // The virtual recording of the truth's run: motion capture sees the links
@@ -191,7 +190,10 @@ GeneratedExperiment GenerateExperiment(const GenerateOptions& o) {
     ThrowInputError("--noise-mm", "", "must be >= 0");
   }
 
-  GeneratedExperiment g{sim::PreparePaperRun(o.run)};
+  // The configuration is parsed once: the truth's run and the nominal
+  // configuration are made from it.
+  const sim::Config given = sim::LoadConfig(sim::ConfigPathOrBundled(o.run.config_path));
+  GeneratedExperiment g{sim::PreparePaperRun(o.run, given)};
   g.experiment_path = o.out;
   g.truth_yaml_path = truth_yaml_path;
   g.truth_h5_path = truth_h5_path;
@@ -207,7 +209,7 @@ GeneratedExperiment GenerateExperiment(const GenerateOptions& o) {
   }
   VirtualExperimentOptions options;
   options.name = fs::path(stem).filename().string();
-  options.nominal_config_yaml = NominalConfigYaml(o, g.run);
+  options.nominal_config_yaml = NominalConfigYaml(o, given);
   options.recording = o.recording;
   std::string error;
   if (!options.recording.IsValid(&error)) ThrowInputError("generate", "recording", error);
