@@ -208,8 +208,9 @@ OutputKind DesignFolderOutput();      // design.json, ccsrm-design/1
 // Loads each experiment (ExperimentLoadOptions) and reports one line about
 // it through `line` (and the mocap pipeline's when it computed the angles).
 // `role` begins the line ("experiment", "held out"). With `config_path`,
-// every experiment uses that arm instead of its own config_yaml; the file's
-// own errors come first, naming it.
+// every experiment uses that arm instead of its own config_yaml: the file is
+// parsed here once for all of them (ExperimentLoadOptions::config), its own
+// errors first, naming it.
 std::vector<Experiment> LoadExperiments(const std::vector<std::string>& paths,
                                         std::optional<double> noise_deg, const char* role,
                                         const std::string& config_path,
