@@ -189,6 +189,32 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
   }
 }
 
+const char* ArmDynamics::StateEntryKind(int k) const {
+  if (k < 2 * n_) {
+    const int q = k % n_;
+    const bool velocity = k >= n_;
+    for (const HoleNodeRef& hole : layout_.holes()) {
+      if (velocity && q == model_.node_offset(hole.cable, hole.node) + 3) return "hole slip speed";
+    }
+    const bool link = q >= model_.link_offset(1);  // nodes first, then links
+    if (velocity) return link ? "link velocity" : "node velocity";
+    return link ? "link coordinate" : "node coordinate";
+  }
+  if (k == 2 * n_) return "energy";
+  const int memory = k - memory_offset();
+  if (memory < static_cast<int>(layout_.holes().size())) return "hole memory";
+  if (presliding_ >= 0 && memory >= presliding_ &&
+      memory < presliding_ + static_cast<int>(layout_.holes().size())) {
+    return "hole presliding";
+  }
+  for (const PairKernel& pair : pair_kernels_) {
+    if (pair.presliding >= 0 && (memory == pair.presliding || memory == pair.presliding + 1)) {
+      return "conduit presliding";
+    }
+  }
+  return "conduit memory";
+}
+
 std::vector<double> ArmDynamics::ErrorScales() const {
   // Coordinates get absolute_tolerance; velocities that over
   // velocity_tolerance_time_s (an error that moves a position by

@@ -66,6 +66,12 @@ class ArmDynamics {
   // control's error bound (GSL's scale_abs).
   std::vector<double> ErrorScales() const;
 
+  // What state entry k is, for diagnostics (CCSRM_TRACE_STEPS): "link
+  // coordinate", "node coordinate", "link velocity", "node velocity", "hole
+  // slip speed", "energy", "hole memory", "conduit memory", "hole presliding"
+  // or "conduit presliding".
+  const char* StateEntryKind(int k) const;
+
   // Straight arm at rest, driving cables uniformly strained to T_d0.
   Eigen::VectorXd InitialState() const;
 
