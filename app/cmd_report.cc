@@ -28,7 +28,8 @@ void AddReportCommand(CLI::App& root) {
                   "folder (ccsrm identify) or loop folder (ccsrm loop)")
       ->required();
   cmd->add_option("--out", a->out,
-                  "Report folder; an existing one is replaced only if it holds an earlier report")
+                  "Report folder; an existing one is replaced only if it holds an earlier report "
+                  "and nothing else")
       ->required();
   cmd->add_option("--format", a->format, "Figure images: png or svg")
       ->check(CLI::IsMember({"png", "svg"}))

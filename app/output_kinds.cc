@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "ccsrm/cameras/camera_model.h"
+#include "ccsrm/common/atomic_file.h"
 
 namespace ccsrm::app {
 namespace {
@@ -37,6 +38,7 @@ OutputKind BoardImagesFolderOutput() {
   return {"folder of checkerboard images (PNG files only)", true, [](const std::string& p) {
             std::error_code ec;
             for (const fs::directory_entry& e : fs::directory_iterator(p, ec)) {
+              if (e.path().filename() == kOutputManifestName) continue;
               if (!e.is_regular_file() || e.path().extension() != ".png") return false;
             }
             return !ec;

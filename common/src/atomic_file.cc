@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "ccsrm/common/error.h"
+#include "output_manifest.h"
 #include "temporaries.h"
 
 namespace ccsrm {
@@ -100,6 +101,7 @@ AtomicOutputDirectory::~AtomicOutputDirectory() {
 
 void AtomicOutputDirectory::Commit() {
   namespace fs = std::filesystem;
+  internal::WriteOutputManifest(temp_path_);
   std::error_code ec;
   if (!fs::exists(target_path_, ec)) {
     if (std::rename(temp_path_.c_str(), target_path_.c_str()) != 0) {

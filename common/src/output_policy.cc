@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "ccsrm/common/error.h"
+#include "output_manifest.h"
 #include "temporaries.h"
 
 namespace ccsrm {
@@ -153,11 +154,26 @@ void CheckOutputPath(const std::string& path, const std::string& option, const O
   const bool is_folder = fs::is_directory(target, ec);
   if (kind.folder && !is_folder) Refuse(path, option, "exists and is not a folder");
   if (!kind.folder && is_folder) Refuse(path, option, "is a folder, expected a file");
-  if (IsEmpty(path)) return;
-  if (kind.recognises && kind.recognises(path)) return;
+  if (IsEmpty(path) || kind.replace_any_existing) return;
+  if (!kind.recognises || !kind.recognises(path)) {
+    Refuse(path, option,
+           "exists and is not a " + kind.description + "; refusing to replace it: choose a new " +
+               (kind.folder ? "folder" : "file") + " or remove it");
+  }
+  if (!kind.folder) return;
+  // A folder of the kind is replaced only when nothing in it is the user's.
+  const std::vector<std::string> foreign = internal::ForeignEntries(path, kind.own_files);
+  if (foreign.empty()) return;
+  std::string names;
+  for (std::size_t i = 0; i < foreign.size() && i < 3; ++i) {
+    names += (i > 0 ? ", '" : "'") + foreign[i] + "'";
+  }
+  if (foreign.size() > 3) names += " and " + std::to_string(foreign.size() - 3) + " more";
   Refuse(path, option,
-         "exists and is not a " + kind.description + "; refusing to replace it: choose a new " +
-             (kind.folder ? "folder" : "file") + " or remove it");
+         "holds " + names +
+             ", which ccsrm did not write there (or which changed since); refusing to replace "
+             "the folder: move " +
+             (foreign.size() == 1 ? "it" : "them") + " out, or choose a new folder");
 }
 
 void RemoveTemporariesOnInterrupt() {

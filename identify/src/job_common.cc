@@ -34,10 +34,13 @@ bool FolderJsonHasSchema(const std::string& folder, const std::string& name,
 // checkpoint in (--resume) when `resumable`.
 OutputKind JobFolder(const std::string& description, const std::string& file,
                      const std::string& schema, bool resumable) {
-  return {description, true, [=](const std::string& p) {
-            return FolderJsonHasSchema(p, file, schema) ||
-                   (resumable && FolderJsonHasSchema(p, "checkpoint.json", kCheckpointSchema));
-          }};
+  OutputKind kind{
+      description, true, [=](const std::string& p) {
+        return FolderJsonHasSchema(p, file, schema) ||
+               (resumable && FolderJsonHasSchema(p, "checkpoint.json", kCheckpointSchema));
+      }};
+  if (resumable) kind.own_files = {"checkpoint.json", "runs.journal"};
+  return kind;
 }
 
 }  // namespace

@@ -182,7 +182,7 @@ GeneratedExperiment GenerateExperiment(const GenerateOptions& o) {
       o.run.config_path, o.run.params_path, o.effects_path,
       sim::ProtocolFileOf(o.run.protocol_path),
       o.run.recorded_inputs ? o.run.recorded_inputs->source_name : std::string()};
-  CheckOutputPath(o.out, "--out", datasets::ExperimentFileOutput(), inputs);
+  CheckOutputPath(o.out, "--out", datasets::GeneratedExperimentFileOutput(), inputs);
   CheckOutputPath(truth_yaml_path, "--out", YamlFileOutput("ccsrm-truth/1", "ccsrm truth file"),
                   inputs);
   CheckOutputPath(truth_h5_path, "--out", datasets::RunFileOutput(), inputs);

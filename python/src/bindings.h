@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "ccsrm/common/output_policy.h"
 #include "ccsrm/datasets/array.h"
 
 namespace ccsrm::python {
@@ -26,6 +27,12 @@ py::array Copy(const std::vector<double>& values);
 
 // Reads a path argument (str or os.PathLike) as a string.
 std::string PathString(const py::handle& path);
+
+// A Python writer's `path` under the command line's output policy
+// (common/output_policy.h): refused (InputError naming the path) unless it
+// is new, empty or an earlier output of `kind`; `overwrite` (the writer's
+// overwrite=True) replaces whatever is there.
+void CheckWriterPath(const std::string& path, OutputKind kind, bool overwrite);
 
 void AddErrors(py::module_& m);
 void AddParameters(py::module_& m);

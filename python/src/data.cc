@@ -10,6 +10,7 @@
 #include "bindings.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/datasets/experiment_file.h"
+#include "ccsrm/datasets/output_kinds.h"
 #include "ccsrm/mocap/c3d.h"
 #include "ccsrm/mocap/marker_io.h"
 #include "ccsrm/mocap/marker_table.h"
@@ -122,12 +123,15 @@ void AddData(py::module_& m) {
       .def_property_readonly("warnings", [](const Processed& p) { return p.summary.warnings; })
       .def(
           "write",
-          [](const Processed& p, const py::object& path) {
+          [](const Processed& p, const py::object& path, bool overwrite) {
             const std::string file = PathString(path);
+            CheckWriterPath(file, datasets::ExperimentFileOutput(), overwrite);
             py::gil_scoped_release release;
             datasets::WriteExperimentFile(file, *p.dataset);
           },
-          py::arg("path"), "Writes the experiment as `ccsrm mocap process --out` does.");
+          py::arg("path"), py::kw_only(), py::arg("overwrite") = false,
+          "Writes the experiment as `ccsrm mocap process --out` does, under its output policy: "
+          "an existing file is replaced only when it is an experiment, or with overwrite=True.");
 
   m.def(
       "process_markers",
@@ -203,8 +207,10 @@ void AddData(py::module_& m) {
   m.def(
       "write_c3d",
       [](const py::object& path, const py::object& positions,
-         const std::vector<std::string>& labels, double rate_hz, const std::string& units) {
+         const std::vector<std::string>& labels, double rate_hz, const std::string& units,
+         bool overwrite) {
         const std::string file = PathString(path);
+        CheckWriterPath(file, mocap::C3dFileOutput(), overwrite);
         MarkerTable table = TableFromArrays(positions, labels, rate_hz);
         mocap::C3dWriteOptions options;
         options.units = units;
@@ -214,12 +220,15 @@ void AddData(py::module_& m) {
         mocap::WriteC3d(file, table, options);
       },
       py::arg("path"), py::arg("positions"), py::arg("labels"), py::arg("rate_hz"),
-      py::arg("units") = "mm",
-      "Writes markers (frames x markers x 3 [m], NaN = not seen) as an Intel float C3D file.");
+      py::arg("units") = "mm", py::kw_only(), py::arg("overwrite") = false,
+      "Writes markers (frames x markers x 3 [m], NaN = not seen) as an Intel float C3D file. "
+      "An existing file is replaced only when it is a C3D file, or with overwrite=True.");
   m.def(
       "write_c3d",
-      [](const py::object& path, const MarkerTable& table, const std::string& units) {
+      [](const py::object& path, const MarkerTable& table, const std::string& units,
+         bool overwrite) {
         const std::string file = PathString(path);
+        CheckWriterPath(file, mocap::C3dFileOutput(), overwrite);
         mocap::C3dWriteOptions options;
         options.units = units;
         std::string error;
@@ -227,8 +236,10 @@ void AddData(py::module_& m) {
         py::gil_scoped_release release;
         mocap::WriteC3d(file, table, options);
       },
-      py::arg("path"), py::arg("table"), py::arg("units") = "mm",
-      "Writes a MarkerTable (e.g. from read_markers) as an Intel float C3D file.");
+      py::arg("path"), py::arg("table"), py::arg("units") = "mm", py::kw_only(),
+      py::arg("overwrite") = false,
+      "Writes a MarkerTable (e.g. from read_markers) as an Intel float C3D file. An existing "
+      "file is replaced only when it is a C3D file, or with overwrite=True.");
 }
 
 }  // namespace ccsrm::python

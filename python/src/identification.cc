@@ -266,13 +266,16 @@ void AddIdentification(py::module_& m) {
           "json() as a dict.")
       .def(
           "write",
-          [](const Fit& f, const py::object& directory) {
+          [](const Fit& f, const py::object& directory, bool overwrite) {
             const std::string dir = PathString(directory);
+            CheckWriterPath(dir, identify::FitFolderOutput(), overwrite);
             py::gil_scoped_release release;
             return identify::WriteFitDirectory(f.summary, f.experiments, dir);
           },
-          py::arg("directory"),
-          "Writes the fit folder `ccsrm identify --out` writes; returns the paths.")
+          py::arg("directory"), py::kw_only(), py::arg("overwrite") = false,
+          "Writes the fit folder `ccsrm identify --out` writes; returns the paths. An existing "
+          "folder is replaced only when it is an earlier fit folder holding nothing but what "
+          "ccsrm wrote, or with overwrite=True.")
       .def("__repr__", [](const Fit& f) { return "<ccsrm.Fit " + f.summary.BriefReport() + ">"; });
 
   m.def("identify", &RunIdentify, py::arg("data"), py::kw_only(), py::arg("free") = py::none(),
@@ -337,12 +340,16 @@ void AddIdentification(py::module_& m) {
           "json() as a dict.")
       .def(
           "write",
-          [](const Loop& l, const py::object& directory) {
+          [](const Loop& l, const py::object& directory, bool overwrite) {
             const std::string dir = PathString(directory);
+            CheckWriterPath(dir, identify::LoopFolderOutput(), overwrite);
             py::gil_scoped_release release;
             return identify::WriteLoopDirectory(l.summary, l.training, l.holdout, dir);
           },
-          py::arg("directory"), "Writes the loop folder `ccsrm loop --out` writes.")
+          py::arg("directory"), py::kw_only(), py::arg("overwrite") = false,
+          "Writes the loop folder `ccsrm loop --out` writes. An existing folder is replaced only "
+          "when it is an earlier loop folder holding nothing but what ccsrm wrote, or with "
+          "overwrite=True.")
       .def("__repr__", [](const Loop& l) { return "<ccsrm.Loop " + l.summary.conclusion + ">"; });
 
   m.def("loop", &RunLoop, py::arg("data"), py::kw_only(), py::arg("holdout") = py::none(),

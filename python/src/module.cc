@@ -41,6 +41,11 @@ std::string PathString(const py::handle& path) {
   return py::str(py::module_::import("os").attr("fspath")(path));
 }
 
+void CheckWriterPath(const std::string& path, OutputKind kind, bool overwrite) {
+  kind.replace_any_existing = overwrite;
+  CheckOutputPath(path, "path", kind, {});
+}
+
 void AddErrors(py::module_& m) {
   // A ValueError, so code that catches bad values generally catches it too;
   // its message is the library's one line, as the command line prints it.

@@ -16,6 +16,7 @@
 
 #include "bindings.h"
 #include "ccsrm/common/error.h"
+#include "ccsrm/datasets/output_kinds.h"
 #include "ccsrm/datasets/run_file.h"
 #include "ccsrm/mocap/generate.h"
 #include "ccsrm/sim/config.h"
@@ -400,12 +401,15 @@ void AddSimulation(py::module_& m) {
       .def_property_readonly("frames", [](const Run& r) { return r.file.frames(); })
       .def(
           "write",
-          [](const Run& r, const py::object& path) {
+          [](const Run& r, const py::object& path, bool overwrite) {
             const std::string file = PathString(path);
+            CheckWriterPath(file, datasets::RunFileOutput(), overwrite);
             py::gil_scoped_release release;
             datasets::WriteRunFile(file, r.file);
           },
-          py::arg("path"), "Writes the ccsrm-run/1 file `ccsrm simulate --out` would.")
+          py::arg("path"), py::kw_only(), py::arg("overwrite") = false,
+          "Writes the ccsrm-run/1 file `ccsrm simulate --out` would, under its output policy: an "
+          "existing file is replaced only when it is a run file, or with overwrite=True.")
       .def("__len__", [](const Run& r) { return r.file.frames(); })
       .def("__repr__", [](const Run& r) {
         return "<ccsrm.Run " + std::to_string(r.file.frames()) + " frames, " +

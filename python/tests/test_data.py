@@ -42,6 +42,23 @@ def test_bad_marker_input(tmp_path):
     assert "positions" in str(e.value)
 
 
+def test_write_c3d_replaces_only_a_c3d_unless_asked(experiment, paper_config, tmp_path):
+    # Issue 47, 2: a user's configuration is not an earlier C3D file.
+    markers = ccsrm.read_markers(experiment)
+    mine = tmp_path / "mycfg.yaml"
+    mine.write_bytes(open(paper_config, "rb").read())
+    with pytest.raises(ccsrm.InputError) as e:
+        ccsrm.write_c3d(mine, markers)
+    assert str(mine) in str(e.value) and "not a C3D file" in str(e.value)
+    assert mine.read_bytes() == open(paper_config, "rb").read()
+    # An earlier C3D is replaced; overwrite=True replaces anything.
+    c3d = tmp_path / "m.c3d"
+    ccsrm.write_c3d(c3d, markers)
+    ccsrm.write_c3d(c3d, markers, units="m")
+    ccsrm.write_c3d(mine, markers, overwrite=True)
+    assert ccsrm.read_markers(mine.rename(tmp_path / "now.c3d")).labels == markers.labels
+
+
 def test_mocap_pipeline_equals_command_line(exe, experiment, paper_config, tmp_path):
     # The real-file route: markers as a C3D file, the arm and the inputs
     # given apart, as `ccsrm mocap process` takes them.

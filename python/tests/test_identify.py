@@ -109,6 +109,13 @@ def test_out_goes_through_the_commands_output_policy(experiment, tmp_path):
     with pytest.raises(ccsrm.InputError):
         ccsrm.loop(experiment, free="T_p", max_rounds=1, out=user)
     assert sorted(p.name for p in user.iterdir()) == ["notes.txt"]
+    # A stub that looks like an earlier fit (issue 47, 3): only what ccsrm
+    # wrote there, on the folder's manifest, makes an earlier output.
+    (user / "fit.json").write_text('{"schema":"ccsrm-fit/1"}')
+    with pytest.raises(ccsrm.InputError) as e:
+        ccsrm.identify(experiment, free="T_p", max_iterations=1, out=user)
+    assert "'notes.txt', which ccsrm did not write" in str(e.value)
+    assert sorted(p.name for p in user.iterdir()) == ["fit.json", "notes.txt"]
 
 
 def test_resume_needs_a_stopped_fit_and_the_loop_takes_a_config(experiment, tmp_path):

@@ -213,6 +213,17 @@ class BadInputTable : public ::testing::Test {
                "put('/mocap/markers', np.full(f['/mocap/markers'].shape, np.nan))");
     MutateHdf5(d / "exp.h5", d / "inf.h5",
                "put('/mocap/markers', np.full(f['/mocap/markers'].shape, np.inf))");
+    // A recorded experiment (issue 47, 4): its measurements no run gives back.
+    MutateHdf5(processed, d / "recorded.h5", "f.attrs['source'] = 'recorded'");
+    // A stub made to look like an earlier fit (issue 47, 3), and a real
+    // report folder a user has added notes to.
+    fs::create_directory(d / "stub");
+    Write(d / "stub" / "fit.json", "{\"schema\":\"ccsrm-fit/1\"}");
+    Write(d / "stub" / "thesis.tex", "\\documentclass{article}\n");
+    o = RunCcsrm("report --in " + (d / "run.h5").string() + " --out " + (w / "report").string());
+    ASSERT_EQ(o.status, 0) << o.err;
+    fs::rename(w / "report", d / "noted_report");
+    Write(d / "noted_report" / "notes.txt", "what I saw in this run\n");
   }
 
   void SetUp() override {
@@ -477,6 +488,15 @@ const std::vector<BadInput>& Rows() {
       {"outputs",
        "identify --data {d}/processed.h5 --free mu --out {d}/mine",
        {"{d}/mine", "--out", "not a ccsrm fit folder"}},  // 1
+      {"outputs",
+       "identify --data {d}/processed.h5 --free mu --out {d}/stub",
+       {"{d}/stub", "--out", "'thesis.tex', which ccsrm did not write"}},  // 47: 3
+      {"outputs",
+       "report --in {d}/run.h5 --out {d}/noted_report",
+       {"{d}/noted_report", "--out", "holds 'notes.txt', which ccsrm did not write"}},  // 47: 3
+      {"outputs",
+       "generate --config {d}/c.yaml --case 1 --duration 0.1 --out {d}/recorded.h5",
+       {"{d}/recorded.h5", "--out", "not a generated ccsrm experiment"}},  // 47: 4
       {"outputs",
        "loop --data {d}/processed.h5 --out {d}/mine",
        {"{d}/mine", "--out", "not a ccsrm loop folder"}},  // 1

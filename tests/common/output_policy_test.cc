@@ -60,12 +60,75 @@ TEST(OutputPolicy, AFolderOfTheUsersFilesIsRefusedAndKept) {
   EXPECT_TRUE(fs::exists(dir / "precious.txt"));
 }
 
+// An earlier output as ccsrm writes it: through AtomicOutputDirectory, which
+// leaves its manifest.
+void WriteEarlierOutput(const fs::path& dir) {
+  AtomicOutputDirectory out(dir.string());
+  Touch(fs::path(out.temp_path()) / "mine", "ours");
+  fs::create_directory(fs::path(out.temp_path()) / "plots");
+  Touch(fs::path(out.temp_path()) / "plots" / "a.svg", "<svg/>");
+  out.Commit();
+}
+
 TEST(OutputPolicy, AnEmptyFolderOrAnEarlierOutputIsReplaced) {
   const fs::path dir = FreshDir("own");
   EXPECT_EQ(Refusal(dir.string(), TestFolderKind(), {}), "");
-  Touch(dir / "mine", "ours");
+  WriteEarlierOutput(dir);
+  EXPECT_TRUE(fs::exists(dir / kOutputManifestName));
   EXPECT_EQ(Refusal(dir.string(), TestFolderKind(), {}), "");
   EXPECT_EQ(Refusal((dir / "new").string(), TestFolderKind(), {}), "");  // does not exist yet
+}
+
+TEST(OutputPolicy, AUsersFileInsideAnEarlierOutputIsRefusedAndKept) {
+  const fs::path dir = FreshDir("own_plus_notes");
+  WriteEarlierOutput(dir);
+  Touch(dir / "plots" / "notes.txt", "my notes");
+  const std::string message = Refusal(dir.string(), TestFolderKind(), {});
+  EXPECT_THAT(message, HasSubstr("--out: holds 'plots/notes.txt', which ccsrm did not write"));
+  EXPECT_TRUE(fs::exists(dir / "plots" / "notes.txt"));
+  // A file ccsrm wrote but the user changed since is the user's now.
+  fs::remove(dir / "plots" / "notes.txt");
+  Touch(dir / "mine", "ours\nannotated by the user");
+  EXPECT_THAT(Refusal(dir.string(), TestFolderKind(), {}), HasSubstr("holds 'mine'"));
+}
+
+TEST(OutputPolicy, AStubThatLooksLikeAnEarlierOutputIsRefused) {
+  // The kind's own file, as a user (or a stub) put it, without a manifest.
+  const fs::path dir = FreshDir("stub");
+  Touch(dir / "mine", "ours");
+  Touch(dir / "thesis.tex", "\\documentclass{article}");
+  EXPECT_THAT(Refusal(dir.string(), TestFolderKind(), {}),
+              HasSubstr("holds 'mine', 'thesis.tex', which ccsrm did not write"));
+  EXPECT_TRUE(fs::exists(dir / "thesis.tex"));
+  // A link inside is never ccsrm's, even on a manifest's folder.
+  const fs::path linked = FreshDir("linked");
+  WriteEarlierOutput(linked);
+  fs::create_symlink(dir / "thesis.tex", linked / "thesis.tex");
+  EXPECT_THAT(Refusal(linked.string(), TestFolderKind(), {}), HasSubstr("holds 'thesis.tex'"));
+}
+
+TEST(OutputPolicy, AStoppedJobsOwnFilesBesideTheManifestAreItsOwn) {
+  const fs::path dir = FreshDir("checkpointed");
+  WriteEarlierOutput(dir);
+  Touch(dir / "checkpoint.json", "{}");
+  Touch(dir / "checkpoint.json.tmp-12345-0", "{");
+  OutputKind kind = TestFolderKind();
+  EXPECT_THAT(Refusal(dir.string(), kind, {}), HasSubstr("holds 'checkpoint.json"));
+  kind.own_files = {"checkpoint.json"};
+  EXPECT_EQ(Refusal(dir.string(), kind, {}), "");
+}
+
+TEST(OutputPolicy, ReplaceAnyExistingLiftsOnlyTheKindRule) {
+  const fs::path dir = FreshDir("overwrite");
+  Touch(dir / "mycfg.yaml", "schema: something else");
+  OutputKind file_kind{"test file", false, [](const std::string&) { return false; }};
+  EXPECT_THAT(Refusal((dir / "mycfg.yaml").string(), file_kind, {}),
+              HasSubstr("exists and is not a test file"));
+  file_kind.replace_any_existing = true;
+  EXPECT_EQ(Refusal((dir / "mycfg.yaml").string(), file_kind, {}), "");
+  // An input stays an input.
+  EXPECT_THAT(Refusal((dir / "mycfg.yaml").string(), file_kind, {(dir / "mycfg.yaml").string()}),
+              HasSubstr("is an input file"));
 }
 
 TEST(OutputPolicy, AnInputIsNeverAnOutput) {

@@ -274,12 +274,17 @@ TEST(ReportCli, AnExistingReportIsReplacedWhole) {
   const fs::path dir = FreshDir("replace");
   const fs::path out = dir / "report";
   ASSERT_EQ(MakeReport(Made().raw_experiment, out).outcome.status, 0);
-  ccsrm::WriteTextFileAtomically((out / "figures" / "stale.png").string(), "old");
+  ASSERT_TRUE(fs::exists(out / "figures" / "marker_gaps.png"));  // the experiment's figure
   const Report r = MakeReport(Made().run, out);
   ASSERT_EQ(r.outcome.status, 0) << r.outcome.err;
   EXPECT_EQ(r.summary["kind"], "run");
-  EXPECT_FALSE(fs::exists(out / "figures" / "stale.png"));
-  EXPECT_FALSE(fs::exists(out / "figures" / "marker_gaps.png"));  // the experiment's figure
+  EXPECT_FALSE(fs::exists(out / "figures" / "marker_gaps.png"));
+  // A file put in since is the user's: the report is then refused, and kept
+  // (docs/conventions.md, "Outputs").
+  ccsrm::WriteTextFileAtomically((out / "figures" / "notes.txt").string(), "mine");
+  ExpectOneLineError(RunCcsrm("report --in " + Made().run + " --out " + out.string()),
+                     "holds 'figures/notes.txt', which ccsrm did not write");
+  EXPECT_EQ(ReadTextFile((out / "figures" / "notes.txt").string()), "mine");
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
 }
 

@@ -36,10 +36,17 @@ class AtomicOutputFile {
 // destructor removes the temporary folder, so the target is either untouched
 // or complete, never half overwritten.
 //
+// Commit() first writes the folder's manifest, kOutputManifestName: every
+// file in it with its size and content digest, so that the output policy
+// (output_policy.h) can tell an earlier output from a folder a user has put
+// files in since.
+//
 // An existing target folder is replaced as a whole: Commit() swaps the two
 // folders with renameat2(RENAME_EXCHANGE) and then removes the old one. The
 // caller decides whether an existing folder may be replaced (e.g. only an
 // earlier output of the same command).
+inline constexpr const char* kOutputManifestName = "ccsrm-manifest.txt";
+
 class AtomicOutputDirectory {
  public:
   // Creates the temporary folder. Throws InputError when the target's parent

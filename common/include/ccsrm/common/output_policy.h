@@ -6,7 +6,9 @@
 //  - an existing output that is not the command's own kind is refused: it is
 //    the user's, not an earlier output of this command;
 //  - the command's own kind (or an empty file or folder) is replaced whole
-//    and atomically (AtomicOutputFile, AtomicOutputDirectory);
+//    and atomically (AtomicOutputFile, AtomicOutputDirectory); a folder only
+//    when everything in it is what ccsrm wrote there, unchanged (its
+//    manifest, atomic_file.h), so a user's file inside is never deleted;
 //  - temporaries are removed on SIGINT, SIGTERM and SIGHUP, and those a
 //    killed run left beside a target are removed by the next run writing it.
 #include <functional>
@@ -24,6 +26,13 @@ struct OutputKind {
   // True when the existing `path` is an earlier output of this kind, which
   // the command replaces. Null: only empty files and folders are replaced.
   std::function<bool(const std::string& path)> recognises;
+  // A folder: top-level files the command writes in place before the folder
+  // is committed (a stopped job's checkpoint and journal), which may sit
+  // beside the manifest's files.
+  std::vector<std::string> own_files = {};
+  // The caller was asked to replace whatever is at the path (Python's
+  // overwrite=True): only the input and parent-folder rules apply.
+  bool replace_any_existing = false;
 };
 
 // A YAML file whose top level has the line `schema: <schema>` within its
@@ -37,7 +46,8 @@ OutputKind YamlFileOutput(const std::string& schema, const std::string& descript
 // killed run left beside it. Throws InputError (one line naming the path and
 // the option) when the path is an input or inside one, holds an input (a
 // folder output), has no existing parent folder, is a file where a folder is
-// written or the reverse, or exists, is not empty and is not `kind`. Empty
+// written or the reverse, or exists, is not empty and is not `kind` (a
+// folder: holds a file that is not on its manifest or changed since). Empty
 // strings in `inputs` (options not given) are skipped.
 void CheckOutputPath(const std::string& path, const std::string& option, const OutputKind& kind,
                      const std::vector<std::string>& inputs);

@@ -7,6 +7,9 @@
 namespace ccsrm::datasets {
 
 OutputKind RunFileOutput();         // ccsrm-run/1: simulate, generate's truth run
-OutputKind ExperimentFileOutput();  // ccsrm-dataset/1: generate, mocap process, dataset
+OutputKind ExperimentFileOutput();  // ccsrm-dataset/1: mocap process, dataset
+// generate: an earlier generated experiment only. A recorded one holds
+// measurements no run can give back, so a simulation never replaces it.
+OutputKind GeneratedExperimentFileOutput();
 
 }  // namespace ccsrm::datasets

@@ -49,14 +49,14 @@ struct GenerateOptions {
 };
 
 struct GeneratedExperiment {
-  sim::PaperRun run;  // as prepared (sim::DescribeRun)
-  sim::Config truth;  // the run's configuration with the truth's effects on
+  sim::PaperRun run;       // as prepared (sim::DescribeRun)
+  sim::Config truth = {};  // the run's configuration with the truth's effects on
   // The simulation: a run that did not complete writes nothing.
-  sim::SimulationSummary simulation;
+  sim::SimulationSummary simulation = {};
   double wall_time_s = 0.0;  // of the simulation
-  std::string experiment_path, truth_yaml_path, truth_h5_path;
+  std::string experiment_path = {}, truth_yaml_path = {}, truth_h5_path = {};
   std::size_t frames = 0, markers = 0;
-  VirtualRecordingSummary recording;  // what the occlusion model hid
+  VirtualRecordingSummary recording = {};  // what the occlusion model hid
 };
 
 // Generates and writes the experiment. Throws InputError for bad options or
