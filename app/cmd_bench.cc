@@ -1,8 +1,8 @@
-// ccsrm bench: the speed figures of SPEC 10 for the paper's case 2.
+// ccsrm bench: the speed figures of SPEC 10 for the paper's case 2, or of
+// another protocol or recorded inputs (--protocol, --inputs).
 #include <sys/resource.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -11,7 +11,6 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
-#include "ccsrm/sim/protocol.h"
 #include "ccsrm/sim/simulator.h"
 #include "commands.h"
 #include "option_checks.h"
@@ -29,6 +28,7 @@ sim::PaperRunOptions CaseTwo() {
 
 struct BenchArgs {
   sim::PaperRunOptions run = CaseTwo();
+  MotionArgs motion;
   int repeat = 3;
 };
 
@@ -40,13 +40,12 @@ double Median(std::vector<double> v) {
 
 void RunBench(const BenchArgs& a) {
   if (a.repeat < 1) ThrowInputError("--repeat", "", "must be >= 1");
-  const sim::PaperRun run = sim::PreparePaperRun(a.run);
+  const sim::PaperRun run = PrepareRun(a.run, a.motion);
   PrintConfigWarnings(run.config);
   const sim::Config& config = run.config;
   const sim::SimulationOptions& options = run.simulation;
-  std::printf("ccsrm bench: case %d, %+.3g deg, %.4g s simulated, %d run(s), one thread\n",
-              a.run.case_number, config.protocol.amplitude_rad * 180.0 / M_PI, options.duration_s,
-              a.repeat);
+  std::printf("ccsrm bench: case %d, %.4g s simulated, %d run(s), one thread\n", a.run.case_number,
+              options.duration_s, a.repeat);
   std::printf("%s", sim::DescribeRun(run).c_str());
   std::vector<double> wall, rtf, rhs_rate;
   sim::SimulationSummary last;
@@ -81,7 +80,7 @@ void AddBenchCommand(CLI::App& root) {
   CLI::App* cmd = root.add_subcommand(
       "bench",
       "Time case 2 of the configured arm and protocol (by default the paper's: +6 "
-      "deg, 48 s): wall time, real-time factor, "
+      "deg, 48 s; or --protocol, --inputs): wall time, real-time factor, "
       "right-hand-side evaluations per second, steps, peak memory");
   auto a = std::make_shared<BenchArgs>();
   AddConfigOption(cmd, &a->run.config_path);
@@ -96,6 +95,7 @@ void AddBenchCommand(CLI::App& root) {
       ->capture_default_str()
       ->check(AtLeast(1));
   AddParameterOptions(cmd, &a->run);
+  AddMotionOptions(cmd, &a->run, &a->motion);
   cmd->callback([a] {
     a->run.config_path = sim::ConfigPathOrBundled(a->run.config_path);
     RunBench(*a);

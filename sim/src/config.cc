@@ -806,6 +806,7 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
     sc.smoothing_step_s = s.Number("smoothing_step_s");
     sc.smooth_connecting_friction = s.Boolean("smooth_connecting_friction");
     sc.smooth_connecting_elasticity = s.Boolean("smooth_connecting_elasticity");
+    sc.smooth_presliding_relaxation = s.OptionalBoolean("smooth_presliding_relaxation", true);
     sc.embed_cable_nodes = s.OptionalBoolean("embed_cable_nodes", true);
     sc.stepper = static_cast<RungeKuttaStepper>(s.OptionalWord("stepper", kStepperWords, 0));
     sc.stick_velocity_tolerance_mps = s.Number("stick_velocity_tolerance_mps");
@@ -948,6 +949,8 @@ std::string ToYaml(const Config& c) {
   out << YAML::Key << "smooth_connecting_friction" << YAML::Value << s.smooth_connecting_friction;
   out << YAML::Key << "smooth_connecting_elasticity" << YAML::Value
       << s.smooth_connecting_elasticity;
+  out << YAML::Key << "smooth_presliding_relaxation" << YAML::Value
+      << s.smooth_presliding_relaxation;
   out << YAML::Key << "embed_cable_nodes" << YAML::Value << s.embed_cable_nodes;
   out << YAML::Key << "stepper" << YAML::Value << kStepperWords[static_cast<int>(s.stepper)];
   out << YAML::Key << "stick_velocity_tolerance_mps" << YAML::Value

@@ -472,7 +472,8 @@ void ArmDynamics::AddPreslidingFriction(int h, int s_col, double t_before, doubl
                                         const double* memory) {
   const PreslidingLaw law{
       {parameters_.mu, parameters_.mu_s, parameters_.v_s, solver_.stick_velocity_tolerance_mps},
-      parameters_.xi_f};
+      parameters_.xi_f,
+      PreslidingRelaxationResolution()};
   HoleReport& report = reports_[h];
   const bool remembers = parameters_.tau_f > 0.0;
   const double target = HoleMemoryTarget(law.friction, v, nullptr);
@@ -584,7 +585,8 @@ void ArmDynamics::AddConnectingMoments(double t, const double* memory) {
           // on the couple's presliding displacement eta, M_p = K eta with
           // K = T_p r Theta mu'_c / xi_c [N m/m], on both joints.
           const ConduitPreslidingLaw presliding_law{law.mu_kinetic, law.mu_static, parameters_.xi_c,
-                                                    solver_.stick_velocity_tolerance_mps};
+                                                    solver_.stick_velocity_tolerance_mps,
+                                                    PreslidingRelaxationResolution()};
           const int eta_index = pair.presliding + axis;
           const double eta = memory[eta_index];
           const ConduitPresliding f = PreslidingConduitFriction(presliding_law, v_tau1, z, eta);

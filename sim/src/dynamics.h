@@ -116,6 +116,12 @@ class ArmDynamics {
   bool SolveAugmentedSystem();
   bool FinishDerivative(const double* qd, double* ydot);
 
+  // h for the presliding laws' relaxation (ElastoplasticSlide), 0 without
+  // solver.smooth_presliding_relaxation.
+  double PreslidingRelaxationResolution() const {
+    return solver_.smooth_presliding_relaxation ? solver_.smoothing_step_s : 0.0;
+  }
+
   // Row `axis` of d(theta_dot of joint k)/d(e_dot of link), 1-based k and
   // link (zero unless link is k or k - 1).
   Eigen::Matrix<double, 1, 4> JointRateRow(int k, int link, int axis) const;

@@ -112,6 +112,73 @@ TEST(PreslidingFriction, NodeLoadedBeyondTheLimitSlidesAtTheSteadyCapstanFrictio
   }
 }
 
+// The relaxation rate -d xi_dot / d xi at (v, xi), by central differences.
+double RelaxationRate(const PreslidingLaw& law, double v, double xi) {
+  const double d = 1e-6 * kXiMax;
+  return -(PreslidingHoleFriction(law, kTension, kWrap, v, 1.0, xi + d).rate -
+           PreslidingHoleFriction(law, kTension, kWrap, v, 1.0, xi - d).rate) /
+         (2.0 * d);
+}
+
+TEST(PreslidingFriction, SmoothedRelaxationKeepsTheLimitAndRelaxesNoFasterThanTheResolution) {
+  // Model smoothing of the relaxation (model notes row 28): sliding at the
+  // limit, xi relaxes to xi_ss at v / xi_ss, far above 1/h when fast; the
+  // smoothed law relaxes at most at 1/h, and leaves the fixed point, slow
+  // sliding and the elastic range as they were.
+  PreslidingLaw smoothed = Law();
+  smoothed.relaxation_resolution_s = kSmoothing;
+  const PreslidingLaw plain = Law();
+  for (double v : {1e-2, -1e-2, 1e-4, -3e-6}) {
+    // xi_ss at z = 1: where the plain law's steady sliding puts it.
+    const double sigma = v > 0.0 ? 1.0 : -1.0;
+    const double xi_ss =
+        sigma * kXiMax * std::abs(std::expm1(-0.25 * kWrap * sigma)) / std::sinh(0.25 * kWrap);
+    const PreslidingFriction at_limit =
+        PreslidingHoleFriction(smoothed, kTension, kWrap, v, 1.0, xi_ss);
+    EXPECT_NEAR(at_limit.rate, 0.0, 1e-9 * std::abs(v)) << "rho = 1 is still the fixed point";
+    EXPECT_NEAR(at_limit.force, HoleSlipFriction(kTension, 0.25, kWrap, v),
+                1e-9 * std::abs(at_limit.force));
+    const double plain_rate = RelaxationRate(plain, v, xi_ss);
+    const double smoothed_rate = RelaxationRate(smoothed, v, xi_ss);
+    EXPECT_NEAR(plain_rate, std::abs(v) / std::abs(xi_ss), 1e-4 * plain_rate);
+    // c = (1 + x^4)^(-1/4) with x = |v| h / xi_ss: at most 1/h, and 1 - x^4/4 slow.
+    const double x = std::abs(v) * kSmoothing / std::abs(xi_ss);
+    EXPECT_NEAR(smoothed_rate, plain_rate / std::pow(1.0 + std::pow(x, 4), 0.25),
+                1e-4 * smoothed_rate);
+    EXPECT_LE(smoothed_rate, 1.0 / kSmoothing * (1.0 + 1e-4));
+    // Elastic range and unloading: the same law.
+    for (double xi : {0.3 * xi_ss, 1.2 * xi_ss}) {
+      const double unloading = -v;
+      EXPECT_EQ(PreslidingHoleFriction(smoothed, kTension, kWrap, v, 1.0, 0.3 * xi_ss).rate, v);
+      EXPECT_EQ(PreslidingHoleFriction(smoothed, kTension, kWrap, unloading, 1.0, xi).rate,
+                unloading);
+    }
+  }
+}
+
+TEST(PreslidingFriction, SmoothedRelaxationsEngagedFractionIsTheRatesSlopeAndDissipates) {
+  // engaged_fraction (model smoothing's share of k) is d xi_dot / d s_dot,
+  // c's dependence on the slip speed included, and the plastic power is
+  // never negative.
+  PreslidingLaw law = Law();
+  law.relaxation_resolution_s = kSmoothing;
+  for (double rho : {0.6, 0.8, 0.95, 1.0, 1.1}) {
+    for (double v : {2e-3, 1e-2, -5e-2, 4e-7}) {
+      const double sigma = v > 0.0 ? 1.0 : -1.0;
+      const double xi_ss =
+          kXiMax * std::abs(std::expm1(-0.25 * kWrap * sigma)) / std::sinh(0.25 * kWrap);
+      const double xi = sigma * rho * xi_ss;
+      const PreslidingFriction f = PreslidingHoleFriction(law, kTension, kWrap, v, 1.0, xi);
+      const double d = 1e-6 * std::abs(v);
+      const double slope = (PreslidingHoleFriction(law, kTension, kWrap, v + d, 1.0, xi).rate -
+                            PreslidingHoleFriction(law, kTension, kWrap, v - d, 1.0, xi).rate) /
+                           (2.0 * d);
+      if (slope >= 0.0) EXPECT_NEAR(f.engaged_fraction, slope, 1e-5) << rho << " " << v;
+      EXPECT_GE(f.plastic_power, 0.0) << rho << " " << v;
+    }
+  }
+}
+
 TEST(PreslidingFriction, UnloadingIsElasticAndALimitThatFallsIsSlidDownTo) {
   const PreslidingLaw law = Law();
   // Unloading: all of s_dot goes into xi, nothing slides.

@@ -146,8 +146,10 @@ ConduitPresliding PreslidingConduitFriction(const ConduitPreslidingLaw& law, dou
   const double q = law.mu_static > 0.0 ? std::max(mu_z / law.mu_static, 1e-3) : 1.0;
   out.coefficient_per_displacement = -law.mu_static / eta_max;
   out.coefficient = out.coefficient_per_displacement * displacement;
-  out.load_ratio = std::abs(displacement) / (eta_max * q);
-  const ElastoplasticYield yield = ElastoplasticSlide(out.load_ratio, sigma, v, law.band_mps);
+  const double eta_ss = eta_max * q;
+  out.load_ratio = std::abs(displacement) / eta_ss;
+  const ElastoplasticYield yield = ElastoplasticSlide(out.load_ratio, sigma, v, law.band_mps,
+                                                      law.relaxation_resolution_s / eta_ss);
   out.engaged_fraction = yield.engaged_fraction;
   out.sliding_speed = yield.sliding;
   out.rate = v - yield.sliding;

@@ -132,7 +132,7 @@ LargeSResult LargeSMomentsWithCoefficient(const LargeSParams& params, double the
 //   mu_m = -mu'_c eta / eta_max,
 // which reaches the current limit mu_z = mu_c + (mu'_c - mu_c) z (memory z)
 // at eta_ss = eta_max mu_z / mu'_c. eta follows
-//   eta_dot = v - ElastoplasticSlide(|eta| / eta_ss, sgn eta, v, band).sliding
+//   eta_dot = v - ElastoplasticSlide(|eta| / eta_ss, sgn eta, v, band, h / eta_ss).sliding
 // with v = v_tau1: a conduit loaded below its limit does not slide at all
 // (eq. 45's stick band lets it creep at up to v_s), at steady sliding mu_m
 // is -mu_z sgn v, eq. 45 beyond its bands. Moments then follow
@@ -143,6 +143,8 @@ struct ConduitPreslidingLaw {
   double mu_static = 0.0;                  // mu'_c
   double presliding_displacement_m = 0.0;  // eta_max
   double band_mps = 0.0;                   // the yield's ramp (v_eps)
+  // h of model smoothing of the relaxation to the limit (ElastoplasticSlide).
+  double relaxation_resolution_s = 0.0;
 };
 struct ConduitPresliding {
   double coefficient = 0.0;  // mu_m [1]

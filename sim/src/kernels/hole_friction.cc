@@ -83,7 +83,8 @@ double SmoothStep(double u) {
 
 }  // namespace
 
-ElastoplasticYield ElastoplasticSlide(double load_ratio, double sigma, double v, double band) {
+ElastoplasticYield ElastoplasticSlide(double load_ratio, double sigma, double v, double band,
+                                      double relaxation_scale) {
   ElastoplasticYield out;
   const double alpha =
       SmoothStep((load_ratio - kPreslidingBreakaway) / (1.0 - kPreslidingBreakaway));
@@ -97,11 +98,20 @@ ElastoplasticYield ElastoplasticSlide(double load_ratio, double sigma, double v,
     ramp = loading * SmoothStep(u);
     ramp_slope = u * u * (9.0 - 8.0 * u);
   }
+  // The relaxation to the limit, rate ramp / displacement_ss at rho = 1, at
+  // most about 1/h: x = ramp h / displacement_ss, c = (1 + x^4)^(-1/4).
+  const double x = ramp * relaxation_scale;
+  const double x4 = x * x * x * x;
+  const double c = 1.0 / std::sqrt(std::sqrt(1.0 + x4));
+  const double dc_dx = x4 > 0.0 ? -c * x4 / (x * (1.0 + x4)) : 0.0;
+  const double yield_share = alpha * (1.0 + c * (load_ratio - 1.0));
+  // d(ramp yield_share)/d(loading), c's part through x = ramp h / ..
+  const double slope = ramp_slope * (yield_share + alpha * (load_ratio - 1.0) * dc_dx * x);
   // The clamp acts only sliding near the band at the limit, where the slope
   // of ramp exceeds 1 (it must catch up with x); a negative mass would be
   // unphysical.
-  out.engaged_fraction = std::max(0.0, 1.0 - alpha * load_ratio * ramp_slope);
-  out.sliding = alpha * load_ratio * sigma * ramp;
+  out.engaged_fraction = std::max(0.0, 1.0 - slope);
+  out.sliding = yield_share * sigma * ramp;
   return out;
 }
 
@@ -130,8 +140,8 @@ PreslidingFriction PreslidingHoleFriction(const PreslidingLaw& law, double tensi
   out.stiffness = t_b * std::sinh(b) / xi_max;
   out.force = -out.stiffness * displacement;
   out.load_ratio = std::abs(displacement) / xi_ss;
-  const ElastoplasticYield yield =
-      ElastoplasticSlide(out.load_ratio, sigma, s_dot, f.stick_velocity_mps);
+  const ElastoplasticYield yield = ElastoplasticSlide(
+      out.load_ratio, sigma, s_dot, f.stick_velocity_mps, law.relaxation_resolution_s / xi_ss);
   out.engaged_fraction = yield.engaged_fraction;
   out.rate = s_dot - yield.sliding;
   out.sliding_speed = yield.sliding;

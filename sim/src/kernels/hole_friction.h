@@ -118,6 +118,9 @@ HoleFrictionForce SmoothedHoleFriction(const HoleFrictionLaw& law, double tensio
 struct PreslidingLaw {
   HoleFrictionLaw friction;
   double presliding_displacement_m = 0.0;  // xi_max
+  // h of model smoothing applied to the relaxation to the limit
+  // (ElastoplasticSlide's relaxation_scale = h / xi_ss); 0: none.
+  double relaxation_resolution_s = 0.0;
 };
 // rho below which presliding is purely elastic (Dupont et al.'s z_ba / z_ss).
 inline constexpr double kPreslidingBreakaway = 0.5;
@@ -125,15 +128,26 @@ inline constexpr double kPreslidingBreakaway = 0.5;
 // The yield of the elastoplastic law, shared by the holes and the large-S
 // conduits: of a contact's slip speed v, the part that slides when its
 // presliding displacement has sign sigma (+-1) and load ratio rho,
-//   sliding = alpha(rho) rho sigma ramp(v sigma),
+//   sliding = alpha(rho) (1 + c (rho - 1)) sigma ramp(v sigma),
 // with alpha and ramp (joined over `band`) as above; the displacement's
-// rate is v - sliding.
+// rate is v - sliding. With c = 1 this is Dupont et al.'s alpha rho.
+// Sliding at the limit, the displacement relaxes to rho = 1 at the rate
+// lambda = c ramp / displacement_ss, which grows with the slip speed (1e3/s
+// at 10 mm/s and 10 um) and held explicit steps of fast motions near 1 ms
+// (docs/model-notes.md row 28). Model smoothing of that relaxation:
+// c = (1 + x^4)^(-1/4), x = ramp h / displacement_ss, so lambda <= ~1/h,
+// the model's time resolution, while c = 1 - x^4/4 + .. leaves slow sliding
+// as it was. rho = 1 stays the only fixed point (steady sliding at eq. 9's
+// force), the elastic range and unloading are untouched, and the plastic
+// power stays >= 0 (1 + c (rho - 1) > 0 wherever alpha > 0).
+// `relaxation_scale` = h / displacement_ss [s/m]; 0 gives c = 1.
 struct ElastoplasticYield {
   double sliding = 0.0;  // [m/s]
   // d(v - sliding)/dv clamped at >= 0 (PreslidingFriction::engaged_fraction).
   double engaged_fraction = 1.0;
 };
-ElastoplasticYield ElastoplasticSlide(double load_ratio, double sigma, double v, double band);
+ElastoplasticYield ElastoplasticSlide(double load_ratio, double sigma, double v, double band,
+                                      double relaxation_scale = 0.0);
 struct PreslidingFriction {
   double force = 0.0;      // F = -k xi [N], right-hand-side signed
   double stiffness = 0.0;  // k [N/m]

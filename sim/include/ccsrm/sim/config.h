@@ -125,6 +125,12 @@ struct SolverConfig {
   // docs/model-notes.md): their torsional modes (150-300 Hz against the link
   // inertia) otherwise cap explicit steps near 1.7 ms.
   bool smooth_connecting_elasticity = true;
+  // Extends model smoothing to the presliding laws' relaxation to their
+  // limit (docs/model-notes.md row 28): sliding fast, it runs at |v|/xi_ss
+  // (1e3/s at 10 mm/s) and caps explicit steps near 1 ms. Smoothed, it is
+  // at most about 1/smoothing_step_s; slow sliding and the steady limit are
+  // unchanged. No effect without a presliding law.
+  bool smooth_presliding_relaxation = true;
   // Solve the equations with every driving-cable node's position written
   // as a function of its link's pose (eq. 7 substituted; 720 of the 1104
   // unknowns of the augmented system go). The same equations as the full
