@@ -108,6 +108,7 @@ TEST(DesignPage, ShowsEveryNumberOfTheDesignAndDrawsTheProposedMotion) {
   if (!testing::ProgramOnPath("gnuplot")) GTEST_SKIP() << "gnuplot not installed";
   const fs::path dir = WriteDesignFolder("written");
   const fs::path out = dir.parent_path() / "design_page_written_report";
+  fs::remove_all(out);  // an earlier run's page, perhaps of an older ccsrm
   const ReportSummary summary = MakeReport(dir.string(), out.string(), ReportOptions());
   EXPECT_EQ(summary.kind, "design");
   const std::string html = ReadTextFile((out / "index.html").string());

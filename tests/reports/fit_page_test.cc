@@ -148,6 +148,7 @@ TEST(FitPage, ReportAgreesWithItsJsonAndReferencesItsFiles) {
   if (!testing::ProgramOnPath("gnuplot")) GTEST_SKIP() << "gnuplot not installed";
   const fs::path dir = WriteFitFolder("written", KnownFitJson());
   const fs::path out = dir.parent_path() / "report";
+  fs::remove_all(out);  // an earlier run's page, perhaps of an older ccsrm
   const ReportSummary summary = MakeReport(dir.string(), out.string(), ReportOptions());
   EXPECT_EQ(summary.kind, "fit");
   const std::string html = ReadTextFile((out / "index.html").string());

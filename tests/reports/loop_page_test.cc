@@ -463,6 +463,7 @@ TEST(LoopPage, ReportAgreesWithItsJsonAndReferencesItsFiles) {
   if (!testing::ProgramOnPath("gnuplot")) GTEST_SKIP() << "gnuplot not installed";
   const fs::path dir = WriteLoopFolder("written", KnownLoopJson());
   const fs::path out = dir.parent_path() / "report";
+  fs::remove_all(out);  // an earlier run's page, perhaps of an older ccsrm
   const ReportSummary summary = MakeReport(dir.string(), out.string(), ReportOptions());
   EXPECT_EQ(summary.kind, "loop");
   const std::string html = ReadTextFile((out / "index.html").string());
@@ -721,6 +722,7 @@ TEST(LoopPage, ScreenshotInHeadlessChromium) {
   if (!testing::ProgramOnPath("chromium")) GTEST_SKIP() << "chromium not installed";
   const fs::path dir = WriteLoopFolder("shot", KnownLoopJson());
   const fs::path out = dir.parent_path() / "report";
+  fs::remove_all(out);  // an earlier run's page, perhaps of an older ccsrm
   MakeReport(dir.string(), out.string(), ReportOptions());
   const fs::path shots = fs::path(CCSRM_BINARY_DIR) / "report_screenshots";
   fs::create_directories(shots);
