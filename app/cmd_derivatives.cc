@@ -235,7 +235,8 @@ void AddDerivativesCommand(CLI::App& root) {
                   "by less than this, RMS [deg] (default 0.003, a tenth of the mocap noise "
                   "floor; 0: none)");
   cmd->add_option("--sweep", a->sweep,
-                  "Instead of derivatives: sweep this parameter and fit a cubic to every angle");
+                  "Instead of derivatives: sweep this parameter and fit a cubic to every angle")
+      ->check(NotEmpty());
   cmd->add_option("--points", a->points, "Values in the sweep (default 21)");
   cmd->add_option("--span", a->span, "Relative half-width of the sweep (default 0.05)");
   cmd->add_option("--json", a->json, "Also write the summary as JSON to this file");

@@ -15,6 +15,7 @@
 #include "ccsrm/sim/effects.h"
 #include "ccsrm/sim/parameters.h"
 #include "commands.h"
+#include "option_checks.h"
 #include "paper_run.h"
 
 namespace ccsrm::app {
@@ -152,15 +153,19 @@ void AddGenerateCommand(CLI::App& root) {
   AddPaperRunOptions(cmd, &a->run);
   AddParameterOptions(cmd, &a->run);
   AddMotionOptions(cmd, &a->run, &a->motion);
+  // A capture system's noise is well below a millimetre; 50 mm (a tenth of
+  // the arm) is no recording of it at all.
   cmd->add_option("--noise-mm", a->noise_mm, "Marker noise, standard deviation [mm]")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(InRange(0.0, 50.0, "mm"));
   cmd->add_option("--resolution-mm", a->resolution_mm,
                   "Round every marker coordinate to this resolution [mm] (the largest power of "
                   "two in m not above it), as a C3D file's integer storage does; shrinks the "
                   "file about four times (default 0: full precision)")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--seed", a->seed, "Seed of the noise and occlusion generator")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(Unsigned64());
   cmd->add_flag("--no-occlusions", a->no_occlusions, "Every marker seen in every frame");
   cmd->add_option("--effects", a->effects_path,
                   "YAML file switching effects on: effect name -> {parameter: value} (truth "

@@ -14,6 +14,7 @@
 #include "ccsrm/sim/simulator.h"
 #include "ccsrm/sim_io/run_file.h"
 #include "commands.h"
+#include "option_checks.h"
 #include "output_kinds.h"
 #include "paper_run.h"
 
@@ -68,8 +69,10 @@ void AddSimulateCommand(CLI::App& root) {
   AddPaperRunOptions(cmd, &a->run);
   AddParameterOptions(cmd, &a->run);
   AddMotionOptions(cmd, &a->run, &a->motion);
+  // NaN is PaperRunOptions' "not given": a typed "nan" is refused here.
   cmd->add_option("--output-rate", a->run.output_rate_hz,
-                  "Output frames per second (default: solver.output_rate_hz)");
+                  "Output frames per second (default: solver.output_rate_hz)")
+      ->check(InRange(1e-3, 1e5, "Hz"));  // solver.output_rate_hz
   cmd->add_option("--out", a->out, "Output run file (.h5)")->required();
   cmd->add_flag("--quiet", a->quiet, "No progress lines");
   cmd->callback([a] {

@@ -47,6 +47,24 @@ std::string RangeRule(double min, double max, const std::string& unit) {
 
 }  // namespace
 
+CLI::Validator NotEmpty() {
+  return CLI::Validator(
+      [](std::string& text) { return text.empty() ? std::string("is empty: give a value") : ""; },
+      "", "");
+}
+
+CLI::Validator Unsigned64() {
+  return CLI::Validator(
+      [](std::string& text) {
+        const bool digits = !text.empty() && text.size() <= 20 &&
+                            text.find_first_not_of("0123456789") == std::string::npos;
+        // 2^64 - 1 has 20 digits; a longer or larger text does not fit.
+        if (digits && (text.size() < 20 || text <= "18446744073709551615")) return std::string();
+        return "must be a whole number in [0, 18446744073709551615], found " + text;
+      },
+      "", "");
+}
+
 CLI::Validator InRange(double min, double max, const std::string& unit) {
   return NumberCheck([min, max](double v) { return v >= min && v <= max; },
                      RangeRule(min, max, unit));

@@ -23,6 +23,14 @@ CLI::Validator Above(double min, const std::string& unit = "");
 // A number of at least `min` (NaN refused).
 CLI::Validator AtLeast(double min, const std::string& unit = "");
 
+// A value given at all: "--config ''" is refused ("is empty: give a
+// value"), never read as the option left out (the default).
+CLI::Validator NotEmpty();
+
+// A whole number in [0, 2^64 - 1], as a seed: "-1" and "1e30" are refused,
+// not wrapped around.
+CLI::Validator Unsigned64();
+
 // For a value checked once parsing is done (e.g. one whose option another
 // command registers): throws CLI::ValidationError naming `option` unless
 // `value` is in [min, max] (NaN refused), with InRange's message.

@@ -46,9 +46,11 @@ void AddPaperRunOptions(CLI::App* command, sim::PaperRunOptions* args) {
 }
 
 void AddConfigOption(CLI::App* command, std::string* config_path) {
-  command->add_option("--config", *config_path,
-                      "Arm configuration (YAML); default: the bundled paper.yaml, from the "
-                      "source tree's configs/ or the installed share/ccsrm/configs");
+  command
+      ->add_option("--config", *config_path,
+                   "Arm configuration (YAML); default: the bundled paper.yaml, from the "
+                   "source tree's configs/ or the installed share/ccsrm/configs")
+      ->check(NotEmpty());
 }
 
 void AddParameterOptions(CLI::App* command, sim::PaperRunOptions* args) {
@@ -60,9 +62,11 @@ void AddParameterOptions(CLI::App* command, sim::PaperRunOptions* args) {
                           ", or an effect's <effect>.<parameter>, which switches the effect "
                           "on: ccsrm generate --list-effects); repeatable, applied after the "
                           "case and --params");
-  command->add_option("--params", args->params_path,
-                      "YAML file of parameter values (name: value, or a truth file's "
-                      "'parameters:')");
+  command
+      ->add_option("--params", args->params_path,
+                   "YAML file of parameter values (name: value, or a truth file's "
+                   "'parameters:')")
+      ->check(NotEmpty());
 }
 
 void AddMotionOptions(CLI::App* command, sim::PaperRunOptions* args, MotionArgs* motion) {
@@ -71,10 +75,12 @@ void AddMotionOptions(CLI::App* command, sim::PaperRunOptions* args, MotionArgs*
       "Protocol file (ccsrm-protocol/1, docs/protocols.md), with optional values of its "
       "parameters after '@' (paper.yaml@ramp_s=10,hold_s=2, in the file's units); default: the "
       "bundled protocols/paper.yaml with the configuration's protocol: section");
+  protocol->check(NotEmpty());
   CLI::Option* inputs = command->add_option(
       "--inputs", motion->inputs_path,
       "Recorded input lengths instead of a protocol: an experiment (/input) or run file, or a "
       "CSV/TSV table with a header (time_s or time_ms, cable1_m or cable1_mm, ...)");
+  inputs->check(NotEmpty());
   protocol->excludes(inputs);
   command
       ->add_option("--inputs-time-unit", motion->time_unit,

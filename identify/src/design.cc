@@ -1,4 +1,5 @@
 #include "ccsrm/identify/design.h"
+#include "ccsrm/identify/runs.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -80,7 +81,9 @@ bool DesignOptions::IsValid(std::string* error) const {
   }
   if (low_pass_order < 1 || low_pass_order > 8) return fail("low_pass_order must be in 1..8");
   if (low_pass_min_run_frames < 2) return fail("low_pass_min_run_frames must be >= 2");
-  if (threads < 1) return fail("threads must be >= 1");
+  if (const std::string problem = ThreadCountProblem(threads); !problem.empty()) {
+    return fail(problem);
+  }
   std::set<std::string> boxed;
   for (const PriorRange& range : prior_box) {
     if (!boxed.insert(range.name).second) {

@@ -1,4 +1,5 @@
 #include "ccsrm/identify/identification.h"
+#include "ccsrm/identify/runs.h"
 
 #include <ceres/ceres.h>
 #include <ceres/covariance.h>
@@ -736,7 +737,9 @@ bool IdentificationOptions::IsValid(std::string* error) const {
   if (!(relative_step > 0.0 && relative_step <= 0.1)) {
     return fail("relative_step must be in (0, 0.1]");
   }
-  if (threads < 1) return fail("threads must be >= 1");
+  if (const std::string problem = ThreadCountProblem(threads); !problem.empty()) {
+    return fail(problem);
+  }
   if (max_iterations < 0) return fail("max_iterations must be >= 0");
   if (!(function_tolerance > 0.0) || !(parameter_tolerance > 0.0) || !(gradient_tolerance > 0.0)) {
     return fail("tolerances must be > 0");

@@ -66,8 +66,38 @@ OutputKind DesignFolderOutput() {
 
 namespace internal {
 
+namespace {
+
+// The same file by two names (a link, "./a.h5"), or the same name twice.
+bool SameFile(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  return fs::equivalent(a, b, ec) ||
+         fs::absolute(a, ec).lexically_normal() == fs::absolute(b, ec).lexically_normal();
+}
+
+}  // namespace
+
+void RefuseRepeatedFiles(const std::vector<std::string>& files, const std::string& option,
+                         const std::vector<std::string>& others, const std::string& others_option) {
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    for (std::size_t j = i + 1; j < files.size(); ++j) {
+      if (SameFile(files[i], files[j])) {
+        ThrowInputError(files[j], option,
+                        "given twice (as '" + files[i] + "'): an experiment counts once");
+      }
+    }
+    for (const std::string& other : others) {
+      if (SameFile(files[i], other)) {
+        ThrowInputError(other, others_option,
+                        "is also in " + option + ": a held-out experiment must not be fitted");
+      }
+    }
+  }
+}
+
 void ApplyFitJob(const FitJobOptions& job, IdentificationOptions* fit) {
   if (job.data.empty()) ThrowInputError("--data", "", "give at least one experiment file");
+  RefuseRepeatedFiles(job.data, "--data", {}, "");
   fit->threads = job.runs.threads;
   fit->max_iterations = job.max_iterations;
   const FitParameterChoice& p = job.parameters;

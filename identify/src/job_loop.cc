@@ -35,6 +35,8 @@ LoopJobResult RunLoopJob(const LoopJobOptions& job) {
   LoopOptions options;
   options.max_rounds = job.max_rounds;
   internal::ApplyFitJob(job, &options.fit);
+  internal::RefuseRepeatedFiles(job.holdout, "--holdout", {}, "");
+  internal::RefuseRepeatedFiles(job.data, "--data", job.holdout, "--holdout");
   const FitParameterChoice& p = job.parameters;
   if (job.candidates) options.candidates = *job.candidates;
   std::string error;

@@ -1,4 +1,5 @@
 #include "ccsrm/identify/mpi_backend.h"
+#include "ccsrm/identify/runs.h"
 
 #include <algorithm>
 #include <atomic>
@@ -27,8 +28,8 @@
 namespace ccsrm::identify {
 
 bool MpiOptions::IsValid(std::string* error) const {
-  if (threads < 1) {
-    *error = "threads must be >= 1";
+  if (const std::string problem = ThreadCountProblem(threads); !problem.empty()) {
+    *error = problem + ", found " + std::to_string(threads);
     return false;
   }
   if (!(run_timeout_s > 0.0)) {

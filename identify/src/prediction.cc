@@ -1,4 +1,5 @@
 #include "ccsrm/identify/prediction.h"
+#include "ccsrm/identify/runs.h"
 
 #include <gsl/gsl_cdf.h>
 #include <yaml-cpp/yaml.h>
@@ -103,8 +104,8 @@ PredictionModel LoadPredictionModel(const std::string& path) {
 }
 
 bool PredictionOptions::IsValid(std::string* error) const {
-  if (threads < 1) {
-    *error = "threads must be >= 1";
+  if (const std::string problem = ThreadCountProblem(threads); !problem.empty()) {
+    *error = problem + ", found " + std::to_string(threads);
     return false;
   }
   if (!(above_noise_ratio > 0.0) || !std::isfinite(above_noise_ratio)) {

@@ -12,6 +12,11 @@ namespace ccsrm::identify {
 
 int DefaultThreads() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
 
+std::string ThreadCountProblem(int threads) {
+  if (threads >= 1 && threads <= kMaxThreads) return "";
+  return "threads: must be in 1.." + std::to_string(kMaxThreads);
+}
+
 std::vector<std::string> AllParameterNames() {
   std::vector<std::string> names;
   for (const sim::ParameterInfo& p : sim::Parameters()) names.push_back(p.name);

@@ -1,6 +1,7 @@
 // DerivativeCheck: the derivatives of the sampled joint angles at several
 // relative steps, and how well they agree.
 #include "ccsrm/identify/sensitivity.h"
+#include "ccsrm/identify/runs.h"
 
 #include <algorithm>
 #include <chrono>
@@ -159,8 +160,8 @@ bool DerivativeCheckOptions::IsValid(std::string* error) const {
       }
     }
   }
-  if (threads < 1) {
-    *error = "threads: must be >= 1, found " + std::to_string(threads);
+  if (const std::string problem = ThreadCountProblem(threads); !problem.empty()) {
+    *error = problem + ", found " + std::to_string(threads);
     return false;
   }
   if (!(tolerance > 0.0) || !std::isfinite(tolerance)) {

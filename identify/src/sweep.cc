@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/identify/runs.h"
 #include "ccsrm/identify/sensitivity.h"
 #include "finite_difference.h"
 #include "run_pool.h"
@@ -37,8 +38,8 @@ bool SweepOptions::IsValid(std::string* error) const {
     *error = "span: " + Format("%g", span) + " is outside (0, 1)";
     return false;
   }
-  if (threads < 1) {
-    *error = "threads: must be >= 1, found " + std::to_string(threads);
+  if (const std::string problem = ThreadCountProblem(threads); !problem.empty()) {
+    *error = problem + ", found " + std::to_string(threads);
     return false;
   }
   return true;

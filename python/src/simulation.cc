@@ -29,6 +29,13 @@
 namespace ccsrm::python {
 namespace {
 
+// A number the caller gave, refused unless finite (InputError naming it).
+double Finite(double value, const char* name) {
+  if (!std::isfinite(value))
+    ThrowInputError(name, "", "must be a finite number, found " + std::to_string(value));
+  return value;
+}
+
 // A configuration and the model built from it, shared read-only by every
 // run (and every thread) that simulates it.
 struct Model {
@@ -121,9 +128,10 @@ std::shared_ptr<Run> SimulateRun(const Model& model, const py::object& params,
 
   sim::PaperRunOptions options;
   if (!protocol.is_none()) sim::ApplyProtocolSpec(PathString(protocol), "protocol", &options);
-  if (duration) options.duration_s = *duration;
-  if (amplitude_deg) options.amplitude_deg = *amplitude_deg;
-  if (output_rate) options.output_rate_hz = *output_rate;
+  // NaN is PaperRunOptions' "not given": a NaN passed in is refused.
+  if (duration) options.duration_s = Finite(*duration, "duration");
+  if (amplitude_deg) options.amplitude_deg = Finite(*amplitude_deg, "amplitude_deg");
+  if (output_rate) options.output_rate_hz = Finite(*output_rate, "output_rate");
   options.recorded_input_options.max_gap_s = max_input_gap;
   if (!inputs.is_none()) {
     // Columns as a table of inputs has them: time [s], then the pulled-in
@@ -186,8 +194,8 @@ py::dict Generate(const py::object& out, const py::object& config, std::optional
   options.run.config_path = sim::ConfigPathOrBundled(config.is_none() ? "" : PathString(config));
   options.run.case_number = case_number.value_or(0);
   if (!protocol.is_none()) sim::ApplyProtocolSpec(PathString(protocol), "protocol", &options.run);
-  if (duration) options.run.duration_s = *duration;
-  if (amplitude_deg) options.run.amplitude_deg = *amplitude_deg;
+  if (duration) options.run.duration_s = Finite(*duration, "duration");
+  if (amplitude_deg) options.run.amplitude_deg = Finite(*amplitude_deg, "amplitude_deg");
   for (const auto& [name, value] : params) {
     char text[48];
     std::snprintf(text, sizeof(text), "=%.17g", value);  // to the last bit

@@ -48,7 +48,7 @@ def test_fit_equals_command_lines_fit_json(exe, experiment, tmp_path):
     (dict(free=" "), "--free: is empty: give at least one name"),
     (dict(free="mu,,T_p"), "--free: empty item in 'mu,,T_p'"),
     (dict(free="T_p", set={"beta": 3}), "--set: parameter 'beta' = 3 is outside [0, 0.1] s"),
-    (dict(free="T_p", threads=0), "identify: threads must be >= 1"),
+    (dict(free="T_p", threads=0), "identify: threads: must be in 1..1024"),
     (dict(free="T_p", relative_step=0.5), "identify: relative_step must be in (0, 0.1]"),
 ])
 def test_bad_fit_options_raise_before_any_run(experiment, kwargs, message):

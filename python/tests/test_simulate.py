@@ -261,3 +261,11 @@ def test_paper_case_2_over_the_whole_protocol_equals_command_line(exe, paper_con
     run = ccsrm.simulate(paper_model, case=2)
     assert run.summary.completed and run.frames == 4801
     assert_same_as_file(run, out)
+
+
+def test_a_nan_is_refused_not_read_as_not_given(paper_model):
+    # Issue 47, 9: NaN is the library's "not given"; passed in, it is refused.
+    for name in ("duration", "amplitude_deg", "output_rate"):
+        with pytest.raises(ccsrm.InputError) as e:
+            ccsrm.simulate(paper_model, case=1, **{name: float("nan")})
+        assert name in str(e.value) and "finite" in str(e.value)

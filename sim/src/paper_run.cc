@@ -183,7 +183,10 @@ void ApplyProtocolSpec(const std::string& spec, const std::string& where,
     if (!problem.empty()) ThrowInputError(where, name, problem);
     // Protocol parameters are given in the file's units (deg for _deg).
     const bool degrees = name.size() > 4 && name.compare(name.size() - 4, 4, "_deg") == 0;
-    options->protocol_parameters[name] = degrees ? value * M_PI / 180.0 : value;
+    if (!options->protocol_parameters.emplace(name, degrees ? value * M_PI / 180.0 : value)
+             .second) {
+      ThrowInputError(where, name, "given twice after '@'");
+    }
     if (end == std::string::npos) return;
     start = end + 1;
   }

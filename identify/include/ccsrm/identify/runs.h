@@ -32,6 +32,14 @@ std::vector<double> SampledJointAnglesDeg(const sim::Trajectory& trajectory);
 // std::thread::hardware_concurrency(), or 1 when it is unknown.
 int DefaultThreads();
 
+// The most runs a batch takes at a time: beyond a machine's cores they only
+// queue, and a slip of the keyboard (100000) would otherwise be refused only
+// by the memory of that many simulations.
+inline constexpr int kMaxThreads = 1024;
+// "" when `threads` is in 1..kMaxThreads, else "threads: must be in
+// 1..1024" (the callers add what was found where they know it).
+std::string ThreadCountProblem(int threads);
+
 // The names of every entry of sim::Parameters(), in table order.
 std::vector<std::string> AllParameterNames();
 
