@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <set>
 #include <string>
 #include <utility>
@@ -119,6 +120,27 @@ void ValidateQuality(const ExperimentFile& experiment, const std::string& file) 
   }
 }
 
+// No capture volume reaches 100 m from its origin (a large hall's is ~20 m):
+// a coordinate beyond is a corrupted sample, which the pipeline would
+// otherwise turn into joint angles without a word (issue 47, 6).
+constexpr double kCaptureVolumeLimitM = 100.0;
+
+void ExpectWithinCaptureVolume(const ExperimentFile& experiment, const std::string& file) {
+  const std::vector<double>& xyz = experiment.mocap_markers.values;
+  const std::size_t markers = experiment.marker_names.size();
+  for (std::size_t i = 0; i < xyz.size(); ++i) {
+    // NaN and infinity are "not seen" (the marker readers' rule).
+    if (!(std::abs(xyz[i]) > kCaptureVolumeLimitM) || std::isinf(xyz[i])) continue;
+    const std::size_t sample = i / 3;
+    char value[32];
+    std::snprintf(value, sizeof(value), "%.6g", xyz[i]);
+    ThrowInputError(file, "/mocap/markers",
+                    "marker '" + experiment.marker_names[sample % markers] + "' at frame " +
+                        std::to_string(sample / markers) + " has a coordinate of " + value +
+                        " m, beyond any capture volume (|coordinate| <= 100 m)");
+  }
+}
+
 }  // namespace
 
 const char* ExperimentSourceName(ExperimentSource source) {
@@ -145,6 +167,7 @@ void ValidateExperimentFile(const ExperimentFile& experiment, const std::string&
                         std::to_string(experiment.marker_names.size()));
   }
   internal::ExpectUniqueNames(file, "/mocap/marker_names", experiment.marker_names);
+  ExpectWithinCaptureVolume(experiment, file);
   if (const auto& a = experiment.clock_alignment) {
     if (a->method != "trigger" && a->method != "estimate" && a->method != "offset") {
       ThrowInputError(file, "clock_alignment",

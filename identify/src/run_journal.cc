@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <utility>
 
@@ -40,18 +42,26 @@ RunJournal::RunJournal(const std::string& path, bool resume)
   std::int64_t valid_bytes = 0;
   if (resume) {
     std::ifstream in(path, std::ios::binary);
+    std::error_code ec;
+    const std::uintmax_t file_size = std::filesystem::file_size(path, ec);
     for (;;) {
       std::uint64_t size = 0, sum = 0;
       if (!in.read(reinterpret_cast<char*>(&size), sizeof(size))) break;
       if (!in.read(reinterpret_cast<char*>(&sum), sizeof(sum))) break;
+      // A size the rest of the file cannot hold is a torn or garbled tail:
+      // checked before anything is allocated for it.
+      const std::uint64_t left =
+          ec ? 0 : file_size - static_cast<std::uint64_t>(valid_bytes) - 2 * sizeof(std::uint64_t);
+      if (size < sizeof(std::uint64_t) || size > left) break;
       std::vector<char> bytes(static_cast<std::size_t>(size));
-      if (size > (1ULL << 34) || !in.read(bytes.data(), static_cast<std::streamsize>(size)) ||
-          Checksum(bytes) != sum) {
+      if (!in.read(bytes.data(), static_cast<std::streamsize>(size)) || Checksum(bytes) != sum) {
         break;  // cut short by a kill: this record and anything after it
       }
       internal::Unpacker unpack(bytes);
+      const std::uint64_t request_size = unpack.Get<std::uint64_t>();
+      if (request_size > size - sizeof(std::uint64_t)) break;
       Record r;
-      r.request.resize(unpack.Get<std::uint64_t>());
+      r.request.resize(request_size);
       r.result.resize(bytes.size() - sizeof(std::uint64_t) - r.request.size());
       std::memcpy(r.request.data(), bytes.data() + sizeof(std::uint64_t), r.request.size());
       std::memcpy(r.result.data(), bytes.data() + sizeof(std::uint64_t) + r.request.size(),

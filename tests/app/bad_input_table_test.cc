@@ -213,6 +213,11 @@ class BadInputTable : public ::testing::Test {
                "put('/mocap/markers', np.full(f['/mocap/markers'].shape, np.nan))");
     MutateHdf5(d / "exp.h5", d / "inf.h5",
                "put('/mocap/markers', np.full(f['/mocap/markers'].shape, np.inf))");
+    // One marker coordinate far outside any capture volume (issue 47, 6).
+    MutateHdf5(d / "exp.h5", d / "outlier.h5",
+               "x = f['/mocap/markers'][...]\nx[2, 1, 0] = 1e20\nput('/mocap/markers', x)");
+    MutateHdf5(d / "exp.h5", d / "outlier1k.h5",
+               "x = f['/mocap/markers'][...]\nx[5, 0, 2] = 1e3\nput('/mocap/markers', x)");
     // A recorded experiment (issue 47, 4): its measurements no run gives back.
     MutateHdf5(processed, d / "recorded.h5", "f.attrs['source'] = 'recorded'");
     // A stub made to look like an earlier fit (issue 47, 3), and a real
@@ -446,6 +451,15 @@ const std::vector<BadInput>& Rows() {
        "mocap process --in {d}/inf.h5 --out {d}/x.h5",
        {"{d}/inf.h5", "/mocap/markers"}},  // 4
       {"markers", "mocap inspect {d}/notes.c3d", {"{d}/notes.c3d"}},
+      {"markers",
+       "mocap process --in {d}/outlier.h5 --out {d}/x.h5",
+       {"{d}/outlier.h5", "/mocap/markers", "frame 2", "1e+20 m", "capture volume"}},  // 47: 6
+      {"markers",
+       "dataset inspect {d}/outlier.h5",
+       {"{d}/outlier.h5", "/mocap/markers", "capture volume"}},  // 47: 6
+      {"markers",
+       "identify --data {d}/outlier1k.h5 --free mu --out {d}/f",
+       {"{d}/outlier1k.h5", "/mocap/markers", "frame 5", "1000 m"}},  // 47: 6
       {"markers", "mocap process --in {d}/missing.c3d --out {d}/x.h5", {"{d}/missing.c3d"}},
       // Actuator logs and maps (dataset assemble, issue 27).
       {"actuators",

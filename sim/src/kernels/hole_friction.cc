@@ -105,7 +105,7 @@ ElastoplasticYield ElastoplasticSlide(double load_ratio, double sigma, double v,
   const double c = 1.0 / std::sqrt(std::sqrt(1.0 + x4));
   const double dc_dx = x4 > 0.0 ? -c * x4 / (x * (1.0 + x4)) : 0.0;
   const double yield_share = alpha * (1.0 + c * (load_ratio - 1.0));
-  // d(ramp yield_share)/d(loading), c's part through x = ramp h / ..
+  // d(ramp yield_share)/d(loading), c depending on the loading through x.
   const double slope = ramp_slope * (yield_share + alpha * (load_ratio - 1.0) * dc_dx * x);
   // The clamp acts only sliding near the band at the limit, where the slope
   // of ramp exceeds 1 (it must catch up with x); a negative mass would be
