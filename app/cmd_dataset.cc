@@ -93,12 +93,9 @@ void AddDatasetCommands(CLI::App& root) {
   inspect->add_option("FILE", args->path, "HDF5 file")->required();
   inspect->add_flag("--json", args->json, "Print one JSON object instead of text");
   inspect->callback([args] {
-    // Read once; an experiment is also checked against its own config_yaml
-    // and the joints' range, as identification and mocap process check it.
-    const datasets::AnyFile file = datasets::ReadAnyFile(args->path);
-    if (const auto* experiment = std::get_if<datasets::ExperimentFile>(&file)) {
-      sim_io::CheckExperimentAgainstConfig(*experiment, args->path);
-    }
+    // Read once, through the door every command reading a file whole uses:
+    // an experiment or run checked against its own config_yaml.
+    const datasets::AnyFile file = sim_io::ReadCheckedFile(args->path);
     const datasets::FileSummary summary = datasets::Summarise(file, args->path);
     if (args->json) {
       std::printf("%s\n", datasets::ToJson(summary).dump(2).c_str());

@@ -120,31 +120,31 @@ void ValidateQuality(const ExperimentFile& experiment, const std::string& file) 
   }
 }
 
-// No capture volume reaches 100 m from its origin (a large hall's is ~20 m):
-// a coordinate beyond is a corrupted sample, which the pipeline would
-// otherwise turn into joint angles without a word (issue 47, 6).
-constexpr double kCaptureVolumeLimitM = 100.0;
-
 void ExpectWithinCaptureVolume(const ExperimentFile& experiment, const std::string& file) {
-  const std::vector<double>& xyz = experiment.mocap_markers.values;
-  const std::size_t markers = experiment.marker_names.size();
-  for (std::size_t i = 0; i < xyz.size(); ++i) {
-    // NaN and infinity are "not seen" (the marker readers' rule).
-    if (!(std::abs(xyz[i]) > kCaptureVolumeLimitM) || std::isinf(xyz[i])) continue;
-    const std::size_t sample = i / 3;
-    char value[32];
-    std::snprintf(value, sizeof(value), "%.6g", xyz[i]);
-    ThrowInputError(file, "/mocap/markers",
-                    "marker '" + experiment.marker_names[sample % markers] + "' at frame " +
-                        std::to_string(sample / markers) + " has a coordinate of " + value +
-                        " m, beyond any capture volume (|coordinate| <= 100 m)");
-  }
+  const std::string beyond =
+      MarkerBeyondCaptureVolume(experiment.mocap_markers.values, experiment.marker_names);
+  if (!beyond.empty()) ThrowInputError(file, "/mocap/markers", beyond);
 }
 
 }  // namespace
 
 const char* ExperimentSourceName(ExperimentSource source) {
   return source == ExperimentSource::kRecorded ? "recorded" : "generated";
+}
+
+std::string MarkerBeyondCaptureVolume(const std::vector<double>& xyz,
+                                      const std::vector<std::string>& names) {
+  const std::size_t markers = names.size();
+  for (std::size_t i = 0; i < xyz.size() && markers > 0; ++i) {
+    if (!(std::abs(xyz[i]) > kCaptureVolumeLimitM) || std::isinf(xyz[i])) continue;
+    const std::size_t sample = i / 3;
+    char value[32];
+    std::snprintf(value, sizeof(value), "%.6g", xyz[i]);
+    return "marker '" + names[sample % markers] + "' at frame " + std::to_string(sample / markers) +
+           " has a coordinate of " + value +
+           " m, beyond any capture volume (|coordinate| <= 100 m)";
+  }
+  return "";
 }
 
 void ValidateExperimentFile(const ExperimentFile& experiment, const std::string& file) {

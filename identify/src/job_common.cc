@@ -98,6 +98,14 @@ void RefuseRepeatedFiles(const std::vector<std::string>& files, const std::strin
 void ApplyFitJob(const FitJobOptions& job, IdentificationOptions* fit) {
   if (job.data.empty()) ThrowInputError("--data", "", "give at least one experiment file");
   RefuseRepeatedFiles(job.data, "--data", {}, "");
+  // The library's 0 (statistics at the start values, which design uses) is
+  // no fit: a job that asked for one would report "converged" unmoved.
+  if (job.max_iterations < 1) {
+    ThrowInputError("--max-iterations", "",
+                    "is " + std::to_string(job.max_iterations) +
+                        ": a fit takes at least 1 iteration (`ccsrm predict` evaluates values "
+                        "without fitting)");
+  }
   fit->threads = job.runs.threads;
   fit->max_iterations = job.max_iterations;
   const FitParameterChoice& p = job.parameters;
@@ -177,6 +185,11 @@ nlohmann::json ReadCheckpoint(const std::string& out, const CheckpointKey& key) 
                     "no checkpoint here: nothing to resume (run without --resume)");
   }
   const nlohmann::json json = nlohmann::json::parse(ReadTextFile(path), nullptr, false);
+  if (json.is_discarded()) {
+    ThrowInputError(path, "--resume",
+                    "corrupt: not JSON (cut short by a full disk?); nothing to resume (remove the "
+                    "folder, or run without --resume into a new one)");
+  }
   if (!json.is_object() || json.value("schema", "") != kCheckpointSchema) {
     ThrowInputError(path, "schema", std::string("not a ") + kCheckpointSchema + " file");
   }

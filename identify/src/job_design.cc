@@ -149,11 +149,12 @@ DesignJobResult RunDesignJob(const DesignJobOptions& job) {
     candidates.push_back(std::move(candidate));
   }
   if (job.out.empty()) ThrowInputError("--out", "", "is required");
-  CheckOutputPath(job.out, "--out", DesignFolderOutput(), inputs);
   // A design is resumed by running it again over the journal of its runs
-  // (as a loop is): it asks for the same runs in the same order.
+  // (as a loop is): it asks for the same runs in the same order. The
+  // checkpoint is read first, so that a corrupt one is named as such.
   const CheckpointKey key = MakeCheckpointKey("design", ResultOptions(job, options), inputs);
   if (job.resume) ReadCheckpoint(job.out, key);  // refuses other data, options or version
+  CheckOutputPath(job.out, "--out", DesignFolderOutput(), inputs);
   DesignJobResult result;
   const sim::Config prior = sim::PreparePaperRun(PriorRun(job), config).config;
   // Under mpirun every rank builds the candidates itself from the same

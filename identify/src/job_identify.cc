@@ -35,12 +35,14 @@ IdentifyJobResult RunIdentifyJob(const IdentifyJobOptions& job) {
   std::vector<std::string> inputs = job.data;
   inputs.push_back(p.params_path);
   if (!job.out.empty()) {
-    CheckOutputPath(job.out, "--out", FitFolderOutput(), inputs);
     const CheckpointKey key = MakeCheckpointKey("identify", ResultOptions(job), inputs);
+    // The checkpoint first: a corrupt one is named as such, not as a folder
+    // of another kind.
     if (job.resume) {
       options.resume = std::make_shared<FitCheckpoint>(
           FitCheckpointFromJson(ReadCheckpoint(job.out, key), CheckpointPath(job.out)));
     }
+    CheckOutputPath(job.out, "--out", FitFolderOutput(), inputs);
     options.on_checkpoint = [out = job.out, key](const FitCheckpoint& c) {
       WriteCheckpoint(out, key, ToJson(c));
     };

@@ -48,9 +48,11 @@ LoopJobResult RunLoopJob(const LoopJobOptions& job) {
   // A loop is resumed by running it again over the journal of its runs.
   std::optional<CheckpointKey> key;
   if (!job.out.empty()) {
-    CheckOutputPath(job.out, "--out", LoopFolderOutput(), inputs);
     key = MakeCheckpointKey("loop", ResultOptions(job), inputs);
-    if (job.resume) ReadCheckpoint(job.out, *key);  // refuses other data, options or version
+    // The checkpoint first: a corrupt one is named as such, not as a folder
+    // of another kind. It refuses other data, options or version.
+    if (job.resume) ReadCheckpoint(job.out, *key);
+    CheckOutputPath(job.out, "--out", LoopFolderOutput(), inputs);
   } else if (job.resume) {
     ThrowInputError("--resume", "", "needs the folder of the stopped loop (--out)");
   }

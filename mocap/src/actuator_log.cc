@@ -183,6 +183,14 @@ ActuatorMap ParseActuatorMap(const std::string& yaml_text, const std::string& fi
             Positive(file, Require(file, node, path, "counts_per_turn"), path + ".counts_per_turn");
         if (const YAML::Node v = node["wrap_counts"]) {
           c.wrap_counts = Positive(file, v, path + ".wrap_counts");
+          // A counter wraps after a whole number of turns at least (a
+          // single-turn absolute encoder: exactly one). Less would take
+          // every step between two samples as under half that range.
+          if (c.wrap_counts < c.counts_per_turn) {
+            Fail(file, v, path + ".wrap_counts",
+                 "is " + v.Scalar() + ", less than counts_per_turn (" + Format(c.counts_per_turn) +
+                     "): a counter wraps after one motor turn at the earliest");
+          }
         }
       } else {
         for (const char* key : {"counts_per_turn", "wrap_counts"}) {
@@ -244,7 +252,17 @@ ActuatorLog ParseActuatorLog(const std::string& text, const std::string& source_
   const internal::TextRow& header = rows[r];
   auto column_of = [&](const std::string& name, const std::string& key) {
     for (std::size_t c = 0; c < header.cells.size(); ++c) {
-      if (header.cells[c] == name) return c;
+      if (header.cells[c] != name) continue;
+      // A mapped column named twice: which one the map means is a guess.
+      for (std::size_t other = c + 1; other < header.cells.size(); ++other) {
+        if (header.cells[other] == name) {
+          ThrowInputError(source_name, "line " + std::to_string(header.line),
+                          "column '" + name + "' (named by " + map_file + ", key '" + key +
+                              "') appears twice, as columns " + std::to_string(c + 1) + " and " +
+                              std::to_string(other + 1));
+        }
+      }
+      return c;
     }
     ThrowInputError(source_name, "line " + std::to_string(header.line),
                     "no column '" + name + "' (named by " + map_file + ", key '" + key +
@@ -287,6 +305,16 @@ ActuatorLog ParseActuatorLog(const std::string& text, const std::string& source_
   for (++r; r < rows.size(); ++r) {
     const internal::TextRow& row = rows[r];
     if (skipped(row)) continue;
+    // More cells than the header names: a delimiter in a value (a decimal
+    // comma) or a row joined from two; any reading of it is a guess.
+    std::size_t cells = row.cells.size();
+    while (cells > header.cells.size() && row.cells[cells - 1].empty()) --cells;
+    if (cells > header.cells.size()) {
+      ThrowInputError(source_name, "line " + std::to_string(row.line),
+                      "has " + std::to_string(cells) + " cells, the header (line " +
+                          std::to_string(header.line) + ") names " +
+                          std::to_string(header.cells.size()) + " columns");
+    }
     const double t = read(row, time_column) * seconds;
     if (!time.empty()) {
       const std::string where =
@@ -297,7 +325,9 @@ ActuatorLog ParseActuatorLog(const std::string& text, const std::string& source_
                             Format(time.back()) + " s, line " + std::to_string(log.lines.back()) +
                             ")");
       }
-      if (t - time.back() > map.max_gap_s) {
+      // The margin absorbs rounding of the unit's scale (100 ms is
+      // 0.10000000000000001 s): a gap exactly at the limit is allowed.
+      if (t - time.back() > map.max_gap_s * (1.0 + 1e-9)) {
         ThrowInputError(source_name, where,
                         "a gap of " + Format(t - time.back()) + " s after " + Format(time.back()) +
                             " s, longer than the " + Format(map.max_gap_s) + " s allowed (" +

@@ -239,7 +239,9 @@ class ParameterSection {
       const std::uint64_t name_at = at + 2;
       need(name_at, static_cast<std::uint64_t>(name_length) + 2,
            "a parameter name and next-record offset");
-      const std::string name = Upper(in_.Chars(name_at, name_length));
+      // Names are ASCII by the format; a damaged file's bytes are escaped so
+      // that a message naming one stays one line.
+      const std::string name = internal::Printable(Upper(in_.Chars(name_at, name_length)));
       const std::uint64_t offset_at = name_at + name_length;
       const std::uint16_t next = in_.U16(offset_at, "next-record offset");
       if (id < 0) {

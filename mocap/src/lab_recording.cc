@@ -14,6 +14,7 @@
 #include "ccsrm/mocap/c3d.h"
 #include "ccsrm/mocap/marker_io.h"
 #include "ccsrm/sim/config.h"
+#include "ccsrm/sim/recorded_inputs.h"
 
 namespace ccsrm::mocap {
 namespace {
@@ -145,6 +146,19 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
                     "maps " + std::to_string(log.length_change_m.cols()) + " cable(s), the arm (" +
                         request.config + ") has " + std::to_string(model.num_cables()) +
                         " driving cables");
+  }
+  {
+    // The log's lengths within the arm's bounds: a column in the wrong unit
+    // (mm declared m) pulls a cable metres, which the kinematic check
+    // cannot see (it compares shapes, not scale).
+    sim::RecordedInputs record;
+    record.source_name = request.actuators;
+    record.time_name = map.time_column;
+    record.cable_names = log.cable_columns;
+    record.time_s = log.time_s;
+    record.length_change_m = log.length_change_m;
+    record.lines.assign(log.lines.begin(), log.lines.end());
+    sim::CheckRecordedInputsOnArm(record, model);
   }
   if (request.sync == ClockSync::kTrigger && log.trigger.size() == 0) {
     ThrowInputError(request.actuator_map, "trigger",

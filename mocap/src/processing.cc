@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/mocap/rigid_bodies.h"
 #include "ccsrm/mocap/signal.h"
 #include "ccsrm/sim/kinematics.h"
@@ -336,6 +337,10 @@ std::size_t CheckProcessingInputs(const MarkerTable& table, const MarkerLayout& 
                     "has no finite sample (every position NaN or infinite): no marker was ever "
                     "seen, so there is no pose to fit");
   }
+  // Every format, at this one door (an experiment's own file is checked
+  // when read, by datasets::ValidateExperimentFile).
+  const std::string beyond = datasets::MarkerBeyondCaptureVolume(table.positions_m, table.labels);
+  if (!beyond.empty()) ThrowInputError(source, MarkerField(table), beyond);
   int num_links = 0;
   for (const RigidBody& body : layout.bodies) num_links = std::max(num_links, body.link);
   return static_cast<std::size_t>(num_links);
@@ -381,6 +386,44 @@ void ReadRawMarkers(const MarkerTable& table, const MarkerLayout& layout,
       const std::vector<Gap> gaps = FindGaps(m->raw.column(k, 0), F, m->raw.stride());
       q.gaps_before_fill = gaps.size();
       q.longest_gap_before_fill = LongestGap(gaps);
+    }
+  }
+}
+
+// The rigid bodies describe the markers recorded: on each body the distance
+// between two markers, as seen (median over the frames both are), is the
+// layout's within 10 mm or a fifth of it, whichever is more. Markers on a
+// rigid body keep their distances within the noise (a fraction of a mm), and
+// a layout placed by hand is off by millimetres (which a static trial
+// refines); more is another arm, another marker set or another unit, and
+// fitting it anyway gives angles of nothing (a fit RMS of 100 mm).
+void CheckLayoutFitsMarkers(const MarkerLayout& layout, const PipelineMarkers& m,
+                            const std::string& source, const std::string& field) {
+  std::vector<double> seen;
+  for (std::size_t b = 0; b < m.B; ++b) {
+    const RigidBody& body = layout.bodies[b];
+    for (std::size_t i = 0; i < body.marker_names.size(); ++i) {
+      for (std::size_t j = i + 1; j < body.marker_names.size(); ++j) {
+        const std::size_t ki = m.offset[b] + i, kj = m.offset[b] + j;
+        seen.clear();
+        for (std::size_t f = 0; f < m.F; ++f) {
+          if (m.raw.finite(f, ki) && m.raw.finite(f, kj)) {
+            seen.push_back((m.raw.get(f, ki) - m.raw.get(f, kj)).norm());
+          }
+        }
+        if (seen.empty()) continue;
+        std::nth_element(seen.begin(), seen.begin() + seen.size() / 2, seen.end());
+        const double measured = seen[seen.size() / 2];
+        const double planned = (body.p_BM[i] - body.p_BM[j]).norm();
+        if (std::abs(measured - planned) <= std::max(0.01, 0.2 * planned)) continue;
+        ThrowInputError(source, field,
+                        "markers '" + body.marker_names[i] + "' and '" + body.marker_names[j] +
+                            "' of " + body.name + " are " + Mm(measured) + " mm apart (median of " +
+                            std::to_string(seen.size()) + " frames), the rigid bodies put them " +
+                            Mm(planned) +
+                            " mm apart: the recording is not of this arm's marker set (another "
+                            "--config or --rigid-bodies, or another unit)");
+      }
     }
   }
 }
@@ -727,10 +770,29 @@ ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<doub
   m.L = num_links;
 
   ReadRawMarkers(table, layout, column, names, &m, &summary);
+  CheckLayoutFitsMarkers(layout, m, source, MarkerField(table));
   FillGaps(layout, options, &m, &summary);
   AlignToGround(layout, &m, &summary);
   const BodyPoses X_WB = FitBodies(layout, options, chain, source, m, &summary);
   const LinkRotations R_WB = StoreLinkPoses(layout, X_WB, m, &result);
+  // A body the fit cannot place within 10 mm RMS: the same bounds as
+  // CheckLayoutFitsMarkers, for what only the joint-constrained fit sees
+  // (links of another length between the same marker clusters).
+  const BodyQuality* worst = nullptr;
+  std::size_t beyond = 0;
+  for (const BodyQuality& q : summary.bodies) {
+    if (!(q.fit_rms_m > 0.01)) continue;
+    ++beyond;
+    if (worst == nullptr || q.fit_rms_m > worst->fit_rms_m) worst = &q;
+  }
+  if (worst != nullptr) {
+    ThrowInputError(source, MarkerField(table),
+                    "the markers of " + worst->name + " fit its rigid body to " +
+                        Mm(worst->fit_rms_m) + " mm RMS (" + std::to_string(beyond) +
+                        " bodies beyond 10 mm; within that on the arm they were placed on): the "
+                        "recording is not of this arm's marker set (another --config or "
+                        "--rigid-bodies)");
+  }
   StoreJointAngles(R_WB, F, m.L, &result);
   if (options.cutoff_hz > 0.0) LowPassFittedMotion(options, rate_hz, F, m.L, &result);
   for (std::size_t j = 0; j < m.L; ++j) {

@@ -55,4 +55,20 @@ std::string AsUtf8(const std::string& text) {
   return out;
 }
 
+std::string Printable(const std::string& text) {
+  std::string out;
+  for (const char c : AsUtf8(text)) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte != 0x7f) {
+      out += c;
+      continue;
+    }
+    static const char* const kHex = "0123456789ABCDEF";
+    out += "\\x";
+    out += kHex[byte >> 4];
+    out += kHex[byte & 0xf];
+  }
+  return out;
+}
+
 }  // namespace ccsrm::mocap::internal

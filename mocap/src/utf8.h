@@ -16,4 +16,9 @@ namespace ccsrm::mocap::internal {
 // practice and never fails.
 std::string AsUtf8(const std::string& text);
 
+// `text` fit for a one-line message: AsUtf8, with every control byte
+// (newline, tab, NUL, DEL: what a damaged file holds in a name) written as
+// \xNN.
+std::string Printable(const std::string& text);
+
 }  // namespace ccsrm::mocap::internal

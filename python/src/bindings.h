@@ -5,6 +5,7 @@
 #include <pybind11/pybind11.h>
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "ccsrm/common/output_policy.h"
@@ -24,6 +25,22 @@ py::array View(const datasets::Array& array, const py::object& owner);
 
 // A copy of `values` as a new numpy array (for small vectors built on the fly).
 py::array Copy(const std::vector<double>& values);
+
+// `value` as a T, or TypeError "<name>: expected <expected>, found <type>"
+// (pybind11's own cast_error would reach Python as a RuntimeError naming a
+// C++ type).
+template <typename T>
+T CastArgument(const py::handle& value, const char* name, const char* expected) {
+  try {
+    return value.cast<T>();
+  } catch (const py::cast_error&) {
+    throw py::type_error(std::string(name) + ": expected " + expected + ", found " +
+                         py::str(py::type::handle_of(value).attr("__name__")).cast<std::string>() +
+                         (py::hasattr(value, "shape")
+                              ? " of shape " + py::str(value.attr("shape")).cast<std::string>()
+                              : std::string()));
+  }
+}
 
 // Reads a path argument (str or os.PathLike) as a string.
 std::string PathString(const py::handle& path);

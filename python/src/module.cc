@@ -50,6 +50,15 @@ void AddErrors(py::module_& m) {
   // A ValueError, so code that catches bad values generally catches it too;
   // its message is the library's one line, as the command line prints it.
   py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
+  // An argument of the wrong type that no CastArgument names: a TypeError
+  // still, as Python's own functions raise, not pybind11's RuntimeError.
+  py::register_local_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const py::cast_error& e) {
+      PyErr_SetString(PyExc_TypeError, e.what());
+    }
+  });
 }
 
 }  // namespace ccsrm::python

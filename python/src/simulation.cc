@@ -118,7 +118,8 @@ std::shared_ptr<Run> SimulateRun(const Model& model, const py::object& params,
     }
     config.parameters = given;
   } else if (!params.is_none()) {
-    overrides = params.cast<std::map<std::string, double>>();
+    overrides = CastArgument<std::map<std::string, double>>(
+        params, "params", "a dict of numbers by parameter name, or ccsrm.Parameters");
   }
   // The case's friction switches, then the given values: the order of
   // --case and --set.
@@ -158,7 +159,10 @@ std::shared_ptr<Run> SimulateRun(const Model& model, const py::object& params,
     options.recorded_inputs = std::move(record);
   }
   std::vector<double> samples;
-  if (!sample_times.is_none()) samples = sample_times.cast<std::vector<double>>();
+  if (!sample_times.is_none()) {
+    samples = CastArgument<std::vector<double>>(sample_times, "sample_times",
+                                                "a 1-D sequence of frame times [s]");
+  }
 
   auto run = std::make_shared<Run>();
   InterruptWatch watch;

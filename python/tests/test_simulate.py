@@ -269,3 +269,24 @@ def test_a_nan_is_refused_not_read_as_not_given(paper_model):
         with pytest.raises(ccsrm.InputError) as e:
             ccsrm.simulate(paper_model, case=1, **{name: float("nan")})
         assert name in str(e.value) and "finite" in str(e.value)
+
+
+def test_arguments_of_the_wrong_type_raise_type_error(paper_model):
+    # Issue 47, 13: a TypeError naming the argument, not pybind11's
+    # RuntimeError naming a C++ type.
+    with pytest.raises(TypeError) as e:
+        ccsrm.simulate(paper_model, case=1, duration=0.1, sample_times=np.zeros((2, 3)))
+    assert "sample_times: expected a 1-D sequence" in str(e.value) and "(2, 3)" in str(e.value)
+    with pytest.raises(TypeError) as e:
+        ccsrm.simulate(paper_model, ["mu", 0.2], case=1, duration=0.1)
+    assert "params: expected a dict of numbers" in str(e.value)
+
+
+def test_inputs_beyond_the_arm_are_refused_not_simulated(paper_model):
+    # Issue 47, 10: a cable pulled 10 m in 10 ms hung the run at t = 0.
+    inputs = np.zeros((2, 7))
+    inputs[1, 0] = 0.01
+    inputs[1, 1] = 10.0
+    with pytest.raises(ccsrm.InputError) as e:
+        ccsrm.simulate(paper_model, inputs=inputs)
+    assert "pulls cable 1 in by 10 m" in str(e.value)

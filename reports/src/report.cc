@@ -14,6 +14,7 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/output_policy.h"
 #include "ccsrm/datasets/inspect.h"
+#include "ccsrm/sim_io/experiment_check.h"
 #include "design_folder.h"
 #include "fit_folder.h"
 #include "loop_folder.h"
@@ -158,7 +159,7 @@ ReportSummary MakeReport(const std::string& input, const std::string& output_fol
                : design     ? BuildDesignDocument(input, options)
                             : BuildFitDocument(input, options);
   } else {
-    const datasets::AnyFile file = datasets::ReadAnyFile(input);
+    const datasets::AnyFile file = sim_io::ReadCheckedFile(input);
     FindGnuplot(options.plot);
     document =
         std::holds_alternative<datasets::RunFile>(file)

@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
@@ -617,9 +618,16 @@ std::vector<std::string> ArmWarnings(const Config& c, const LineMap* lines) {
 }
 
 void CheckSolver(const SolverConfig& s, const Checker& check) {
-  check.NonNegative("solver.baumgarte_alpha_per_s", s.baumgarte_alpha_per_s);
-  check.NonNegative("solver.baumgarte_beta_per_s2", s.baumgarte_beta_per_s2);
-  check.NonNegative("solver.smoothing_step_s", s.smoothing_step_s);
+  // Stabilisation up to 1000 times the paper's 100 /s: past it the time
+  // constant 1/alpha is below 10 us, shorter than any step the integrator
+  // takes on such arms, and alpha^2 swamps the augmented mass matrix (at
+  // 1e300 it is singular at t = 0). beta likewise, as alpha^2.
+  check.InRange("solver.baumgarte_alpha_per_s", s.baumgarte_alpha_per_s, 0.0, 1e5, "/s");
+  check.InRange("solver.baumgarte_beta_per_s2", s.baumgarte_beta_per_s2, 0.0, 1e10, "/s^2");
+  // h smooths each friction switch over that time (the paper's 0.01 s);
+  // beyond 1 s, the arm's slowest mode period, it would average a whole
+  // move away.
+  check.InRange("solver.smoothing_step_s", s.smoothing_step_s, 0.0, 1.0, "s");
   if (s.hole_friction == HoleFrictionModel::kSmoothed && !(s.smoothing_step_s > 0.0)) {
     // The stick band's slope, T mu' theta / v_eps ~ 1e6 N s/m against a
     // node mass of 1e-4 kg, is integrable explicitly only when smoothed.
@@ -685,10 +693,16 @@ void ValidateWithLines(const Config& c, const LineMap* lines) {
 
 void CheckProtocol(const ProtocolConfig& pr, const Checker& check) {
   check.InRange("protocol.amplitude_deg", pr.amplitude_rad / kDegToRad, -60.0, 60.0);
+  // Each phase at most 1e5 s (28 h): longer is no experiment, and a run of
+  // the protocol's length would not end (1e7 frames at 100 Hz).
   check.Positive("protocol.ramp_s", pr.ramp_s);
-  check.NonNegative("protocol.hold_s", pr.hold_s);
   check.Positive("protocol.return_s", pr.return_s);
-  check.NonNegative("protocol.rest_s", pr.rest_s);
+  for (const auto& [key, value] : {std::pair<const char*, double>{"protocol.ramp_s", pr.ramp_s},
+                                   {"protocol.hold_s", pr.hold_s},
+                                   {"protocol.return_s", pr.return_s},
+                                   {"protocol.rest_s", pr.rest_s}}) {
+    check.InRange(key, value, 0.0, 1e5, "s");
+  }
 }
 
 }  // namespace

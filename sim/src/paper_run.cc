@@ -115,6 +115,7 @@ PaperRun PreparePaperRun(const PaperRunOptions& o, Config config, const ArmModel
   if (o.recorded_inputs) {
     recorded = MakeRecordedCableInputs(*o.recorded_inputs, model.num_cables(),
                                        o.recorded_input_options, &inputs_note);
+    CheckRecordedInputsOnArm(*o.recorded_inputs, model, o.recorded_input_options);
   } else if (default_protocol) {
     // The configuration's protocol section sets the paper protocol's
     // parameters (SI values, as the configuration holds them).

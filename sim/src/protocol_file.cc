@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <set>
 #include <string>
 #include <vector>
@@ -28,6 +29,15 @@ constexpr double kDegToRad = kPi / 180.0;
 // (a sine's rate at a whole number of cycles differs from its start by ~1e-15).
 constexpr double kJoinRateTolerance = 1e-6;
 constexpr int kMaxRepeat = 100000;
+// Pieces of one segment once every repeat is expanded: a day of 1 s moves
+// (86 400) fits; nested repeats of 1000 x 1000 x 1000 would take minutes and
+// gigabytes to expand before a single check.
+constexpr std::size_t kMaxPieces = 100000;
+// Highest frequency of a sine or chirp [Hz]: the inputs are planned at 1 ms
+// (PlanProtocolInputs), and 20 samples a period keep a sine a sine there, so
+// that its cable speeds are checked; 50 Hz is also far above the modes of
+// such arms (about 1 Hz). A 1 MHz sine sampled at 1 ms is all zeros.
+constexpr double kMaxFrequencyHz = 50.0;
 
 // The unit of a field or parameter name: the text after its last '_'
 // ("duration_s" -> "s"); the factor to SI for the units protocols use.
@@ -274,7 +284,7 @@ class ProtocolReader {
         piece.amplitude = State(amplitude, body_key + ".amplitude", joints);
         if (sine) {
           piece.start_frequency_hz = piece.end_frequency_hz =
-              Positive(body, body_key, "frequency_hz");
+              Frequency(body, body_key, "frequency_hz");
           const bool has_cycles = body["cycles"].IsDefined();
           if (has_cycles == body["duration_s"].IsDefined()) {
             Fail(body, body_key, "give duration_s or cycles (one of them)");
@@ -283,8 +293,8 @@ class ProtocolReader {
                                  ? Positive(body, body_key, "cycles") / piece.start_frequency_hz
                                  : Positive(body, body_key, "duration_s");
         } else {
-          piece.start_frequency_hz = Positive(body, body_key, "start_hz");
-          piece.end_frequency_hz = Positive(body, body_key, "end_hz");
+          piece.start_frequency_hz = Frequency(body, body_key, "start_hz");
+          piece.end_frequency_hz = Frequency(body, body_key, "end_hz");
           piece.duration_s = Positive(body, body_key, "duration_s");
           piece.exponential_sweep =
               Word(body, body_key, "sweep", {"linear", "exponential"}) == "exponential";
@@ -313,6 +323,12 @@ class ProtocolReader {
         if (!inner.IsDefined()) Fail(body, body_key, "missing key 'pieces'");
         std::vector<ProtocolPiece> block;
         Pieces(inner, body_key + ".pieces", joints, &block);
+        if (out->size() + block.size() * static_cast<std::size_t>(times) > kMaxPieces) {
+          Fail(times_node, body_key + ".times",
+               "expands the segment to " +
+                   std::to_string(out->size() + block.size() * static_cast<std::size_t>(times)) +
+                   " pieces, beyond the " + std::to_string(kMaxPieces) + " a protocol may have");
+        }
         for (int k = 0; k < static_cast<int>(times); ++k)
           out->insert(out->end(), block.begin(), block.end());
       } else {
@@ -320,6 +336,20 @@ class ProtocolReader {
              "unknown piece (expected hold, move, step, sine, chirp or repeat)");
       }
     }
+  }
+
+  // A frequency in (0, kMaxFrequencyHz].
+  double Frequency(const YAML::Node& body, const std::string& key, const std::string& name) const {
+    const double f = Positive(body, key, name);
+    if (f > kMaxFrequencyHz) {
+      char what[160];
+      std::snprintf(what, sizeof(what),
+                    "%.4g Hz is above the %.0f Hz a protocol may ask (inputs planned at 1 ms, 20 "
+                    "samples a period)",
+                    f, kMaxFrequencyHz);
+      Fail(body[name], Join(key, name), what);
+    }
+    return f;
   }
 
   JointAngles Target(const YAML::Node& body, const std::string& key, int joints) const {

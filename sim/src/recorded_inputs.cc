@@ -59,6 +59,7 @@ bool RecordedInputOptions::IsValid(std::string* error) const {
   if (!(regular_step_tolerance >= 0.0)) return fail("regular_step_tolerance must be >= 0");
   if (!(resample_step_s >= 0.0) || !std::isfinite(resample_step_s))
     return fail("resample_step_s must be >= 0");
+  if (!(max_cable_speed_mps > 0.0)) return fail("max_cable_speed_mps must be > 0");
   if (!time_unit.empty() && time_unit != "s" && time_unit != "ms")
     return fail("time unit must be s or ms");
   if (!length_unit.empty() && length_unit != "m" && length_unit != "mm")
@@ -211,7 +212,7 @@ CableInputs MakeRecordedCableInputs(const RecordedInputs& r, int num_cables,
                       "time " + Number(r.time_s[i]) + " s does not increase (previous " +
                           Number(r.time_s[i - 1]) + " s)");
     }
-    if (step > options.max_gap_s) {
+    if (step > options.max_gap_s * (1.0 + 1e-9)) {  // a gap at the limit in ms rounds above it
       ThrowInputError(r.source_name, SampleWhere(r, i, r.time_name),
                       "a gap of " + Number(step) + " s after " + Number(r.time_s[i - 1]) +
                           " s, longer than the " + Number(options.max_gap_s) +
@@ -257,6 +258,47 @@ CableInputs MakeRecordedCableInputs(const RecordedInputs& r, int num_cables,
             ", resampled linearly every " + Number(step) + " s";
   }
   return CableInputs(std::move(time), std::move(length));
+}
+
+double CableRouteLengthM(const ArmModel& model, int cable) {
+  const int anchor_link = model.cables().at(cable).nodes.back().link;
+  double length = 0.0;
+  for (int l = 1; l <= anchor_link; ++l) length += model.link(l).length_m;
+  return length;
+}
+
+void CheckRecordedInputsOnArm(const RecordedInputs& r, const ArmModel& model,
+                              const RecordedInputOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) ThrowInputError("recorded inputs", "options", error);
+  const Eigen::Index n = r.time_s.size();
+  const Eigen::Index cables = std::min<Eigen::Index>(r.length_change_m.cols(), model.num_cables());
+  for (Eigen::Index c = 0; c < cables; ++c) {
+    const std::string& name = r.cable_names.at(c);
+    const double route = CableRouteLengthM(model, static_cast<int>(c));
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double length = r.length_change_m(i, c);
+      if (std::abs(length) > route) {
+        ThrowInputError(r.source_name, SampleWhere(r, i, name),
+                        (length > 0.0 ? "pulls cable " + std::to_string(c + 1) + " in by "
+                                      : "pays cable " + std::to_string(c + 1) + " out by ") +
+                            Number(std::abs(length)) + " m at t = " + Number(r.time_s[i]) +
+                            " s, more than the " + Number(route) +
+                            " m of arm it runs through: a length unit wrong (mm read as m?)");
+      }
+      if (i == 0) continue;
+      const double speed =
+          std::abs(length - r.length_change_m(i - 1, c)) / (r.time_s[i] - r.time_s[i - 1]);
+      if (speed > options.max_cable_speed_mps) {
+        ThrowInputError(r.source_name, SampleWhere(r, i, name),
+                        "cable " + std::to_string(c + 1) + " moves at " + Number(speed) +
+                            " m/s after t = " + Number(r.time_s[i - 1]) + " s, beyond the " +
+                            Number(options.max_cable_speed_mps) +
+                            " m/s any actuator of such an arm reaches: a length unit or a "
+                            "corrupt sample");
+      }
+    }
+  }
 }
 
 }  // namespace ccsrm::sim

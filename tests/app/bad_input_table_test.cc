@@ -168,6 +168,47 @@ class BadInputTable : public ::testing::Test {
     Write(d / "nanlog.csv", header + "\n0" + row + "\n0.01,1,2,NaN,4,5,6\n");
     Write(d / "backlog.csv", header + "\n0" + row + "\n0.02" + row + "\n0.01" + row + "\n");
     Write(d / "gaplog.csv", header + "\n0" + row + "\n5" + row + "\n");
+    // Issue 47, 7: what dataset assemble took before. Cable lengths in mm
+    // declared m (17.7 mm read as 17.7 m), a length of 1e9 mm, a counter
+    // said to wrap at 2 counts, a mapped column twice, a row of 8 cells.
+    std::string lengths = "schema: ccsrm-actuators/1\ntime: {column: t_s, unit: s}\ncables:\n";
+    std::string counts = lengths;
+    for (int c = 1; c <= 6; ++c) {
+      lengths += "  - {column: m" + std::to_string(c) + ", signal: length_change, unit: m}\n";
+      counts += "  - {column: m" + std::to_string(c) +
+                ", signal: motor_angle, unit: counts, drum_radius_m: 0.01, counts_per_turn: "
+                "4096, wrap_counts: 2}\n";
+    }
+    Write(d / "metres.yaml", lengths);
+    Write(d / "mmlengths.yaml", std::regex_replace(lengths, std::regex("unit: m\\}"), "unit: mm}"));
+    Write(d / "wrap2.yaml", counts);
+    Write(d / "mmlog.csv", header + "\n0,0,0,0,0,0,0\n0.01,17.7,0,0,0,0,0\n");
+    Write(d / "hugelog.csv", header + "\n0,0,0,0,0,0,0\n0.01,0,1e9,0,0,0,0\n");
+    Write(d / "duplog.csv", "t_s,m1,m2,m3,m4,m5,m6,m3\n0,0,0,0,0,0,0,0\n0.01,0,0,0,0,0,0,0\n");
+    Write(d / "widelog.csv", header + "\n0" + row + "\n0.01" + row + ",7\n");
+    // Issue 47, 10 and 9: inputs that tore the arm apart (the run hung at
+    // t = 0), a protocol of a billion pieces, a 1 MHz sine.
+    Write(d / "torn.csv",
+          "time_s,cable1_m,cable2_m,cable3_m,cable4_m,cable5_m,cable6_m\n0,0,0,0,0,0,0\n"
+          "0.01,10,0,0,0,0,0\n");
+    Write(d / "jerk.csv",
+          "time_s,cable1_m,cable2_m,cable3_m,cable4_m,cable5_m,cable6_m\n0,0,0,0,0,0,0\n"
+          "0.01,0,0.05,0,0,0,0\n");
+    Write(d / "nested.yaml",
+          "schema: ccsrm-protocol/1\nsegments:\n  all:\n    - repeat:\n        times: 1000\n"
+          "        pieces:\n          - repeat:\n              times: 1000\n              pieces:\n"
+          "                - repeat: {times: 1000, pieces: [{hold: {duration_s: 1}}]}\n");
+    Write(d / "megahertz.yaml",
+          "schema: ccsrm-protocol/1\nsegments:\n  all:\n"
+          "    - sine: {amplitude: {theta_x_deg: 1}, frequency_hz: 1.0e6, duration_s: 1}\n");
+    // Issue 47, 11: configurations every run of which fails or never ends.
+    Write(d / "hugeh.yaml", EditedPaper("smoothing_step_s: .*", "smoothing_step_s: 1e300"));
+    Write(d / "hugealpha.yaml",
+          EditedPaper("baumgarte_alpha_per_s: .*", "baumgarte_alpha_per_s: 1e300"));
+    Write(d / "hugeramp.yaml", EditedPaper("  ramp_s: .*", "  ramp_s: 1e300"));
+    // Issue 47, 13: a checkpoint cut short.
+    fs::create_directory(d / "cutfit");
+    Write(d / "cutfit" / "checkpoint.json", "{\"schema\": \"ccsrm-checkpoint/1\", \"itera");
 
     // Made in a work folder, then moved in: the rows compare the scratch
     // folder with itself, and these are its inputs.
@@ -218,6 +259,43 @@ class BadInputTable : public ::testing::Test {
                "x = f['/mocap/markers'][...]\nx[2, 1, 0] = 1e20\nput('/mocap/markers', x)");
     MutateHdf5(d / "exp.h5", d / "outlier1k.h5",
                "x = f['/mocap/markers'][...]\nx[5, 0, 2] = 1e3\nput('/mocap/markers', x)");
+    // Issue 47, 12: files one command refused and another read.
+    MutateHdf5(d / "run.h5", d / "nanrun.h5",
+               "x = f['/input_length_change'][...]\nx[1, 0] = np.nan\n"
+               "put('/input_length_change', x)");
+    MutateHdf5(d / "run.h5", d / "noconfigrun.h5", "f.attrs['config_yaml'] = ''");
+    MutateHdf5(processed, d / "negmass.h5",
+               "import re\nf.attrs['config_yaml'] = re.sub(r'link_mass_kg: [0-9.e-]+', "
+               "'link_mass_kg: -1.0', f.attrs['config_yaml'], count=1)");
+    // Issue 47, 13: a C3D whose parameter name a damaged byte made "LAB\nLS"
+    // and whose type another made 32.
+    o = RunCcsrm("mocap export --in " + (d / "exp.h5").string() + " --out " +
+                 (w / "flip.c3d").string());
+    ASSERT_EQ(o.status, 0) << o.err;
+    fs::rename(w / "flip.c3d", d / "flip.c3d");
+    {
+      std::string bytes = ccsrm::ReadTextFile((d / "flip.c3d").string());
+      const std::size_t at = bytes.find("LABELS");
+      ASSERT_NE(at, std::string::npos);
+      bytes[at + 3] = '\n';
+      bytes[at + 8] = 32;  // its type, after the 2-byte offset: none of -1, 1, 2, 4
+      std::ofstream(d / "flip.c3d", std::ios::binary) << bytes;
+    }
+    // Issue 47, 6 at the marker files' own door: a C3D whose first point
+    // sits 1000 m out (floating-point points: the header's scale is < 0).
+    o = RunCcsrm("mocap export --in " + (d / "exp.h5").string() + " --out " +
+                 (d / "outlier.c3d").string());
+    ASSERT_EQ(o.status, 0) << o.err;
+    Write(w / "far.py",
+          "import struct, sys\np = sys.argv[1]\nb = bytearray(open(p, 'rb').read())\n"
+          "scale = struct.unpack_from('<f', b, 12)[0]\nassert scale < 0, scale\n"
+          "start = (struct.unpack_from('<H', b, 16)[0] - 1) * 512\n"
+          "struct.pack_into('<f', b, start, 1.0e6)\nopen(p, 'wb').write(b)\n");
+    ASSERT_EQ(std::system((std::string(kPython) + " " + (w / "far.py").string() + " " +
+                           (d / "outlier.c3d").string())
+                              .c_str()),
+              0);
+    fs::remove(w / "far.py");
     // A recorded experiment (issue 47, 4): its measurements no run gives back.
     MutateHdf5(processed, d / "recorded.h5", "f.attrs['source'] = 'recorded'");
     // A stub made to look like an earlier fit (issue 47, 3), and a real
@@ -537,6 +615,84 @@ const std::vector<BadInput>& Rows() {
       {"overrides",
        "loop --data {d}/processed.h5 --holdout {d}/processed.h5 --out {d}/l",
        {"{d}/processed.h5", "--holdout", "also in --data"}},
+      // Issue 47, 7: actuator logs and maps.
+      {"actuators",
+       "dataset assemble --markers {d}/exp.h5 --actuators {d}/mmlog.csv --actuator-map "
+       "{d}/metres.yaml --config {d}/c.yaml --sync offset=0 --out {d}/x.h5",
+       {"{d}/mmlog.csv", "line 3, column 'm1'", "pulls cable 1 in by 17.7 m", "mm read as m"}},
+      {"actuators",
+       "dataset assemble --markers {d}/exp.h5 --actuators {d}/hugelog.csv --actuator-map "
+       "{d}/mmlengths.yaml --config {d}/c.yaml --sync offset=0 --out {d}/x.h5",
+       {"{d}/hugelog.csv", "column 'm2'", "pulls cable 2 in by 1e+06 m"}},
+      {"actuators",
+       "dataset assemble --markers {d}/exp.h5 --actuators {d}/log.csv --actuator-map "
+       "{d}/wrap2.yaml --config {d}/c.yaml --sync offset=0 --out {d}/x.h5",
+       {"{d}/wrap2.yaml", "cables[0].wrap_counts", "less than counts_per_turn"}},
+      {"actuators",
+       "dataset assemble --markers {d}/exp.h5 --actuators {d}/duplog.csv --actuator-map "
+       "{d}/map.yaml --config {d}/c.yaml --sync offset=0 --out {d}/x.h5",
+       {"{d}/duplog.csv", "line 1", "column 'm3'", "appears twice"}},
+      {"actuators",
+       "dataset assemble --markers {d}/exp.h5 --actuators {d}/widelog.csv --actuator-map "
+       "{d}/map.yaml --config {d}/c.yaml --sync offset=0 --out {d}/x.h5",
+       {"{d}/widelog.csv", "line 3", "has 8 cells", "names 7 columns"}},
+      // Issue 47, 9 and 10: runs that could not mean anything, or not end.
+      {"overrides",
+       "identify --data {d}/processed.h5 --free mu --max-iterations 0 --out {d}/f",
+       {"--max-iterations", "is 0", "ccsrm predict"}},
+      {"overrides",
+       "loop --data {d}/processed.h5 --max-iterations 0 --out {d}/l",
+       {"--max-iterations", "is 0"}},
+      {"markers",
+       "mocap process --in {d}/exp9.h5 --config {d}/c.yaml --out {d}/x.h5",
+       {"{d}/exp9.h5", "/mocap/markers", "mm RMS", "not of this arm's marker set"}},
+      {"overrides",
+       "simulate --config {d}/c.yaml --protocol {d}/megahertz.yaml --out {d}/x.h5",
+       {"{d}/megahertz.yaml", "frequency_hz", "1e+06 Hz is above the 50 Hz"}},
+      {"overrides",
+       "simulate --config {d}/c.yaml --protocol {d}/nested.yaml --duration 2 --out {d}/x.h5",
+       {"{d}/nested.yaml", "times", "beyond the 100000"}},
+      {"hdf5",
+       "simulate --config {d}/c.yaml --inputs {d}/torn.csv --out {d}/x.h5",
+       {"{d}/torn.csv", "line 3, column 'cable1_m'", "pulls cable 1 in by 10 m",
+        "m of arm it runs through"}},
+      {"hdf5",
+       "simulate --config {d}/c.yaml --inputs {d}/jerk.csv --out {d}/x.h5",
+       {"{d}/jerk.csv", "line 3, column 'cable2_m'", "moves at 5 m/s"}},
+      // Issue 47, 11: configurations every run of which failed or never ended.
+      {"configs", "config check {d}/hugeh.yaml", {"{d}/hugeh.yaml", "smoothing_step_s", "[0, 1]"}},
+      {"configs",
+       "config check {d}/hugealpha.yaml",
+       {"{d}/hugealpha.yaml", "baumgarte_alpha_per_s", "1e+300"}},
+      {"configs",
+       "simulate --config {d}/hugeramp.yaml --out {d}/x.h5",
+       {"{d}/hugeramp.yaml", "protocol.ramp_s", "[0, 100000]"}},
+      // Issue 47, 12: one door per kind of file, at every command.
+      {"hdf5",
+       "report --in {d}/nanlength.h5 --out {d}/r",
+       {"{d}/nanlength.h5", "/input/length_change", "finite"}},
+      {"hdf5", "report --in {d}/badyaml.h5 --out {d}/r", {"{d}/badyaml.h5", "config_yaml"}},
+      {"hdf5", "report --in {d}/one.h5 --out {d}/r", {"{d}/one.h5", "/mocap/time"}},
+      {"hdf5",
+       "dataset inspect {d}/nanrun.h5",
+       {"{d}/nanrun.h5", "/input_length_change", "finite"}},
+      {"hdf5",
+       "dataset inspect {d}/noconfigrun.h5",
+       {"{d}/noconfigrun.h5", "config_yaml", "empty"}},
+      {"hdf5",
+       "simulate --config {d}/c.yaml --inputs {d}/negmass.h5 --out {d}/x.h5",
+       {"{d}/negmass.h5", "config_yaml", "link_mass_kg"}},
+      {"hdf5",
+       "simulate --config {d}/c.yaml --inputs {d}/badyaml.h5 --out {d}/x.h5",
+       {"{d}/badyaml.h5", "config_yaml"}},
+      // Issue 47, 13: messages that name the cause, on one line.
+      {"overrides",
+       "identify --data {d}/processed.h5 --free mu --resume --out {d}/cutfit",
+       {"{d}/cutfit/checkpoint.json", "corrupt"}},
+      {"markers", "mocap inspect {d}/flip.c3d", {"{d}/flip.c3d", "LAB\\x0ALS"}},
+      {"markers",
+       "mocap process --in {d}/outlier.c3d --config {d}/c.yaml --out {d}/x.h5",
+       {"{d}/outlier.c3d", "at frame 0 has a coordinate of 1000 m", "capture volume"}},
       {"outputs",
        "loop --data {d}/processed.h5 --out {d}/mine",
        {"{d}/mine", "--out", "not a ccsrm loop folder"}},  // 1
@@ -680,8 +836,10 @@ bool RunAndInterrupt(const std::string& args, std::chrono::milliseconds delay, i
   return why->empty();
 }
 
-// Interrupts at several moments of a run and of a fit: whatever the moment,
-// the process ends by the signal and the output folder holds no temporary.
+// Interrupts at several moments of a run, a fit, a loop, a design and a
+// generated experiment: whatever the moment, the process ends by the signal
+// and the output folder holds no temporary and no output, only what --resume
+// continues from.
 TEST_F(BadInputTable, InterruptsLeaveNoTemporaries) {
   const fs::path d = ccsrm::testing::ScratchDirectory("bad_input_table_interrupt");
   // Work that lasts far beyond the latest signal on any machine: 600 s of
@@ -697,7 +855,21 @@ TEST_F(BadInputTable, InterruptsLeaveNoTemporaries) {
            "--out " + (d / "fit").string(),
        SIGTERM},
   };
-  for (const auto& [args, signal_number] : commands) {
+  // Issue 47: the other writing commands, each with one of the signals a
+  // user or a scheduler sends.
+  const std::string protocols = std::string(CCSRM_SOURCE_DIR) + "/configs/protocols/";
+  const std::vector<std::pair<std::string, int>> more = {
+      {"loop --data " + sample + " --max-rounds 3 --threads 2 --out " + (d / "loop").string(),
+       SIGINT},
+      {"design --free mu,mu_c,T_p --plans " + protocols + "paper.yaml " + protocols +
+           "fast-reversals.yaml --threads 2 --out " + (d / "design").string(),
+       SIGTERM},
+      {"generate --config " + Paper() + " --case 2 --duration 600 --out " + (d / "gen.h5").string(),
+       SIGTERM},
+  };
+  std::vector<std::pair<std::string, int>> all = commands;
+  all.insert(all.end(), more.begin(), more.end());
+  for (const auto& [args, signal_number] : all) {
     for (const int ms : {300, 900}) {
       SCOPED_TRACE(args + " interrupted after " + std::to_string(ms) + " ms");
       int status = 0;
@@ -708,8 +880,58 @@ TEST_F(BadInputTable, InterruptsLeaveNoTemporaries) {
       ASSERT_TRUE(WIFSIGNALED(status)) << "exited with " << WEXITSTATUS(status) << ": " << err;
       EXPECT_EQ(WTERMSIG(status), signal_number);
       EXPECT_THAT(err, HasSubstr("ccsrm: interrupted")) << err;
-      EXPECT_TRUE(fs::is_empty(d)) << "an interrupted command left something in " << d;
+      // What --resume continues from is kept by design: a folder with the
+      // job's checkpoint.json and runs.journal (docs/cluster.md).
+      std::string left;
+      for (const fs::directory_entry& e : fs::recursive_directory_iterator(d)) {
+        const std::string name = e.path().filename().string();
+        if (e.is_directory() && e.path().parent_path() == d &&
+            name.find(".tmp-") == std::string::npos)
+          continue;
+        if (name == "checkpoint.json" || name == "runs.journal") continue;
+        left += " " + fs::relative(e.path(), d).string();
+      }
+      EXPECT_EQ(left, "") << "an interrupted command left this in " << d;
+      fs::remove_all(d);
+      fs::create_directories(d);
     }
+  }
+}
+
+// SIGKILL cannot be caught: a killed command leaves its temporaries and what
+// --resume continues from (checkpoint.json, runs.journal), never an output
+// half-written under its final name (every output is renamed into place
+// whole); the next command into the same place removes the temporaries (the
+// test above).
+TEST_F(BadInputTable, AKilledCommandLeavesNoOutputUnderItsFinalName) {
+  const fs::path d = ccsrm::testing::ScratchDirectory("bad_input_table_killed");
+  const std::string sample = std::string(CCSRM_SOURCE_DIR) + "/datasets/samples/loop/train1.h5";
+  const std::vector<std::pair<std::string, std::string>> commands = {
+      {"identify --data " + sample + " --free mu,mu_c,T_p --threads 2 --out " +
+           (d / "fit").string(),
+       "fit"},
+      {"loop --data " + sample + " --threads 2 --out " + (d / "loop").string(), "loop"},
+      {"generate --config " + Paper() + " --case 2 --duration 600 --out " + (d / "gen.h5").string(),
+       "gen.h5"},
+  };
+  for (const auto& [args, output] : commands) {
+    SCOPED_TRACE(args);
+    int status = 0;
+    std::string err, why;
+    ASSERT_TRUE(RunAndInterrupt(args, std::chrono::milliseconds(600), SIGKILL, &status, &err, &why))
+        << why << ": " << err;
+    ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+    const auto left_by_design = [&d](const fs::path& p) {
+      const std::string name = p.filename().string();
+      return fs::relative(p, d).string().find(".tmp-") != std::string::npos ||
+             name == "checkpoint.json" || name == "runs.journal";
+    };
+    for (const fs::directory_entry& e : fs::recursive_directory_iterator(d)) {
+      if (e.path() == d / output && e.is_directory()) continue;  // the resumable folder
+      EXPECT_TRUE(left_by_design(e.path())) << "a killed command left " << e.path();
+    }
+    fs::remove_all(d);
+    fs::create_directories(d);
   }
 }
 

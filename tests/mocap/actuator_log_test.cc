@@ -81,6 +81,19 @@ struct BadCase {
   std::string expected;  // a part of the one-line message
 };
 
+// Issue 47, 13: a 10 Hz log stamped in ms steps exactly the 0.1 s allowed;
+// 100 ms is 0.10000000000000001 s, which must not read as a longer gap.
+TEST(ActuatorLog, AGapOfExactlyTheLimitInMillisecondsIsAllowed) {
+  const std::string text = "t_ms,len1,motor2,enc3,sync\n0,0,0,0,0\n100,1,0,0,0\n200,2,0,0,0\n";
+  const ActuatorLog log = ParseActuatorLog(text, "log.csv", Map(), "map.yaml");
+  EXPECT_EQ(log.time_s.size(), 3);
+  // A trailing empty cell (a delimiter at the end of a row) is no extra column.
+  EXPECT_EQ(ParseActuatorLog("t_ms,len1,motor2,enc3,sync\n0,0,0,0,0,\n100,1,0,0,0,\n", "log.csv",
+                             Map(), "map.yaml")
+                .time_s.size(),
+            2);
+}
+
 TEST(ActuatorLog, BadLogsAreOneLineNamingLineAndColumn) {
   const std::string header = "t_ms,len1,motor2,enc3,sync\n";
   const BadCase cases[] = {
@@ -100,6 +113,12 @@ TEST(ActuatorLog, BadLogsAreOneLineNamingLineAndColumn) {
       // Found by the fuzzer: a byte order mark before a comment made the
       // comment the header line, then no row was left (an internal check).
       {"BOM and a comment", "\xEF\xBB\xBF# controller log", "log.csv: empty"},
+      // Issue 47, 7: a mapped column twice, a row wider than the header.
+      {"a column twice", "t_ms,len1,motor2,enc3,sync,len1\n0,0,0,0,0,0\n",
+       "log.csv: line 1: column 'len1' (named by map.yaml, key 'cables[0].column') appears twice, "
+       "as columns 2 and 6"},
+      {"a wide row", header + "0,0,0,0,0\n1,0,0,0,0,9\n",
+       "log.csv: line 3: has 6 cells, the header (line 1) names 5 columns"},
   };
   for (const BadCase& c : cases) {
     SCOPED_TRACE(c.what);

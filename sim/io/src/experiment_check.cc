@@ -5,6 +5,8 @@
 #include <string>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/sim/recorded_inputs.h"
+#include "ccsrm/sim_io/recorded_inputs.h"
 
 namespace ccsrm::sim_io {
 namespace {
@@ -93,6 +95,10 @@ void CheckInputArrays(const datasets::Array& time, const datasets::Array& length
                     "has " + std::to_string(cables) + " cable columns, the arm of " + arm_source +
                         " has " + std::to_string(arm->num_cables()) + " driving cables");
   }
+  if (arm != nullptr && cables != 0) {
+    sim::CheckRecordedInputsOnArm(
+        InputsFromArrays(file, time_path, length_path, time, length_change), *arm);
+  }
 }
 
 // The arm of a non-empty config_yaml (`known` when the caller parsed it),
@@ -172,6 +178,26 @@ void CheckInputs(const datasets::RunFile& run, const std::string& file, const si
                  const std::string& arm_source) {
   CheckInputArrays(run.time, run.input_length_change, file, "/time", "/input_length_change", arm,
                    arm_source);
+}
+
+void CheckRunAgainstConfig(const datasets::RunFile& run, const std::string& file) {
+  if (run.config_yaml.empty()) {
+    ThrowInputError(file, "config_yaml",
+                    "is empty: a run file records the configuration that made it");
+  }
+  const sim::Config config = sim::ParseConfig(run.config_yaml, file + ": attribute 'config_yaml'");
+  const sim::ArmModel model(config.arm);
+  CheckInputs(run, file, &model, "its config_yaml");
+}
+
+datasets::AnyFile ReadCheckedFile(const std::string& path) {
+  datasets::AnyFile file = datasets::ReadAnyFile(path);
+  if (const auto* experiment = std::get_if<datasets::ExperimentFile>(&file)) {
+    CheckExperimentAgainstConfig(*experiment, path);
+  } else {
+    CheckRunAgainstConfig(std::get<datasets::RunFile>(file), path);
+  }
+  return file;
 }
 
 }  // namespace ccsrm::sim_io

@@ -7,6 +7,7 @@
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/datasets/inspect.h"
+#include "ccsrm/sim_io/experiment_check.h"
 
 namespace ccsrm::sim_io {
 namespace {
@@ -19,9 +20,11 @@ bool LooksLikeHdf5(const std::string& path) {
   return in.gcount() == 8 && std::string(signature, 8) == "\x89HDF\r\n\x1a\n";
 }
 
-sim::RecordedInputs FromArrays(const std::string& path, const std::string& time_name,
-                               const std::string& length_name, const datasets::Array& time,
-                               const datasets::Array& length) {
+}  // namespace
+
+sim::RecordedInputs InputsFromArrays(const std::string& path, const std::string& time_name,
+                                     const std::string& length_name, const datasets::Array& time,
+                                     const datasets::Array& length) {
   sim::RecordedInputs r;
   r.source_name = path;
   r.time_name = time_name;
@@ -42,18 +45,16 @@ sim::RecordedInputs FromArrays(const std::string& path, const std::string& time_
   return r;
 }
 
-}  // namespace
-
 sim::RecordedInputs ReadRecordedInputs(const std::string& path,
                                        const sim::RecordedInputOptions& options) {
   if (!LooksLikeHdf5(path)) return sim::ParseInputTable(ReadTextFile(path), path, options);
-  const datasets::AnyFile file = datasets::ReadAnyFile(path);
+  const datasets::AnyFile file = ReadCheckedFile(path);
   if (const auto* experiment = std::get_if<datasets::ExperimentFile>(&file)) {
-    return FromArrays(path, "/input/time", "/input/length_change", experiment->input_time,
-                      experiment->input_length_change);
+    return InputsFromArrays(path, "/input/time", "/input/length_change", experiment->input_time,
+                            experiment->input_length_change);
   }
   const auto& run = std::get<datasets::RunFile>(file);
-  return FromArrays(path, "/time", "/input_length_change", run.time, run.input_length_change);
+  return InputsFromArrays(path, "/time", "/input_length_change", run.time, run.input_length_change);
 }
 
 }  // namespace ccsrm::sim_io

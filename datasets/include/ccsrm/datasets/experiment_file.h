@@ -97,10 +97,24 @@ struct ExperimentFile {
   std::optional<Array> measured_joint_twist;
 };
 
+// No capture volume reaches this far from its origin [m] (a large hall's is
+// about 20 m): a marker coordinate beyond is a corrupted sample, which the
+// pipeline would otherwise turn into joint angles without a word. Checked
+// for experiments here and for every marker file at mocap processing.
+inline constexpr double kCaptureVolumeLimitM = 100.0;
+
+// The first coordinate of `xyz` (frames × markers × 3, row-major; `names`
+// one per marker) beyond kCaptureVolumeLimitM, said in a message ("marker
+// 'L3a' at frame 2 has a coordinate of 1e+20 m, beyond any capture volume
+// ..."), or "" when there is none. NaN and infinity are "not seen".
+std::string MarkerBeyondCaptureVolume(const std::vector<double>& xyz,
+                                      const std::vector<std::string>& names);
+
 // Checks that `experiment` is a consistent ccsrm-dataset/1 record (shapes
 // agree with the time bases and with each other, times strictly increasing
 // and finite, marker names unique, rigid-body names valid and their markers
-// listed in marker_names). `file` only labels the message.
+// listed in marker_names, no coordinate beyond kCaptureVolumeLimitM). `file`
+// only labels the message.
 // Throws InputError "<file>: <path>: <problem>" on the first inconsistency.
 void ValidateExperimentFile(const ExperimentFile& experiment, const std::string& file);
 

@@ -42,6 +42,11 @@ struct RecordedInputOptions {
   // "ms" for time, "m" or "mm" for lengths; empty: the name must carry it.
   std::string time_unit;
   std::string length_unit;
+  // Fastest a cable may be pulled in or paid out between two samples [m/s]
+  // (CheckRecordedInputsOnArm): ten times the protocols' planning limit
+  // (ProtocolLimits::cable_speed_mps). No actuator of such an arm reaches
+  // it; a length in the wrong unit (mm read as m) or a corrupt sample does.
+  double max_cable_speed_mps = 1.0;
 
   bool IsValid(std::string* error) const;
 };
@@ -66,5 +71,22 @@ RecordedInputs ParseInputTable(const std::string& text, const std::string& sourc
 CableInputs MakeRecordedCableInputs(const RecordedInputs& record, int num_cables,
                                     const RecordedInputOptions& options = {},
                                     std::string* note = nullptr);
+
+// The length [m] of arm a driving cable runs through, from the base to the
+// link it is anchored to (the straight arm's link lengths): no pull can
+// shorten its path inside the arm by more, nor a payout lengthen it by more
+// without the cable lying slack in a heap.
+double CableRouteLengthM(const ArmModel& model, int cable);
+
+// The first door of recorded inputs on an arm, after MakeRecordedCableInputs'
+// checks of form (every command that takes them calls it: simulate --inputs,
+// mocap process --inputs, dataset assemble, every experiment file read):
+// no |pulled-in length| beyond the cable's CableRouteLengthM, no speed
+// between two samples beyond options.max_cable_speed_mps. Either is a unit
+// or a corrupt sample, and would otherwise tear the arm apart in the
+// simulator (steps of nanoseconds: a hang, not an answer). Throws
+// InputError naming the file, the column and the line (or sample index).
+void CheckRecordedInputsOnArm(const RecordedInputs& record, const ArmModel& model,
+                              const RecordedInputOptions& options = {});
 
 }  // namespace ccsrm::sim

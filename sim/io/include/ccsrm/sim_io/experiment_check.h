@@ -10,6 +10,7 @@
 #include <string>
 
 #include "ccsrm/datasets/experiment_file.h"
+#include "ccsrm/datasets/inspect.h"
 #include "ccsrm/datasets/run_file.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
@@ -46,6 +47,18 @@ std::optional<ExperimentArm> CheckExperimentAgainstConfig(
     const datasets::ExperimentFile& experiment, const std::string& file,
     const ExperimentArm* known_arm = nullptr);
 
+// The check of a run file (ccsrm-run/1) against its own config_yaml, which
+// every run file has (simulate writes it): it parses, and the run's inputs
+// pass CheckInputs against that arm. Throws InputError as above.
+void CheckRunAgainstConfig(const datasets::RunFile& run, const std::string& file);
+
+// The one door of a ccsrm HDF5 file read whole by a command (`dataset
+// inspect`, `report`, `simulate --inputs`, `mocap process --inputs`):
+// datasets::ReadAnyFile, then CheckExperimentAgainstConfig or
+// CheckRunAgainstConfig, so that every command refuses the same files with
+// the same line.
+datasets::AnyFile ReadCheckedFile(const std::string& path);
+
 // The one check of recorded cable inputs, at every door they come through
 // (CheckExperimentAgainstConfig for an experiment's own; `ccsrm mocap
 // process --inputs FILE` where it reads another file's): the time base
@@ -53,7 +66,9 @@ std::optional<ExperimentArm> CheckExperimentAgainstConfig(
 // and strictly increasing; the length changes (/input/length_change, or a
 // run's /input_length_change) are one row per time with every value finite;
 // and, with `arm` given, they have either no cable column (no actuator
-// record) or one per driving cable of that arm. `file` names the file and
+// record) or one per driving cable of that arm, within its physical bounds
+// (sim::CheckRecordedInputsOnArm: no pull beyond a cable's route, no speed
+// beyond any actuator's). `file` names the file and
 // `arm_source` where the arm came from ("arm.yaml", "e.h5 (its
 // config_yaml)") in messages. Throws InputError "<file>: <path>: <problem>"
 // on the first problem.
