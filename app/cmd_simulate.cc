@@ -50,6 +50,7 @@ int RunSimulate(const SimulateArgs& a) {
                          sim_io::ToRunFile(run.model, result, sim_io::PaperRunFileInfo(run)));
   std::printf("%s", sim::DescribeRun(run).c_str());
   std::printf("%s", result.summary.FullReport().c_str());
+  std::printf("%s", sim::DescribeRunStates(run, result).c_str());
   std::printf("  output:                    %s (%zu frames)\n", a.out.c_str(),
               result.trajectory.size());
   if (!result.summary.completed()) {

@@ -57,16 +57,30 @@ std::string IdentificationSummary::BriefReport() const {
   char text[512];
   std::snprintf(text, sizeof(text),
                 "identification %s after %d iterations (%lld simulations, %d threads, %.1f s): "
-                "RMS %s -> %s deg, fit %s %%",
+                "RMS %s -> %s deg, fit %s %%%s",
                 TerminationName(termination), iterations, static_cast<long long>(simulations),
                 threads, wall_time_s, Cell("%.4f", start_errors.rms_deg_overall).c_str(),
                 Cell("%.4f", errors.rms_deg_overall).c_str(),
-                Cell("%.1f", errors.fit_percent_overall).c_str());
+                Cell("%.1f", errors.fit_percent_overall).c_str(),
+                !adequacy.assessed ? ""
+                : adequacy.adequate()
+                    ? "; the model explains the data"
+                    : Format("; the model does NOT explain the data (%zu joint axes above their "
+                             "noise)",
+                             adequacy.above_noise.size())
+                          .c_str());
   return text;
+}
+
+std::array<double, 2> IdentificationSummary::MisfitInterval(const ParameterEstimate& p) const {
+  const double scale = adequacy.misfit_scale();
+  return {p.value - scale * (p.value - p.ci95_lower), p.value + scale * (p.ci95_upper - p.value)};
 }
 
 std::string IdentificationSummary::FullReport() const {
   std::ostringstream out;
+  // The answer first: whether the model explains the data at all.
+  out << "model: " << adequacy.Verdict() << "\n";
   out << BriefReport() << "\n";
   out << "  termination: " << TerminationName(termination) << " (" << message << ")\n";
   out << "  residuals: " << residuals << " (effective " << Cell("%.0f", effective_samples)
@@ -78,18 +92,28 @@ std::string IdentificationSummary::FullReport() const {
               ? ", second order (central, or one-sided inside the bounds) throughout\n\n"
               : ", first-order forward while descending, second order (central, or "
                 "one-sided inside the bounds) at the final point\n\n");
+  // When the model misses, the intervals assume what is false; beside
+  // them, the interval widened by the misfit.
+  const bool misfit = adequacy.assessed && !adequacy.adequate();
   out << "  parameter      start          estimate       std error      95 % interval"
-         "                  units\n";
+         "                 "
+      << (misfit ? Format(" 95 %% x misfit %.2f             ", adequacy.misfit_scale()) : "")
+      << " units\n";
   for (const ParameterEstimate& p : parameters) {
     if (!p.free) continue;
-    char line[512];
+    char line[640];
+    const auto bracket = [](double lo, double hi) {
+      return "[" + Cell("%.6g", lo) + ", " + Cell("%.6g", hi) + "]";
+    };
     const std::string interval =
-        p.identifiable ? "[" + Cell("%.6g", p.ci95_lower) + ", " + Cell("%.6g", p.ci95_upper) + "]"
-                       : "not identifiable";
-    std::snprintf(line, sizeof(line), "  %-14s %-14s %-14s %-14s %-30s %s%s\n", p.name.c_str(),
+        p.identifiable ? bracket(p.ci95_lower, p.ci95_upper) : "not identifiable";
+    const std::array<double, 2> wide = MisfitInterval(p);
+    const std::string widened = !misfit ? "" : p.identifiable ? bracket(wide[0], wide[1]) : "-";
+    std::snprintf(line, sizeof(line), "  %-14s %-14s %-14s %-14s %-30s %s%s%s\n", p.name.c_str(),
                   Cell("%.6g", p.start).c_str(), Cell("%.6g", p.value).c_str(),
                   p.identifiable ? Cell("%.3g", p.std_error).c_str() : "-", interval.c_str(),
-                  p.units.c_str(), p.at_bound ? "  (at a bound)" : "");
+                  misfit ? Format("%-30s ", widened.c_str()).c_str() : "", p.units.c_str(),
+                  p.at_bound ? "  (at a bound)" : "");
     out << line;
   }
   if (!covariance_available) out << "  no covariance: " << covariance_message << "\n";
@@ -150,6 +174,10 @@ nlohmann::json ToJson(const IdentificationSummary& s) {
       entry["std_error"] = p.identifiable ? Number(p.std_error) : nullptr;
       entry["ci95"] = p.identifiable ? nlohmann::json{Number(p.ci95_lower), Number(p.ci95_upper)}
                                      : nlohmann::json(nullptr);
+      const std::array<double, 2> wide = s.MisfitInterval(p);
+      entry["ci95_scaled_by_misfit"] = p.identifiable
+                                           ? nlohmann::json{Number(wide[0]), Number(wide[1])}
+                                           : nlohmann::json(nullptr);
       entry["identifiable"] = p.identifiable;
       entry["bounds"] = {p.lower, p.upper};
       entry["scale"] = p.scale;
@@ -197,6 +225,7 @@ nlohmann::json ToJson(const IdentificationSummary& s) {
   return {{"schema", "ccsrm-fit/1"},
           {"arm", arm},
           {"converged", s.converged()},
+          {"adequacy", ToJson(s.adequacy)},
           {"termination", TerminationName(s.termination)},
           {"message", s.message},
           {"iterations", s.iterations},

@@ -1159,6 +1159,7 @@ void TabulateErrors(const std::vector<Experiment>& experiments, const FitProblem
   }
   summary->start_errors = AngleErrors(all, start_angles);
   summary->errors = AngleErrors(all, final_angles);
+  if (final_eval.ok) summary->adequacy = AssessModelAdequacy(all, final_angles);
 }
 
 }  // namespace

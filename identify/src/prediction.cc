@@ -1,7 +1,6 @@
 #include "ccsrm/identify/prediction.h"
 #include "ccsrm/identify/runs.h"
 
-#include <gsl/gsl_cdf.h>
 #include <yaml-cpp/yaml.h>
 #include <algorithm>
 #include <chrono>
@@ -14,7 +13,6 @@
 #include "ccsrm/common/yaml_document.h"
 #include "ccsrm/identify/fit_file.h"
 #include "ccsrm/sim/effects.h"
-#include "statistics.h"
 
 namespace ccsrm::identify {
 namespace {
@@ -236,7 +234,6 @@ PredictionSummary Predict(const std::vector<Experiment>& recordings, const Predi
   summary.effects = parameters.front().EnabledEffects();
   summary.threads = backend->parallelism();
   summary.simulations = static_cast<std::int64_t>(requests.size());
-  summary.above_noise_ratio = options.above_noise_ratio;
   std::vector<const Experiment*> all;
   std::vector<const Eigen::MatrixXd*> predicted;
   for (std::size_t e = 0; e < recordings.size(); ++e) {
@@ -256,55 +253,15 @@ PredictionSummary Predict(const std::vector<Experiment>& recordings, const Predi
     }
     summary.recordings.push_back(std::move(r));
   }
-  // Every channel's weighted residual, its size and whether it is noise.
-  struct Channel {
-    ChannelAboveNoise c;
-    bool large = false;
-  };
-  std::vector<Channel> channels;
   for (std::size_t e = 0; e < recordings.size(); ++e) {
     RecordingPrediction& r = summary.recordings[e];
     const Experiment& x = recordings[e];
     r.errors = ComputePredictionErrors({&x}, {&r.predicted_rad});
     all.push_back(&x);
     predicted.push_back(&r.predicted_rad);
-    for (int j = 0; j < x.joints; ++j) {
-      const std::size_t jj = static_cast<std::size_t>(j);
-      for (int a = 0; a < 2; ++a) {
-        std::vector<double> weighted;
-        double sum = 0.0;
-        for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
-          const double m = x.measured_rad(f, 2 * j + a);
-          if (!std::isfinite(m)) continue;
-          const double w = (r.predicted_rad(f, 2 * j + a) - m) * kDeg / x.noise_deg[jj];
-          weighted.push_back(w);
-          sum += w * w;
-        }
-        if (weighted.empty()) continue;
-        Channel ch;
-        ch.c.recording = r.name;
-        ch.c.joint = j + 1;
-        ch.c.axis = a;
-        ch.c.rms_deg = r.errors.channels.rms_deg[jj][static_cast<std::size_t>(a)];
-        ch.c.noise_deg = x.noise_deg[jj];
-        const double n = static_cast<double>(weighted.size());
-        ch.c.effective_samples = internal::EffectiveSampleSize({weighted});
-        // A run that ended early leaves NaN: never noise.
-        ch.c.p_value = std::isfinite(sum) ? gsl_cdf_chisq_Q(sum * ch.c.effective_samples / n,
-                                                            ch.c.effective_samples)
-                                          : 0.0;
-        ch.large = !(ch.c.rms_deg <= options.above_noise_ratio * ch.c.noise_deg);
-        channels.push_back(ch);
-      }
-    }
   }
-  summary.significance = options.significance;
-  summary.channels = channels.size();
-  for (const Channel& ch : channels) {
-    if (ch.large && ch.c.p_value < options.significance / static_cast<double>(channels.size())) {
-      summary.above_noise.push_back(ch.c);
-    }
-  }
+  summary.adequacy =
+      AssessModelAdequacy(all, predicted, options.above_noise_ratio, options.significance);
   summary.errors = ComputePredictionErrors(all, predicted);
   if (summary.completed) summary.message = "every run completed";
   summary.wall_time_s =

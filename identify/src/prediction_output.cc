@@ -59,13 +59,15 @@ std::string PredictionSummary::BriefReport() const {
                 recordings.size(), recordings.size() == 1 ? "" : "s", model.source.c_str(),
                 EffectList(effects).c_str(), Cell("%.4f", errors.channels.rms_deg_overall).c_str(),
                 Cell("%.4f", errors.max_abs_deg_overall).c_str(),
-                Cell("%.3f", errors.weighted_rms).c_str(), above_noise.size(), channels,
+                Cell("%.3f", errors.weighted_rms).c_str(), adequacy.above_noise.size(),
+                adequacy.channels,
                 completed ? "" : (" (a run did not complete: " + message + ")").c_str());
   return text;
 }
 
 std::string PredictionSummary::FullReport() const {
   std::ostringstream out;
+  out << adequacy.Verdict() << "\n";
   out << BriefReport() << "\n";
   out << "  model: " << model.source << " (" << model.kind << "), " << model.values.size()
       << " parameter values";
@@ -104,7 +106,8 @@ std::string PredictionSummary::FullReport() const {
   char rule[200];
   std::snprintf(rule, sizeof(rule),
                 "RMS above %.3g times its noise, and beyond chance: p < %.3g over the %zu channels",
-                above_noise_ratio, significance, channels);
+                adequacy.above_noise_ratio, adequacy.significance, adequacy.channels);
+  const std::vector<ChannelAboveNoise>& above_noise = adequacy.above_noise;
   if (above_noise.empty()) {
     out << "  no channel stands above the noise (" << rule
         << "): the model predicts these recordings to the noise floor\n";
@@ -144,16 +147,11 @@ nlohmann::json ToJson(const PredictionSummary& s) {
   }
   nlohmann::json effects_files = nlohmann::json::array();
   for (const PredictionModel::Effects& e : s.model.effects) effects_files.push_back(e.file);
-  nlohmann::json above = nlohmann::json::array();
-  for (const ChannelAboveNoise& c : s.above_noise) {
-    above.push_back({{"recording", c.recording},
-                     {"joint", c.joint},
-                     {"axis", c.axis == 0 ? "x" : "y"},
-                     {"rms_deg", Number(c.rms_deg)},
-                     {"noise_deg", Number(c.noise_deg)},
-                     {"effective_samples", Number(c.effective_samples)},
-                     {"p_value", Number(c.p_value)}});
-  }
+  // The adequacy's channels as pred.json has always listed them (axis "x"
+  // or "y"), beside the verdict.
+  nlohmann::json adequacy = ToJson(s.adequacy);
+  nlohmann::json above = adequacy["above_noise"];
+  for (nlohmann::json& c : above) c["axis"] = c["axis"] == "theta_x" ? "x" : "y";
   return {{"schema", "ccsrm-prediction/1"},
           {"model",
            {{"source", s.model.source},
@@ -168,9 +166,12 @@ nlohmann::json ToJson(const PredictionSummary& s) {
           {"max_abs_deg", Number(s.errors.max_abs_deg_overall)},
           {"weighted_rms", Number(s.errors.weighted_rms)},
           {"errors", ErrorsJson(s.errors)},
-          {"above_noise_ratio", s.above_noise_ratio},
-          {"significance", s.significance},
-          {"channels", s.channels},
+          {"verdict", adequacy["verdict"]},
+          {"adequate", adequacy["adequate"]},
+          {"above_noise_ratio", s.adequacy.above_noise_ratio},
+          {"significance", s.adequacy.significance},
+          {"channels", s.adequacy.channels},
+          {"worst_ratio", adequacy["worst_ratio"]},
           {"above_noise", above},
           {"threads", s.threads},
           {"simulations", s.simulations},

@@ -10,6 +10,16 @@ command line, so a run or a fit from Python is the command's, to the bit.
     >>> run.joint_angles.shape          # frames x joints x (theta_x, theta_y)
     (101, 12, 2)
 """
+import sys as _sys
+
+try:  # every array ccsrm returns is a numpy array: say so at import, not at the first read
+    import numpy as _numpy  # noqa: F401
+except ImportError as _error:  # pragma: no cover - depends on the interpreter
+    raise ImportError(
+        "ccsrm needs numpy, which " + _sys.executable + " does not have: use Debian's "
+        "/usr/bin/python3 with python3-numpy (scripts/install-deps.sh installs it), or "
+        "pip install numpy into this environment") from _error
+
 from ._core import (  # noqa: F401  (the public API)
     Dataset,
     EffectInfo,

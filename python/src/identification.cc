@@ -31,7 +31,8 @@ struct Fit {
 // takes it (read by the commands' reader, with their messages).
 std::vector<std::string> Names(const py::object& names, const std::string& option) {
   if (py::isinstance<py::str>(names)) return SplitNameList(names.cast<std::string>(), option);
-  return names.cast<std::vector<std::string>>();
+  return CastArgument<std::vector<std::string>>(names, option.c_str(),
+                                                "a list of names or one comma-separated string");
 }
 
 // Values by name, from a dict of numbers or from "name=value" strings as
@@ -41,11 +42,13 @@ std::vector<std::pair<std::string, double>> Values(const py::object& values) {
   if (values.is_none()) return out;
   if (py::isinstance<py::dict>(values)) {
     for (const auto& [name, value] : values.cast<py::dict>()) {
-      out.emplace_back(name.cast<std::string>(), value.cast<double>());
+      out.emplace_back(CastArgument<std::string>(name, "set", "parameter names (str)"),
+                       CastArgument<double>(value, "set", "numbers as values"));
     }
     return out;
   }
-  for (const std::string& text : values.cast<std::vector<std::string>>()) {
+  for (const std::string& text : CastArgument<std::vector<std::string>>(
+           values, "set", "a dict of numbers by name, or 'name=value' strings")) {
     out.push_back(sim::ParseParameterAssignment(text, "--set"));
   }
   return out;
@@ -225,6 +228,21 @@ void AddIdentification(py::module_& m) {
           "termination",
           [](const Fit& f) { return identify::TerminationName(f.summary.termination); })
       .def_property_readonly("converged", [](const Fit& f) { return f.summary.converged(); })
+      .def_property_readonly(
+          "adequate", [](const Fit& f) { return f.summary.adequacy.adequate(); },
+          "Whether the fitted model explains the data: no joint axis's residual stands above "
+          "its measured noise (read `verdict` before `converged`).")
+      .def_property_readonly(
+          "verdict", [](const Fit& f) { return f.summary.adequacy.Verdict(); },
+          "One line: whether the model explains the data, with the worst joint axis.")
+      .def_property_readonly(
+          "adequacy",
+          [](const Fit& f) {
+            return py::module_::import("json").attr("loads")(
+                identify::ToJson(f.summary.adequacy).dump());
+          },
+          "fit.json's 'adequacy' as a dict: the verdict, the channels above the noise, the "
+          "misfit scale of the intervals.")
       .def_property_readonly("message", [](const Fit& f) { return f.summary.message; })
       .def_property_readonly("iterations", [](const Fit& f) { return f.summary.iterations; })
       .def_property_readonly("simulations", [](const Fit& f) { return f.summary.simulations; })

@@ -38,6 +38,10 @@ def test_fit_equals_command_lines_fit_json(exe, experiment, tmp_path):
     # One report per iteration, from the start (iteration 0).
     assert [p["iteration"] for p in iterations] == list(range(len(iterations)))
     assert iterations[0]["cost"] == fit.cost_history[0] and "T_p" in iterations[-1]["values"]
+    # Issue 44: the verdict, as fit.json and the command's report give it.
+    assert fit.verdict == cli["adequacy"]["verdict"] and fit.adequacy == cli["adequacy"]
+    assert fit.adequate == cli["adequacy"]["adequate"]
+    assert fit.full_report().startswith("model: " + fit.verdict)
     t_p = fit["T_p"]
     assert t_p.free and t_p.value == cli["parameters"]["T_p"]["value"]
     assert "T_p" in fit.full_report()
@@ -50,6 +54,8 @@ def test_fit_equals_command_lines_fit_json(exe, experiment, tmp_path):
     (dict(free="T_p", set={"beta": 3}), "--set: parameter 'beta' = 3 is outside [0, 0.1] s"),
     (dict(free="T_p", threads=0), "identify: threads: must be in 1..1024"),
     (dict(free="T_p", relative_step=0.5), "identify: relative_step must be in (0, 0.1]"),
+    # Issue 47, 9: 0 iterations is no fit (it would say "converged", unmoved).
+    (dict(free="T_p", max_iterations=0), "--max-iterations: is 0: a fit takes at least 1"),
 ])
 def test_bad_fit_options_raise_before_any_run(experiment, kwargs, message):
     with pytest.raises(ccsrm.InputError) as e:

@@ -55,6 +55,12 @@ FitParameter ReadParameter(const JsonReader& in, const json& entry, const std::s
     p.ci95_lower = interval[0];
     p.ci95_upper = interval[1];
   }
+  if (entry.contains("ci95_scaled_by_misfit") && !entry["ci95_scaled_by_misfit"].is_null()) {
+    const std::array<double, 2> interval =
+        in.Pair(entry["ci95_scaled_by_misfit"], at + ".ci95_scaled_by_misfit", true);
+    p.ci95_misfit_lower = interval[0];
+    p.ci95_misfit_upper = interval[1];
+  }
   const std::array<double, 2> bounds = in.Pair(in.At(entry, at, "bounds"), at + ".bounds", false);
   p.lower = bounds[0];
   p.upper = bounds[1];
@@ -157,6 +163,13 @@ FitFolder ReadFitFolder(const std::string& folder) {
   FitFolder fit;
   fit.folder = folder;
   fit.converged = in.Flag(root, "", "converged");
+  if (root.contains("adequacy")) {
+    const json& adequacy = in.Object(root, "", "adequacy");
+    fit.adequacy_known = in.Flag(adequacy, "adequacy", "assessed");
+    fit.adequate = in.Flag(adequacy, "adequacy", "adequate");
+    fit.verdict = in.Text(adequacy, "adequacy", "verdict");
+    fit.misfit_scale = in.NumberAt(adequacy, "adequacy", "misfit_scale");
+  }
   fit.termination = in.Text(root, "", "termination");
   fit.message = in.Text(root, "", "message");
   fit.iterations = in.NumberAt(root, "", "iterations");

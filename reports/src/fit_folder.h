@@ -30,6 +30,9 @@ struct FitParameter {
   bool identifiable = true;
   double std_error = kUnknown;
   double ci95_lower = kUnknown, ci95_upper = kUnknown;
+  // The interval widened by the misfit (fit.json 'ci95_scaled_by_misfit');
+  // unknown in a fit.json written before it.
+  double ci95_misfit_lower = kUnknown, ci95_misfit_upper = kUnknown;
   double lower = kUnknown, upper = kUnknown;  // bounds of the fit
   bool at_bound = false;
 };
@@ -95,6 +98,13 @@ struct FitFolder {
   std::vector<double> cost_history;  // start, then each accepted step
   double residuals = 0;
   double effective_samples = kUnknown, residual_variance = kUnknown;
+  // fit.json 'adequacy' (absent before issue 44: then not known): whether
+  // the model explains the data, in one line, and the factor the intervals
+  // widen by when it does not.
+  bool adequacy_known = false;
+  bool adequate = true;
+  std::string verdict;
+  double misfit_scale = 1.0;
   std::vector<FitExperiment> experiments;
 };
 

@@ -6,6 +6,7 @@
 // experiments with their noise. Every number is read from fit.json or the
 // angles files as ccsrm identify wrote them.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <set>
 #include <string>
@@ -98,6 +99,12 @@ std::string ParameterSentence(const FitParameter& p, const FitFolder& fit) {
             unit;
   }
   text += "; start " + Show(p.start, kValue) + unit + ")";
+  if (fit.adequacy_known && !fit.adequate && std::isfinite(p.ci95_misfit_lower)) {
+    text += ", or " + Show(p.ci95_misfit_lower, kValue) + " to " +
+            Show(p.ci95_misfit_upper, kValue) + unit +
+            " with the interval widened by the misfit (× " +
+            Show(fit.misfit_scale, NumberFormat::Fixed(2)) + ")";
+  }
   if (p.at_bound) {
     text += ", at a bound of its range [" + Show(p.lower, kValue) + ", " + Show(p.upper, kValue) +
             "]" + unit + ", where its interval is not symmetric";
@@ -107,6 +114,19 @@ std::string ParameterSentence(const FitParameter& p, const FitFolder& fit) {
 
 Section SummarySection(const FitFolder& fit) {
   Section section{"summary", "Summary", {}};
+  // The answer first: whether the model explains the data at all, before
+  // any number that assumes it does.
+  if (fit.adequacy_known) {
+    std::string verdict = fit.verdict;
+    if (!verdict.empty())
+      verdict[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(verdict[0])));
+    section.blocks.push_back(Paragraph{
+        verdict + (fit.adequate ? "."
+                                : ". The estimates and intervals below are those of the "
+                                  "model as declared; each parameter also gives its interval "
+                                  "widened by the misfit."),
+        !fit.adequate});
+  }
   Table table = FitTable(fit);
   std::vector<std::string> names;
   for (const FitExperiment& e : fit.experiments) names.push_back(e.name);

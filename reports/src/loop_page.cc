@@ -6,6 +6,7 @@
 // in a table is loop.json's; the figures draw the angles files of declared/,
 // final/ and holdout/.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -162,8 +163,57 @@ Table DiscoveredTermsTable(const LoopFolder& loop) {
   return table;
 }
 
+// The answer, before how it was found (issue 44): what the loop added, with
+// its fitted values and intervals, the error before and after against the
+// noise, and whether the final model explains the data.
+Paragraph AnswerParagraph(const LoopFolder& loop) {
+  std::string text;
+  if (loop.added_effects.empty() && loop.declared_corrections.empty() &&
+      loop.discovered_terms.empty()) {
+    text = "Answer: nothing added; the declared model is kept.";
+  } else {
+    std::vector<std::string> found;
+    for (const std::string& effect : loop.added_effects) {
+      std::vector<std::string> values;
+      for (const LoopEstimate& e : loop.parameters) {
+        if (e.name.rfind(effect + ".", 0) != 0) continue;
+        values.push_back(e.name + " = " + Show(e.value, kValue) +
+                         (std::isfinite(e.ci95_lower) ? " [" + Show(e.ci95_lower, kValue) + ", " +
+                                                            Show(e.ci95_upper, kValue) + "]"
+                                                      : std::string()) +
+                         (e.units.empty() || e.units == "1" ? "" : " " + e.units));
+      }
+      found.push_back(values.empty() ? effect : effect + ": " + ListNames(values));
+    }
+    for (const LoopDeclaredCorrection& d : loop.declared_corrections) {
+      found.push_back("the declared " + d.config_key + " corrected from " +
+                      Show(d.declared, kValue) + " to " + Show(d.corrected, kValue));
+    }
+    if (!loop.discovered_terms.empty()) found.push_back("terms found in the data (table below)");
+    text = "Answer: added " + ListNames(found) + ".";
+  }
+  text += " Training RMS error " + Show(loop.rms_before_deg, kRms) + " deg declared, " +
+          Show(loop.rms_after_deg, kRms) + " deg final";
+  if (std::isfinite(loop.holdout_rms_before_deg) && std::isfinite(loop.holdout_rms_after_deg)) {
+    text += "; held out " + Show(loop.holdout_rms_before_deg, kRms) + " deg declared, " +
+            Show(loop.holdout_rms_after_deg, kRms) + " deg final";
+  }
+  text += "; the noise floor is " + Show(loop.noise_floor_deg, kRms) + " deg.";
+  bool misfit = false;
+  if (loop.final_model && loop.final_model->adequacy_known) {
+    std::string verdict = loop.final_model->verdict;
+    if (!verdict.empty()) {
+      verdict[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(verdict[0])));
+    }
+    text += " " + verdict + ".";
+    misfit = !loop.final_model->adequate;
+  }
+  return Paragraph{text, misfit};
+}
+
 Section SummarySection(const LoopFolder& loop) {
   Section section{"summary", "Summary", {}};
+  section.blocks.push_back(AnswerParagraph(loop));
   std::vector<std::string> training, holdout;
   for (const LoopFolder::Data& d : loop.data) (d.holdout ? holdout : training).push_back(d.name);
   std::string text =

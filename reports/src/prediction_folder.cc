@@ -119,6 +119,7 @@ PredictionFolder ReadPredictionFolder(const std::string& folder) {
   p.above_noise_ratio = in.NumberAt(root, "", "above_noise_ratio");
   p.significance = in.NumberAt(root, "", "significance");
   p.channels = in.NumberAt(root, "", "channels");
+  if (root.contains("verdict")) p.verdict = in.Text(root, "", "verdict");
   const json& above = in.List(root, "", "above_noise");
   for (std::size_t i = 0; i < above.size(); ++i) {
     const std::string at = "above_noise[" + std::to_string(i) + "]";

@@ -77,6 +77,8 @@ struct PredictionFolder {
   double significance = kUnknown;  // family-wise, over `channels`
   double channels = 0;
   std::vector<PredictionChannel> above_noise;
+  // pred.json 'verdict' (issue 44; empty in an older pred.json).
+  std::string verdict;
   double threads = 0, simulations = 0, wall_time_s = kUnknown;
   std::vector<PredictionRecording> recordings;
 };

@@ -5,6 +5,7 @@
 // the model that was run. Every number is read from pred.json or the angles
 // files as ccsrm predict wrote them.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <set>
 #include <string>
@@ -41,6 +42,12 @@ std::string ChannelName(int joint, int axis) {
 
 Section SummarySection(const PredictionFolder& p) {
   Section section{"summary", "Summary", {}};
+  // The answer first: whether the model explains these recordings.
+  if (!p.verdict.empty()) {
+    std::string verdict = p.verdict;
+    verdict[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(verdict[0])));
+    section.blocks.push_back(Paragraph{verdict + ".", !p.above_noise.empty()});
+  }
   std::vector<std::string> names;
   for (const PredictionRecording& r : p.recordings) names.push_back(r.name);
   std::string text =

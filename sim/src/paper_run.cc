@@ -1,6 +1,7 @@
 #include "ccsrm/sim/paper_run.h"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <system_error>
 
@@ -197,6 +198,79 @@ std::string ProtocolYamlOf(const PaperRun& run) {
   // The default (the paper protocol of the configuration's protocol:
   // section) is recorded by config_yaml itself, as in every earlier file.
   return run.protocol && !run.default_protocol ? run.protocol->ToYaml() : std::string();
+}
+
+std::vector<PlanError> PlanErrors(const PaperRun& run, const Trajectory& trajectory) {
+  std::vector<PlanError> errors;
+  if (!run.protocol || trajectory.size() == 0) return errors;
+  const Protocol& protocol = *run.protocol;
+  std::vector<double> sum_sq(protocol.segment_joints.size(), 0.0);
+  std::vector<std::size_t> count(protocol.segment_joints.size(), 0);
+  for (std::size_t s = 0; s < protocol.segment_joints.size(); ++s) {
+    errors.push_back({static_cast<int>(s) + 1});
+  }
+  for (std::size_t f = 0; f < trajectory.size(); ++f) {
+    const JointAngles plan = protocol.PlannedAngles(trajectory.time[f]);
+    const std::vector<Eigen::Vector2d>& angles = trajectory.frames[f].joint_angles;
+    int joint = 0;
+    for (std::size_t s = 0; s < protocol.segment_joints.size(); ++s) {
+      for (int j = 0; j < protocol.segment_joints[s]; ++j, ++joint) {
+        for (int a = 0; a < 2; ++a) {
+          const double e =
+              angles[static_cast<std::size_t>(joint)][a] - plan[static_cast<std::size_t>(joint)][a];
+          sum_sq[s] += e * e;
+          ++count[s];
+          if (std::abs(e) > errors[s].max_abs_rad) {
+            errors[s].max_abs_rad = std::abs(e);
+            errors[s].worst_joint = joint + 1;
+            errors[s].worst_axis = a;
+            errors[s].worst_time_s = trajectory.time[f];
+          }
+        }
+      }
+    }
+  }
+  for (std::size_t s = 0; s < errors.size(); ++s) {
+    errors[s].rms_rad = count[s] > 0 ? std::sqrt(sum_sq[s] / static_cast<double>(count[s])) : 0.0;
+  }
+  return errors;
+}
+
+std::string DescribeRunStates(const PaperRun& run, const SimulationResult& result) {
+  constexpr double kDeg = 180.0 / 3.14159265358979323846;
+  std::string out;
+  char line[256];
+  for (const PlanError& e : PlanErrors(run, result.trajectory)) {
+    std::snprintf(line, sizeof(line),
+                  "  error to the plan, seg. %d: RMS %.3g deg, largest %.3g deg (joint %d %s at "
+                  "%.2f s)\n",
+                  e.segment, e.rms_rad * kDeg, e.max_abs_rad * kDeg, e.worst_joint,
+                  e.worst_axis == 0 ? "θx" : "θy", e.worst_time_s);
+    out += line;
+  }
+  int holes = 0, most = 0;
+  double most_at = 0.0;
+  for (const DrivingCableModel& c : run.model.cables()) holes += c.num_holes();
+  for (std::size_t f = 0; f < result.trajectory.size(); ++f) {
+    int stuck = 0;
+    for (const std::vector<int>& cable : result.trajectory.frames[f].hole_stuck) {
+      for (int s : cable) stuck += s != 0;
+    }
+    if (stuck > most) {
+      most = stuck;
+      most_at = result.trajectory.time[f];
+    }
+  }
+  if (holes > 0) {
+    std::snprintf(line, sizeof(line),
+                  "  stuck hole nodes:          at most %d of %d (t = %.2f s)%s\n", most, holes,
+                  most_at,
+                  run.config.solver.hole_friction == HoleFrictionModel::kEvents
+                      ? ""
+                      : "; this law sticks without switch events");
+    out += line;
+  }
+  return out;
 }
 
 }  // namespace ccsrm::sim

@@ -335,7 +335,7 @@ std::string SimulationSummary::FullReport() const {
                 static_cast<long long>(rhs_evaluations),
                 wall_time_s > 0 ? rhs_evaluations / wall_time_s : 0.0);
   out << line;
-  std::snprintf(line, sizeof(line), "  stick-slip switches:       %lld\n",
+  std::snprintf(line, sizeof(line), "  stick-slip switches:       %lld (events law)\n",
                 static_cast<long long>(stick_slip_switches));
   out << line;
   if (failed_releases > 0) {

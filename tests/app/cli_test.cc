@@ -69,6 +69,11 @@ TEST(Cli, SimulateWritesARunFileThatInspectReads) {
   EXPECT_THAT(sim.out, HasSubstr("simulation completed"));
   EXPECT_THAT(sim.out, HasSubstr("real-time factor"));
   EXPECT_THAT(sim.out, HasSubstr("stick-slip switches"));
+  // Issue 44: the error to the plan per segment, and the stuck nodes the
+  // run's states hold, whatever the law.
+  EXPECT_THAT(sim.out, HasSubstr("error to the plan, seg. 1: RMS"));
+  EXPECT_THAT(sim.out, HasSubstr("error to the plan, seg. 2: RMS"));
+  EXPECT_THAT(sim.out, HasSubstr("stuck hole nodes:          at most"));
   const ccsrm::datasets::RunFile file = ccsrm::datasets::ReadRunFile(run);
   EXPECT_EQ(file.frames(), 6u);  // 0 .. 0.05 s at 100 Hz
   EXPECT_EQ(file.case_name, "1");

@@ -414,11 +414,18 @@ TEST(LoopPage, KnownLoopShowsItsNumbers) {
   EXPECT_EQ(loop("simulations"), 512);
   EXPECT_EQ(loop("rounds"), 2);
 
+  // The page opens with the answer (issue 44): what was added, its value
+  // and interval, the error before and after.
+  const Paragraph& answer = std::get<Paragraph>(document.sections[0].blocks[0]);
+  EXPECT_THAT(answer.text, HasSubstr("Answer: added table_tilt: table_tilt.lateral_rad = "
+                                     "0.0009877 [0.00094, 0.00103] rad"));
+  EXPECT_THAT(answer.text, HasSubstr("0.0935 deg declared, 0.0412 deg final"));
+  EXPECT_THAT(answer.text, HasSubstr("held out 0.1212 deg declared, 0.0523 deg final"));
   // The text says what happened, in the tables' numbers.
-  const Paragraph& headline = std::get<Paragraph>(document.sections[0].blocks[0]);
+  const Paragraph& headline = std::get<Paragraph>(document.sections[0].blocks[1]);
   EXPECT_THAT(headline.text, HasSubstr("went from 0.0935 deg with the declared model to 0.0412"));
   EXPECT_THAT(headline.text, HasSubstr("the held-out error from 0.1212 to 0.0523 deg"));
-  const Paragraph& conclusion = std::get<Paragraph>(document.sections[0].blocks[1]);
+  const Paragraph& conclusion = std::get<Paragraph>(document.sections[0].blocks[2]);
   EXPECT_THAT(conclusion.text, HasSubstr("worst in motion 2"));
   const Paragraph& remains = std::get<Paragraph>(document.sections.back().blocks[0]);
   EXPECT_THAT(remains.text, HasSubstr("2 joint axes keep a residual above its noise threshold"));

@@ -204,10 +204,19 @@ TEST(ReportCli, FitReportShowsTheFitJsonNumbers) {
   EXPECT_EQ(RowOf(r.summary, "fit", "quantity", "iterations")["value"], fit["iterations"]);
   EXPECT_NEAR(RowOf(r.summary, "fit", "quantity", "RMS error fitted")["value"].get<double>(),
               fit["rms_deg"].get<double>(), 5e-5);
-  // At most the note that 3 iterations were not enough.
+  // At most the notes that 3 iterations were not enough, and that the model
+  // stopped there does not explain the data (issue 44: said first).
   for (const nlohmann::json& notice : r.summary["notices"]) {
-    EXPECT_THAT(notice.get<std::string>(), HasSubstr("did not converge"));
+    EXPECT_THAT(notice.get<std::string>(),
+                ::testing::AnyOf(HasSubstr("did not converge"),
+                                 HasSubstr("The model does NOT explain the data")));
   }
+  // The verdict opens the page: the first paragraph after the title.
+  const std::size_t verdict =
+      r.html.find(fit["adequacy"]["adequate"].get<bool>() ? "The model explains the data"
+                                                          : "The model does NOT explain the data");
+  ASSERT_NE(verdict, std::string::npos);
+  EXPECT_LT(verdict, r.html.find("Fit of T_p"));
   // The paper arm's two segments, from the fitted run's configuration.
   const std::string first = r.summary["figures"][0]["script"];
   EXPECT_THAT(first, HasSubstr("figures/angles_x_"));

@@ -273,6 +273,36 @@ TEST(ProtocolChecks, RefuseACableFasterThanTheLimitNamingThePiece) {
   }
 }
 
+// Issue 44: simulate's summary gives the error to the plan per segment. A
+// trajectory that is the plan has none; one joint off by 0.5 deg at one
+// frame is the largest, on its own segment only, with its RMS over the
+// segment's frames, joints and axes.
+TEST(PlanErrors, AreTheDistanceToThePlanPerSegment) {
+  PaperRunOptions options;
+  options.config_path = kPaperConfig;
+  options.duration_s = 4.0;
+  const PaperRun run = PreparePaperRun(options);
+  Trajectory trajectory;
+  for (int f = 0; f <= 40; ++f) {
+    const double t = 0.1 * f;
+    TrajectoryFrame frame;
+    for (const Eigen::Vector2d& a : run.protocol->PlannedAngles(t)) frame.joint_angles.push_back(a);
+    trajectory.time.push_back(t);
+    trajectory.frames.push_back(frame);
+  }
+  for (const PlanError& e : PlanErrors(run, trajectory)) EXPECT_EQ(e.max_abs_rad, 0.0);
+  trajectory.frames[30].joint_angles[8].y() += 0.5 * kDeg;  // joint 9 θy, segment 2, t = 3 s
+  const std::vector<PlanError> errors = PlanErrors(run, trajectory);
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0].max_abs_rad, 0.0);
+  EXPECT_NEAR(errors[1].max_abs_rad, 0.5 * kDeg, 1e-12);
+  EXPECT_EQ(errors[1].worst_joint, 9);
+  EXPECT_EQ(errors[1].worst_axis, 1);
+  EXPECT_DOUBLE_EQ(errors[1].worst_time_s, 3.0);
+  // One error among 41 frames x 6 joints x 2 axes.
+  EXPECT_NEAR(errors[1].rms_rad, 0.5 * kDeg / std::sqrt(41.0 * 12.0), 1e-12);
+}
+
 TEST(RecordedInputTable, ReadsUnitsFromTheHeaderAndResamplesIrregularStampsLinearly) {
   const std::string csv =
       "# actuator log\n"

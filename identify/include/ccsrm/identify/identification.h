@@ -53,6 +53,7 @@
 #include <utility>
 #include <vector>
 
+#include "ccsrm/identify/adequacy.h"
 #include "ccsrm/identify/experiment.h"
 #include "ccsrm/identify/runs.h"
 #include "ccsrm/identify/simulation_backend.h"
@@ -317,8 +318,15 @@ struct IdentificationSummary {
   std::vector<ExperimentFit> experiments;
   bool covariance_available = false;
   std::string covariance_message;  // why not, when not
+  // Whether the fitted model explains the data (adequacy.h): the residual of
+  // the final point against each joint axis's measured noise. Reported
+  // first; not assessed when the final run did not complete.
+  ModelAdequacy adequacy;
 
   const ParameterEstimate* Find(const std::string& name) const;
+  // The 95 % interval of `p` widened by adequacy.misfit_scale() about the
+  // estimate (the interval itself when the model is adequate).
+  std::array<double, 2> MisfitInterval(const ParameterEstimate& p) const;
   // One line; and the whole result as a table.
   std::string BriefReport() const;
   std::string FullReport() const;

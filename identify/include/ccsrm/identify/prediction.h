@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "ccsrm/identify/adequacy.h"
 #include "ccsrm/identify/experiment.h"
 #include "ccsrm/identify/identification.h"
 #include "ccsrm/identify/simulation_backend.h"
@@ -70,20 +71,10 @@ struct PredictionOptions {
   // Another backend (null: threads on this machine). It must have been given
   // the same recordings, in the same order.
   std::shared_ptr<SimulationBackend> backend;
-  // A channel (recording, joint, axis) is listed as above the noise when
-  // both hold: its RMS error exceeds above_noise_ratio times its
-  // measurement noise (default 1.5, the loop's threshold for an unexplained
-  // channel, LoopOptions::unexplained_noise_ratio: a size worth naming), and
-  // its residual is not noise by chance: mocap residuals are filtered, so a
-  // channel's N frames carry N_eff independent samples (N over the
-  // residual's integrated autocorrelation time), and Σ r² N_eff / N of the
-  // weighted residuals r is then a chi-square of N_eff degrees of freedom;
-  // its p-value must be below `significance` over the number of channels
-  // (Bonferroni; default 0.01 family-wise, the loop's score_significance).
-  // On a few seconds of 1 Hz-filtered mocap a channel has N_eff of about 7,
-  // and its RMS alone scatters by a quarter around the noise.
-  double above_noise_ratio = 1.5;
-  double significance = 0.01;
+  // The rule of a channel above the noise (AssessModelAdequacy; defaults
+  // kAboveNoiseRatio and kAboveNoiseSignificance, as identification's).
+  double above_noise_ratio = kAboveNoiseRatio;
+  double significance = kAboveNoiseSignificance;
   // Called after each finished run, one call at a time; may be empty.
   RunFinishedCallback on_run;
 
@@ -111,17 +102,6 @@ struct PredictionErrors {
 PredictionErrors ComputePredictionErrors(const std::vector<const Experiment*>& recordings,
                                          const std::vector<const Eigen::MatrixXd*>& predicted);
 
-// A channel whose error stands above its noise.
-struct ChannelAboveNoise {
-  std::string recording;
-  int joint = 0;  // 1-based
-  int axis = 0;   // 0 θx, 1 θy
-  double rms_deg = 0.0;
-  double noise_deg = 0.0;
-  double effective_samples = 0.0;  // N_eff of its residual
-  double p_value = 0.0;            // of its chi-square as noise
-};
-
 struct RecordingPrediction {
   std::string name;
   std::string path;
@@ -138,10 +118,9 @@ struct PredictionSummary {
   std::vector<std::string> effects;  // on in the predicted model
   std::vector<RecordingPrediction> recordings;
   PredictionErrors errors;  // every recording together
-  std::vector<ChannelAboveNoise> above_noise;
-  double above_noise_ratio = 0.0;
-  double significance = 0.0;  // family-wise, over `channels`
-  std::size_t channels = 0;   // tested: recordings x joints x 2 with a measured sample
+  // Whether the model explains the recordings: the channels above the
+  // noise, and the verdict that heads the report (adequacy.h).
+  ModelAdequacy adequacy;
   int threads = 0;
   std::int64_t simulations = 0;
   double wall_time_s = 0.0;

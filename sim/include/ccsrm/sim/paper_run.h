@@ -116,6 +116,26 @@ std::string ProtocolYamlOf(const PaperRun& run);
 // the recorded inputs) followed.
 std::string DescribeRun(const PaperRun& run);
 
+// How far a run's joints came from the protocol's plan, per segment: the
+// largest |angle - plan| over its joints, both axes and every frame, where
+// and when, and the RMS over the same [rad]. Empty for recorded inputs (no
+// plan).
+struct PlanError {
+  int segment = 0;  // 1-based
+  double max_abs_rad = 0.0;
+  int worst_joint = 0;  // 1-based, of the arm
+  int worst_axis = 0;   // 0 θx, 1 θy
+  double worst_time_s = 0.0;
+  double rms_rad = 0.0;
+};
+std::vector<PlanError> PlanErrors(const PaperRun& run, const Trajectory& trajectory);
+
+// The lines `ccsrm simulate` prints below the simulation's summary: the
+// error to the plan per segment, and the stuck hole nodes the run's states
+// hold (under the presliding and smoothed laws, which switch without
+// events, the switch counter above stays 0 while nodes stick).
+std::string DescribeRunStates(const PaperRun& run, const SimulationResult& result);
+
 // The path of the configuration `name` ("paper.yaml") that ships with ccsrm:
 // in the configs/ folder of the source tree the program was built from, else
 // in the installed data folder (<prefix>/share/ccsrm/configs, where `cmake
