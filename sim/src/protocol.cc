@@ -126,16 +126,16 @@ void CheckPlannedJointRange(const ArmModel& model, const Eigen::VectorXd& time,
   if (worst_joint == 0) return;
   const double deg = 180.0 / M_PI;
   const int segment = model.link(worst_joint).segment + 1;
-  ThrowInputError(source, "",
-                  "the plan tilts joint " + std::to_string(worst_joint) + " (segment " +
-                      std::to_string(segment) + ") to " + Format("%.1f", worst_tilt * deg) +
-                      " deg (beyond from t = " + Format("%.3g", first_time) +
-                      " s), past its range of " +
-                      Format("%.1f", model.joint_range_rad(worst_joint) * deg) +
-                      " deg where its disks meet (2 atan(d/2R), d = " +
-                      Format("%.3g", model.arm().joint_disk_gap_m * 1e3) +
-                      " mm, R = " + Format("%.3g", model.joint_disk_radius_m(worst_joint) * 1e3) +
-                      " mm the hole circle); ccsrm has no contact between disks");
+  ThrowInputError(
+      source, "",
+      "the plan tilts joint " + std::to_string(worst_joint) + " (segment " +
+          std::to_string(segment) + ") to " + Format("%.1f", worst_tilt * deg) +
+          " deg (beyond from t = " + Format("%.3g", first_time) + " s), past its range of " +
+          Format("%.1f", model.joint_range_rad(worst_joint) * deg) +
+          " deg where its disks meet (2 atan(d/2R), d = " +
+          Format("%.3g", model.arm().joint_disk_gap_m * 1e3) + " mm, R = " +
+          Format("%.3g", model.joint_disk_radius_m(worst_joint) * 1e3) + " mm the hole circle)" +
+          internal::RangeSetBy(model.arm(), worst_joint) + "; ccsrm has no contact between disks");
 }
 
 // Stretch [m] each cable needs beyond its kinematic length for the
@@ -448,5 +448,30 @@ std::string DescribeProtocolFile(const Protocol& protocol) {
   }
   return text;
 }
+
+namespace internal {
+
+std::string RangeSetBy(const ArmConfig& arm, int joint) {
+  const int own = arm.segment_of_link(joint);  // 0-based
+  if (own < 0) return "";
+  int widest = own;
+  for (const DrivingCableRoute& route : arm.driving.cables) {
+    const int s = route.segment - 1;
+    if (s >= own &&
+        arm.segments[s].hole_circle_radius_m > arm.segments[widest].hole_circle_radius_m) {
+      widest = s;
+    }
+  }
+  if (widest == own) return "";
+  char text[200];
+  std::snprintf(text, sizeof(text),
+                " (R = %.3g mm: the hole circle of segment %d, whose cables pass joint %d; "
+                "segment %d's own is %.3g mm)",
+                arm.segments[widest].hole_circle_radius_m * 1e3, widest + 1, joint, own + 1,
+                arm.segments[own].hole_circle_radius_m * 1e3);
+  return text;
+}
+
+}  // namespace internal
 
 }  // namespace ccsrm::sim

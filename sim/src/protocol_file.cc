@@ -377,7 +377,7 @@ std::string Degrees(double rad) {
 // the limits, no jump in rate at a join or into the final hold.
 void CheckSegment(const std::string& file, const std::vector<ProtocolPiece>& pieces,
                   int first_joint, const std::vector<double>& bend_limits,
-                  double bend_limit_override) {
+                  double bend_limit_override, const ArmConfig& arm) {
   auto fail = [&](const ProtocolPiece& p, const std::string& what) {
     ThrowInputError(file, p.source.Where(), what);
   };
@@ -420,7 +420,8 @@ void CheckSegment(const std::string& file, const std::vector<ProtocolPiece>& pie
                     " deg (beyond from " + Degrees(first_beyond * kDegToRad) +
                     " s into the piece), past its " + Degrees(limit) + " deg (" +
                     (narrowed ? "limits.joint_bend_deg"
-                              : "its range, where its disks meet at the hole circle") +
+                              : "its range, where its disks meet at the hole circle" +
+                                    internal::RangeSetBy(arm, first_joint + j)) +
                     ")");
       }
     }
@@ -557,7 +558,8 @@ Protocol ParseProtocol(const std::string& yaml_text, const std::string& source_n
       p.start = state;
       state = internal::PieceAngles(p, p.duration_s);
     }
-    CheckSegment(source_name, pieces, first_joint, bend_limits, protocol.limits.joint_bend_rad);
+    CheckSegment(source_name, pieces, first_joint, bend_limits, protocol.limits.joint_bend_rad,
+                 arm);
     protocol.segments.push_back(std::move(pieces));
     protocol.segment_joints.push_back(joints);
     first_joint += joints;

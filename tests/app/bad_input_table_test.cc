@@ -138,6 +138,9 @@ class BadInputTable : public ::testing::Test {
     Write(d / "samehole.yaml", EditedThreeSegment("hole_angle_deg: 160.0", "hole_angle_deg: 40.0"));
     Write(d / "halfplane.yaml",
           EditedThreeSegment("hole_angle_deg: 280.0", "hole_angle_deg: 100.0"));
+    // Issue 44: segment 3's hole circle (0.16 m) sets joint 1's range.
+    Write(d / "wide3.yaml",
+          EditedThreeSegment("hole_circle_radius_m: 0.015", "hole_circle_radius_m: 0.16"));
     fs::create_directory(d / "confdir");
     Write(d / "p.yaml", "mu: 0.2\n");
     Write(d / "proto.yaml",
@@ -369,6 +372,10 @@ const std::vector<BadInput>& Rows() {
       {"configs",
        "simulate --config {d}/halfplane.yaml --duration 0.1 --out {d}/run2.h5",
        {"{d}/halfplane.yaml", "segment 2", "half-plane"}},
+      {"configs",
+       "simulate --config {d}/wide3.yaml --case 1 --out {d}/run2.h5",
+       {"{d}/wide3.yaml", "past its 5.725 deg",
+        "the hole circle of segment 3, whose cables pass joint 1"}},  // issue 44
       // Command-line values and parameter files.
       {"overrides",
        "simulate --config {d}/c.yaml --set mu=1e-400 --duration 0.1 --out {d}/run2.h5",
