@@ -105,7 +105,7 @@ nlohmann::json ToJson(const ModelAdequacy& a) {
   for (const ChannelAboveNoise& c : a.above_noise) {
     above.push_back({{"recording", c.recording},
                      {"joint", c.joint},
-                     {"axis", c.axis == 0 ? "theta_x" : "theta_y"},
+                     {"axis", c.axis == 0 ? "x" : "y"},
                      {"rms_deg", c.rms_deg},
                      {"noise_deg", c.noise_deg},
                      {"effective_samples", c.effective_samples},

@@ -147,11 +147,7 @@ nlohmann::json ToJson(const PredictionSummary& s) {
   }
   nlohmann::json effects_files = nlohmann::json::array();
   for (const PredictionModel::Effects& e : s.model.effects) effects_files.push_back(e.file);
-  // The adequacy's channels as pred.json has always listed them (axis "x"
-  // or "y"), beside the verdict.
-  nlohmann::json adequacy = ToJson(s.adequacy);
-  nlohmann::json above = adequacy["above_noise"];
-  for (nlohmann::json& c : above) c["axis"] = c["axis"] == "theta_x" ? "x" : "y";
+  const nlohmann::json adequacy = ToJson(s.adequacy);
   return {{"schema", "ccsrm-prediction/1"},
           {"model",
            {{"source", s.model.source},
@@ -172,7 +168,7 @@ nlohmann::json ToJson(const PredictionSummary& s) {
           {"significance", s.adequacy.significance},
           {"channels", s.adequacy.channels},
           {"worst_ratio", adequacy["worst_ratio"]},
-          {"above_noise", above},
+          {"above_noise", adequacy["above_noise"]},
           {"threads", s.threads},
           {"simulations", s.simulations},
           {"wall_time_s", Number(s.wall_time_s)},

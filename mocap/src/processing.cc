@@ -390,44 +390,6 @@ void ReadRawMarkers(const MarkerTable& table, const MarkerLayout& layout,
   }
 }
 
-// The rigid bodies describe the markers recorded: on each body the distance
-// between two markers, as seen (median over the frames both are), is the
-// layout's within 10 mm or a fifth of it, whichever is more. Markers on a
-// rigid body keep their distances within the noise (a fraction of a mm), and
-// a layout placed by hand is off by millimetres (which a static trial
-// refines); more is another arm, another marker set or another unit, and
-// fitting it anyway gives angles of nothing (a fit RMS of 100 mm).
-void CheckLayoutFitsMarkers(const MarkerLayout& layout, const PipelineMarkers& m,
-                            const std::string& source, const std::string& field) {
-  std::vector<double> seen;
-  for (std::size_t b = 0; b < m.B; ++b) {
-    const RigidBody& body = layout.bodies[b];
-    for (std::size_t i = 0; i < body.marker_names.size(); ++i) {
-      for (std::size_t j = i + 1; j < body.marker_names.size(); ++j) {
-        const std::size_t ki = m.offset[b] + i, kj = m.offset[b] + j;
-        seen.clear();
-        for (std::size_t f = 0; f < m.F; ++f) {
-          if (m.raw.finite(f, ki) && m.raw.finite(f, kj)) {
-            seen.push_back((m.raw.get(f, ki) - m.raw.get(f, kj)).norm());
-          }
-        }
-        if (seen.empty()) continue;
-        std::nth_element(seen.begin(), seen.begin() + seen.size() / 2, seen.end());
-        const double measured = seen[seen.size() / 2];
-        const double planned = (body.p_BM[i] - body.p_BM[j]).norm();
-        if (std::abs(measured - planned) <= std::max(0.01, 0.2 * planned)) continue;
-        ThrowInputError(source, field,
-                        "markers '" + body.marker_names[i] + "' and '" + body.marker_names[j] +
-                            "' of " + body.name + " are " + Mm(measured) + " mm apart (median of " +
-                            std::to_string(seen.size()) + " frames), the rigid bodies put them " +
-                            Mm(planned) +
-                            " mm apart: the recording is not of this arm's marker set (another "
-                            "--config or --rigid-bodies, or another unit)");
-      }
-    }
-  }
-}
-
 // Gaps filled by splines (never across a whole-body loss), then from the
 // body's other markers (rigid fill), and each marker's gaps after.
 void FillGaps(const MarkerLayout& layout, const ProcessingOptions& options, PipelineMarkers* m,
@@ -770,14 +732,15 @@ ProcessingResult ProcessMarkers(const MarkerTable& table, const std::vector<doub
   m.L = num_links;
 
   ReadRawMarkers(table, layout, column, names, &m, &summary);
-  CheckLayoutFitsMarkers(layout, m, source, MarkerField(table));
   FillGaps(layout, options, &m, &summary);
   AlignToGround(layout, &m, &summary);
   const BodyPoses X_WB = FitBodies(layout, options, chain, source, m, &summary);
   const LinkRotations R_WB = StoreLinkPoses(layout, X_WB, m, &result);
-  // A body the fit cannot place within 10 mm RMS: the same bounds as
-  // CheckLayoutFitsMarkers, for what only the joint-constrained fit sees
-  // (links of another length between the same marker clusters).
+  // The rigid bodies must describe the markers recorded. Markers on a rigid
+  // body fit it within the noise (a fraction of a mm), and a layout placed
+  // by hand is off by millimetres (which a static trial refines); a body
+  // fitted worse than 10 mm RMS is another arm, another marker set or
+  // another unit, and its angles would be of nothing.
   const BodyQuality* worst = nullptr;
   std::size_t beyond = 0;
   for (const BodyQuality& q : summary.bodies) {
