@@ -67,7 +67,7 @@ ModelAdequacy AssessModelAdequacy(const std::vector<const Experiment*>& recordin
         for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
           const double m = x.measured_rad(f, 2 * j + a);
           if (!std::isfinite(m)) continue;
-          const double w = (sim(f, 2 * j + a) - m) * kDeg / x.noise_deg[jj];
+          const double w = (sim(f, 2 * j + a) - m) * kDeg / x.NoiseDeg(f, 2 * j + a);
           weighted.push_back(w);
           sum += w * w;
         }

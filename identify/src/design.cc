@@ -51,6 +51,7 @@ Experiment AsExperiment(const PlannedExperiment& planned, const DesignOptions& o
     e.low_pass = Experiment::LowPass{options.low_pass_hz, options.low_pass_order,
                                      options.low_pass_min_run_frames, options.frame_rate_hz};
   }
+  SetRelativeNoise(&e);
   return e;
 }
 

@@ -237,7 +237,10 @@ Series ChannelSeries(const Experiment& x, const Eigen::MatrixXd& sim, int j, int
       heading += hk;
     }
     s.time.push_back(x.sample_time_s[f]);
-    s.residual_deg.push_back((m - v) * kDeg);
+    // Simulated - measured, over the frame's relative noise: a recording's
+    // ends, where the low-pass leaves more noise, weigh what they know.
+    s.residual_deg.push_back((v - m) * kDeg * x.noise_deg[static_cast<std::size_t>(j)] /
+                             x.NoiseDeg(static_cast<Eigen::Index>(f), col));
     s.angle_deg.push_back(v * kDeg);
     s.heading_deg.push_back(ok ? heading * kDeg : v * kDeg);
     s.input_rate.push_back(context.input_rate[f]);

@@ -23,22 +23,40 @@ double Median(std::vector<double> v) {
   return v[mid];
 }
 
-// Per joint: RMS about the median of the measured twist [deg]; NaN when a
-// joint has fewer than 10 finite frames.
+// The noise profile of the experiment's recorded low-pass, if it has one.
+std::optional<mocap::ZeroLagNoiseGain> LowPassNoiseGain(const Experiment& e) {
+  if (!e.low_pass) return std::nullopt;
+  const Experiment::LowPass& f = *e.low_pass;
+  return mocap::ZeroLagNoiseGain(mocap::DesignButterworthLowPass(f.order, f.cutoff_hz, f.rate_hz),
+                                 f.cutoff_hz, f.rate_hz,
+                                 static_cast<std::size_t>(f.min_run_frames));
+}
+
+// Per joint: RMS about the median of the measured twist [deg], each frame's
+// deviation over the low-pass's relative noise there (the twist was filtered
+// like the angles), so that it is the interior's noise; NaN when a joint has
+// fewer than 10 finite frames.
 std::vector<double> TwistScatterDeg(const datasets::Array& twist, std::size_t first_frame,
-                                    int joints) {
+                                    int joints, mocap::ZeroLagNoiseGain* gain) {
   std::vector<double> out(static_cast<std::size_t>(joints),
                           std::numeric_limits<double>::quiet_NaN());
+  const std::size_t frames = twist.rows() - std::min(first_frame, twist.rows());
   for (int j = 0; j < joints; ++j) {
-    std::vector<double> values;
-    for (std::size_t f = first_frame; f < twist.rows(); ++f) {
-      const double v = twist.at(f, static_cast<std::size_t>(j));
-      if (std::isfinite(v)) values.push_back(v);
+    const double* column = twist.values.data() + first_frame * twist.shape[1] + j;
+    const std::vector<double> relative =
+        gain ? gain->Relative(column, frames, twist.shape[1]) : std::vector<double>(frames, 1.0);
+    std::vector<double> values, scale;
+    for (std::size_t f = 0; f < frames; ++f) {
+      const double v = column[f * twist.shape[1]];
+      if (std::isfinite(v)) values.push_back(v), scale.push_back(relative[f]);
     }
     if (values.size() < 10) continue;
     const double median = Median(values);
     double sum = 0.0;
-    for (double v : values) sum += (v - median) * (v - median);
+    for (std::size_t k = 0; k < values.size(); ++k) {
+      const double d = (values[k] - median) / scale[k];
+      sum += d * d;
+    }
     out[static_cast<std::size_t>(j)] = std::sqrt(sum / static_cast<double>(values.size())) * kDeg;
   }
   return out;
@@ -172,7 +190,7 @@ void SetRecordedLowPass(const datasets::ExperimentFile& file, const std::string&
 // The noise of each joint: given, else from the twist scatter from frame
 // `first` on, else the floor.
 void SetNoise(const datasets::ExperimentFile& file, std::size_t first,
-              const ExperimentLoadOptions& options, Experiment* e) {
+              const ExperimentLoadOptions& options, mocap::ZeroLagNoiseGain* gain, Experiment* e) {
   const std::size_t joints = static_cast<std::size_t>(e->joints);
   e->noise_deg.assign(joints, kMocapNoiseFloorDeg);
   if (options.noise_deg) {
@@ -181,7 +199,7 @@ void SetNoise(const datasets::ExperimentFile& file, std::size_t first,
   } else if (file.measured_joint_twist && file.measured_joint_twist->rank() == 2 &&
              file.measured_joint_twist->shape[1] == joints) {
     const std::vector<double> scatter =
-        TwistScatterDeg(*file.measured_joint_twist, first, e->joints);
+        TwistScatterDeg(*file.measured_joint_twist, first, e->joints, gain);
     bool any = false;
     for (std::size_t j = 0; j < joints; ++j) {
       if (std::isfinite(scatter[j])) {
@@ -243,7 +261,9 @@ Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::s
     e.pipeline_report = processed->result.summary.BriefReport();
   }
   SetRecordedLowPass(file, path, &e);
-  SetNoise(file, first, options, &e);
+  SetRelativeNoise(&e);
+  std::optional<mocap::ZeroLagNoiseGain> gain = LowPassNoiseGain(e);
+  SetNoise(file, first, options, gain ? &*gain : nullptr, &e);
   return e;
 }
 
@@ -262,6 +282,18 @@ void Experiment::AsMeasured(Eigen::MatrixXd* angles_rad) const {
     mocap::ZeroLagLowPass(sections, low_pass->cutoff_hz, low_pass->rate_hz,
                           angles_rad->col(c).data(), static_cast<std::size_t>(angles_rad->rows()),
                           1, static_cast<std::size_t>(low_pass->min_run_frames));
+  }
+}
+
+void SetRelativeNoise(Experiment* e) {
+  const Eigen::MatrixXd& measured = e->measured_rad;
+  e->relative_noise = Eigen::MatrixXd::Ones(measured.rows(), measured.cols());
+  std::optional<mocap::ZeroLagNoiseGain> gain = LowPassNoiseGain(*e);
+  if (!gain) return;
+  for (Eigen::Index c = 0; c < measured.cols(); ++c) {
+    const std::vector<double> relative =
+        gain->Relative(measured.col(c).data(), static_cast<std::size_t>(measured.rows()));
+    e->relative_noise.col(c) = Eigen::Map<const Eigen::VectorXd>(relative.data(), measured.rows());
   }
 }
 

@@ -288,7 +288,8 @@ class FitProblem {
     return *plan;
   }
 
-  // (simulated - measured) / noise at every residual index.
+  // (simulated - measured) / noise at every residual index (the frame's own
+  // noise: Experiment::NoiseDeg).
   Eigen::VectorXd Residuals(const std::vector<Eigen::MatrixXd>& angles_rad) const {
     Eigen::VectorXd r(static_cast<Eigen::Index>(index_.size()));
     for (std::size_t k = 0; k < index_.size(); ++k) {
@@ -296,8 +297,7 @@ class FitProblem {
       const Experiment& x = experiments_[at.experiment];
       const double sim = angles_rad[at.experiment](at.frame, at.column);
       const double meas = x.measured_rad(at.frame, at.column);
-      r[static_cast<Eigen::Index>(k)] =
-          (sim - meas) * kDeg / x.noise_deg[static_cast<std::size_t>(at.column / 2)];
+      r[static_cast<Eigen::Index>(k)] = (sim - meas) * kDeg / x.NoiseDeg(at.frame, at.column);
     }
     return r;
   }

@@ -53,8 +53,7 @@ Eigen::VectorXd Weighted(const std::vector<Experiment>& experiments,
       for (Eigen::Index c = 0; c < x.measured_rad.cols(); ++c) {
         if (!std::isfinite(x.measured_rad(f, c))) continue;
         const double reference = difference_only ? (*base[e])(f, c) : x.measured_rad(f, c);
-        double v =
-            ((*angles[e])(f, c) - reference) * kDeg / x.noise_deg[static_cast<std::size_t>(c / 2)];
+        double v = ((*angles[e])(f, c) - reference) * kDeg / x.NoiseDeg(f, c);
         if (!std::isfinite(v)) v = 0.0;
         out.push_back(v);
       }

@@ -148,7 +148,7 @@ PredictionErrors ComputePredictionErrors(const std::vector<const Experiment*>& r
           } else if (std::isfinite(largest)) {
             largest = std::max(largest, std::abs(d));
           }
-          const double r = d / x.noise_deg[jj];  // identification's residual
+          const double r = d / x.NoiseDeg(f, 2 * j + a);  // identification's residual
           weighted_sq += r * r;
           ++samples;
         }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
 
@@ -192,6 +193,104 @@ void ZeroLagLowPass(const std::vector<BiquadSection>& sections, double cutoff_hz
     for (std::size_t j = i; j < end; ++j) x[j * stride] = run[j - i];
     i = end;
   }
+}
+
+ZeroLagNoiseGain::ZeroLagNoiseGain(std::vector<BiquadSection> sections, double cutoff_hz,
+                                   double sample_rate_hz, std::size_t min_run)
+    : sections_(std::move(sections)),
+      cutoff_hz_(cutoff_hz),
+      sample_rate_hz_(sample_rate_hz),
+      min_run_(std::max<std::size_t>(min_run, 2)) {
+  // The kernel from an impulse in the middle of a run long enough that
+  // neither end's padding nor pivot reaches it; kept to two paddings each
+  // side, where an IIR tail past the padding's three cutoff periods is long
+  // gone (the padding itself assumes as much).
+  const std::size_t pad = FiltFiltPadding(cutoff_hz, sample_rate_hz, SIZE_MAX);
+  reach_ = 2 * pad;
+  const std::size_t n = 2 * reach_ + 1;
+  std::vector<double> y(n, 0.0);
+  y[reach_] = 1.0;
+  FiltFilt(sections_, y.data(), n, FiltFiltPadding(cutoff_hz, sample_rate_hz, n),
+           FiltFiltEndWindow(cutoff_hz, sample_rate_hz, n));
+  kernel_sq_prefix_.assign(n + 1, 0.0);
+  for (std::size_t t = 0; t < n; ++t) kernel_sq_prefix_[t + 1] = kernel_sq_prefix_[t] + y[t] * y[t];
+  interior_gain_ = std::sqrt(kernel_sq_prefix_.back());
+  // Columns an end touches: the padding's reflection and the pivot's line.
+  const std::size_t edge = std::max(pad, FiltFiltEndWindow(cutoff_hz, sample_rate_hz, SIZE_MAX));
+  // Rows past edge + reach_ see neither end: a long run's ends are those of
+  // a run of 2 splice_.
+  splice_ = edge + 1 + reach_ + 1;
+}
+
+std::vector<double> ZeroLagNoiseGain::ExactRunGain(std::size_t n) const {
+  const std::size_t pad = FiltFiltPadding(cutoff_hz_, sample_rate_hz_, n);
+  const std::size_t window = FiltFiltEndWindow(cutoff_hz_, sample_rate_hz_, n);
+  const std::size_t edge = std::max(pad, window - 1);  // last column the left end touches
+  std::vector<double> sq(n, 0.0), y(n);
+  const auto add_column = [&](std::size_t k) {
+    std::fill(y.begin(), y.end(), 0.0);
+    y[k] = 1.0;
+    FiltFilt(sections_, y.data(), n, pad, window);
+    for (std::size_t i = 0; i < n; ++i) sq[i] += y[i] * y[i];
+  };
+  if (n <= 2 * (edge + 1)) {  // every column touches an end
+    for (std::size_t k = 0; k < n; ++k) add_column(k);
+  } else {
+    for (std::size_t k = 0; k <= edge; ++k) add_column(k);
+    for (std::size_t k = n - 1 - edge; k < n; ++k) add_column(k);
+    // Every other column k is the shifted kernel: row i gets Σ h(i - k)² over
+    // k in [edge + 1, n - 2 - edge], from the prefix sums (d = i - k).
+    const auto r = static_cast<std::ptrdiff_t>(reach_);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto ii = static_cast<std::ptrdiff_t>(i);
+      const std::ptrdiff_t lo = std::max(ii - static_cast<std::ptrdiff_t>(n - 2 - edge), -r);
+      const std::ptrdiff_t hi = std::min(ii - static_cast<std::ptrdiff_t>(edge + 1), r);
+      if (lo <= hi) {
+        sq[i] += kernel_sq_prefix_[static_cast<std::size_t>(hi + r + 1)] -
+                 kernel_sq_prefix_[static_cast<std::size_t>(lo + r)];
+      }
+    }
+  }
+  for (double& v : sq) v = std::sqrt(v);
+  return sq;
+}
+
+const std::vector<double>& ZeroLagNoiseGain::RunGain(std::size_t n) {
+  if (const auto it = by_length_.find(n); it != by_length_.end()) return it->second;
+  std::vector<double> gain;
+  if (n <= 2 * splice_) {
+    gain = ExactRunGain(n);
+  } else {
+    // The ends of a run of 2 splice_, the interior's gain between them.
+    const std::vector<double>& ends = RunGain(2 * splice_);
+    gain.assign(n, interior_gain_);
+    for (std::size_t t = 0; t < splice_; ++t) {
+      gain[t] = ends[t];
+      gain[n - 1 - t] = ends[2 * splice_ - 1 - t];
+    }
+  }
+  return by_length_.emplace(n, std::move(gain)).first->second;
+}
+
+std::vector<double> ZeroLagNoiseGain::Relative(const double* x, std::size_t n, std::size_t stride) {
+  std::vector<double> out(n, std::numeric_limits<double>::quiet_NaN());
+  std::size_t i = 0;
+  while (i < n) {
+    if (!std::isfinite(x[i * stride])) {
+      ++i;
+      continue;
+    }
+    std::size_t end = i;
+    while (end < n && std::isfinite(x[end * stride])) ++end;
+    if (end - i < min_run_) {
+      for (std::size_t j = i; j < end; ++j) out[j] = 1.0 / interior_gain_;
+    } else {
+      const std::vector<double>& gain = RunGain(end - i);
+      for (std::size_t j = i; j < end; ++j) out[j] = gain[j - i] / interior_gain_;
+    }
+    i = end;
+  }
+  return out;
 }
 
 std::vector<Gap> FindGaps(const double* x, std::size_t n, std::size_t stride) {

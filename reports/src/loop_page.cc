@@ -789,7 +789,7 @@ Section RoundSection(const LoopRound& round) {
   section.blocks.push_back(EstimateTable("round_" + k + "_estimates", round));
   section.blocks.push_back(CrossCorrelationBlock(
       "cross_correlation_round_" + k, round.evidence, "Residual against the signals, round " + k,
-      "Cross-correlation of the residual of the round's starting model (measured − simulated) "
+      "Cross-correlation of the residual of the round's starting model (simulated − measured) "
       "with each signal of the simulated motion, pooled over every joint and axis, against the "
       "shift of the signal (loop.json 'cross_correlation' at 'lags_s'). Dashed: the 95 % band "
       "of no relation at lag 0; red: the signal's pooled correlation lies outside it."));
@@ -880,7 +880,7 @@ Table ChannelTable(const LoopDiagnostics& d) {
   table.id = "final_channels";
   table.title = "Final residual per joint and axis";
   table.caption =
-      "loop.json 'final_evidence.channels' (residual measured − simulated of the final model): "
+      "loop.json 'final_evidence.channels' (residual simulated − measured of the final model): "
       "RMS, mean and the experiment's noise; the share of autocorrelation lags outside the "
       "white-noise band (about 0.05 for white noise) and the autocorrelation time [frames]; the "
       "mean slope during holds and the loop area against the angle.";

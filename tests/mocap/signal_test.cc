@@ -7,6 +7,7 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <random>
 #include <vector>
 
 namespace ccsrm::mocap {
@@ -113,6 +114,76 @@ TEST(ZeroLagLowPass, ConstantsPassUnchangedAndRampsAlmostUpToTheEnds) {
   std::vector<double> constant(n, -0.25);
   ZeroLagLowPass(DesignButterworthLowPass(3, 1.5, kRate), 1.5, kRate, constant.data(), n);
   for (std::size_t i = 0; i < n; ++i) EXPECT_NEAR(constant[i], -0.25, 1e-15) << i;
+}
+
+// The profile is the filter's own: the scatter of many filtered white-noise
+// signals at each sample, over the interior's.
+TEST(ZeroLagNoiseGain, MatchesTheScatterOfFilteredWhiteNoise) {
+  const std::size_t n = 400;
+  const double cutoff = 4.0;
+  const auto sections = DesignButterworthLowPass(2, cutoff, kRate);
+  ZeroLagNoiseGain gain(sections, cutoff, kRate);
+  std::vector<double> ones(n, 0.0);
+  const std::vector<double> relative = gain.Relative(ones.data(), n);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  const int draws = 4000;
+  std::vector<double> sq(n, 0.0);
+  for (int d = 0; d < draws; ++d) {
+    std::vector<double> x(n);
+    for (double& v : x) v = noise(rng);
+    ZeroLagLowPass(sections, cutoff, kRate, x.data(), n);
+    for (std::size_t i = 0; i < n; ++i) sq[i] += x[i] * x[i];
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const double scatter = std::sqrt(sq[i] / draws) / gain.interior_gain();
+    // A standard deviation from 4000 draws is within 1.1 % (one sigma) of
+    // the truth: 5 % is four and a half sigma.
+    EXPECT_NEAR(scatter / relative[i], 1.0, 0.05) << i;
+  }
+  // The middle is the interior; the last sample sits on the pivot, a line's
+  // end over half a cutoff period (13 samples): 2 / sqrt(13) against the
+  // interior's gain, well above it.
+  EXPECT_NEAR(relative[n / 2], 1.0, 1e-9);
+  EXPECT_GT(relative[n - 1], 1.5);
+  EXPECT_GT(relative[0], 1.5);
+}
+
+// A long run's profile is spliced from a shorter run's ends: it must equal
+// the operator's own row norms, one impulse per column.
+TEST(ZeroLagNoiseGain, LongRunsEqualTheOperatorsRowNorms) {
+  const double cutoff = 10.0;
+  const auto sections = DesignButterworthLowPass(4, cutoff, kRate);
+  ZeroLagNoiseGain gain(sections, cutoff, kRate);
+  for (const std::size_t n : {std::size_t{40}, std::size_t{150}, std::size_t{700}}) {
+    std::vector<double> sq(n, 0.0);
+    for (std::size_t k = 0; k < n; ++k) {
+      std::vector<double> y(n, 0.0);
+      y[k] = 1.0;
+      ZeroLagLowPass(sections, cutoff, kRate, y.data(), n);
+      for (std::size_t i = 0; i < n; ++i) sq[i] += y[i] * y[i];
+    }
+    std::vector<double> zeros(n, 0.0);
+    const std::vector<double> relative = gain.Relative(zeros.data(), n);
+    for (std::size_t i = 0; i < n; ++i) {
+      EXPECT_NEAR(relative[i] * gain.interior_gain(), std::sqrt(sq[i]), 1e-9) << n << " " << i;
+    }
+  }
+}
+
+TEST(ZeroLagNoiseGain, GapsStayNaNAndShortRunsKeepTheirRawNoise) {
+  const double cutoff = 5.0;
+  ZeroLagNoiseGain gain(DesignButterworthLowPass(2, cutoff, kRate), cutoff, kRate, 10);
+  std::vector<double> x(300, 0.0);
+  for (std::size_t i = 100; i < 110; ++i) x[i] = kNaN;
+  for (std::size_t i = 115; i < 300; ++i) x[i] = kNaN;
+  const std::vector<double> relative = gain.Relative(x.data(), x.size());
+  EXPECT_TRUE(std::isnan(relative[105]));
+  EXPECT_TRUE(std::isnan(relative[200]));
+  // Frames 110..114: five, below the minimum run of 10, left unfiltered.
+  EXPECT_DOUBLE_EQ(relative[112], 1.0 / gain.interior_gain());
+  EXPECT_GT(1.0 / gain.interior_gain(), 3.0);  // a 5 Hz low-pass at 100 Hz removes most noise
+  EXPECT_TRUE(std::isfinite(relative[50]));
 }
 
 TEST(ZeroLagLowPass, FiltersEachFiniteRunAndKeepsNaN) {

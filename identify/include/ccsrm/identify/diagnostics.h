@@ -4,8 +4,11 @@
 // (loop.h) reports them as the evidence beside each candidate effect; its
 // decisions rest on scores and refits, not on these.
 //
-// The residual is measured - simulated [deg] (what the model misses), at
-// every measured frame. Its signals are taken from the simulated motion:
+// The residual is simulated - measured [deg] (SPEC 5's sign, as in every
+// fit, page and CSV), at every measured frame, each frame over its relative
+// noise (Experiment::NoiseDeg): at a recording's ends the zero-lag low-pass
+// leaves up to twice the interior's noise, which is not physics. Its signals
+// are taken from the simulated motion:
 //   rate_sign   sign of the joint rate (0 while the joint is still)
 //   rate        joint rate
 //   angle       joint angle

@@ -65,8 +65,15 @@ struct Experiment {
   // Measured angles [rad], row per frame, column 2 j + a (joint j 0-based,
   // axis a: 0 θx, 1 θy); NaN where not measured.
   Eigen::MatrixXd measured_rad;
-  std::vector<double> noise_deg;  // per joint
-  std::string noise_source;       // "given", "joint twist scatter" or "default floor ..."
+  std::vector<double> noise_deg;  // per joint, far from a recording's ends and gaps
+  // The noise of each measured angle over its joint's noise_deg, laid out as
+  // measured_rad: 1 without a recorded low-pass; with one, the filter's own
+  // white-noise gain at the frame over its interior gain
+  // (mocap::ZeroLagNoiseGain), up to about 2 at a run's ends, where the
+  // zero-lag low-pass sits on a pivot of fewer samples. NaN where nothing
+  // was measured. Empty (an experiment built in code): 1 everywhere.
+  Eigen::MatrixXd relative_noise;
+  std::string noise_source;  // "given", "joint twist scatter" or "default floor ..."
   // True when the file had no /measured/joint_angles and the mocap pipeline
   // computed them at load, with default settings.
   bool angles_from_pipeline = false;
@@ -92,6 +99,13 @@ struct Experiment {
   // would trade damping for that difference.
   void AsMeasured(Eigen::MatrixXd* angles_rad) const;
 
+  // The noise [deg] of measured_rad(frame, column): what a residual there is
+  // weighed by, so that a recording's ends count for what they know.
+  double NoiseDeg(Eigen::Index frame, Eigen::Index column) const {
+    const double joint = noise_deg[static_cast<std::size_t>(column / 2)];
+    return relative_noise.size() == 0 ? joint : joint * relative_noise(frame, column);
+  }
+
   // Simulated time [s] of a run sampled on the solver's output grid rather
   // than at sample times (FrameExperiment: `ccsrm derivatives` under MPI,
   // sample_time_s empty); 0 for a recording, whose runs end at its last frame.
@@ -115,6 +129,11 @@ struct Experiment {
 // first input sample, or no finite measured angle after it.
 Experiment MakeExperiment(const datasets::ExperimentFile& file, const std::string& path,
                           const ExperimentLoadOptions& options);
+
+// Fills e->relative_noise from e->low_pass and the gaps of e->measured_rad.
+// MakeExperiment does; an experiment built in code with a low-pass calls it
+// after setting both.
+void SetRelativeNoise(Experiment* e);
 
 // Reads `path` (ccsrm-dataset/1) and builds the experiment from it.
 Experiment LoadExperiment(const std::string& path, const ExperimentLoadOptions& options);

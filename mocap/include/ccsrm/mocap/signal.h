@@ -4,6 +4,7 @@
 // sampled at a uniform rate unless a time vector is given; NaN marks a sample
 // that was not seen.
 #include <cstddef>
+#include <map>
 #include <vector>
 
 #include "ccsrm/datasets/array.h"
@@ -53,6 +54,47 @@ void FiltFilt(const std::vector<BiquadSection>& sections, double* x, std::size_t
 void ZeroLagLowPass(const std::vector<BiquadSection>& sections, double cutoff_hz,
                     double sample_rate_hz, double* x, std::size_t n, std::size_t stride = 1,
                     std::size_t min_run = 2);
+
+// How much white noise ZeroLagLowPass leaves at each sample, relative to
+// what it leaves far from any end. FiltFilt is one linear operator A on a run
+// of n finite samples, and independent noise of equal variance σ² leaves
+// σ² Σ_k A_ik² at sample i. Inside a run that is the interior gain g² = Σ h²
+// of the forward-backward kernel h; near an end the pivot (a line's end over
+// FiltFiltEndWindow samples) and the one-sided support leave up to about
+// twice the interior's noise (docs/model-notes.md, "Recording edges"). A
+// comparison that weighs every frame alike takes those ends for structure;
+// dividing a residual by this profile gives every frame the interior's noise.
+// Profiles are computed exactly (one impulse per column of A that the ends
+// touch) and kept per run length.
+class ZeroLagNoiseGain {
+ public:
+  ZeroLagNoiseGain(std::vector<BiquadSection> sections, double cutoff_hz, double sample_rate_hz,
+                   std::size_t min_run = 2);
+
+  // Per sample of x[0], x[stride], ... x[(n-1)·stride]: the noise the
+  // low-pass leaves there over the interior's; NaN where x is NaN. A run
+  // shorter than min_run, which ZeroLagLowPass leaves unfiltered, keeps its
+  // raw noise: 1 / interior_gain().
+  std::vector<double> Relative(const double* x, std::size_t n, std::size_t stride = 1);
+
+  // sqrt(Σ h²): the standard deviation the low-pass leaves of unit white noise.
+  double interior_gain() const { return interior_gain_; }
+
+ private:
+  // sqrt(Σ_k A_ik²) at every sample i of a run of n samples.
+  const std::vector<double>& RunGain(std::size_t n);
+  std::vector<double> ExactRunGain(std::size_t n) const;
+
+  std::vector<BiquadSection> sections_;
+  double cutoff_hz_ = 0.0;
+  double sample_rate_hz_ = 0.0;
+  std::size_t min_run_ = 2;
+  std::size_t reach_ = 0;                 // kernel half-width kept: two paddings
+  std::vector<double> kernel_sq_prefix_;  // Σ h(d)² for d < t - reach_, t = 0..2 reach_ + 1
+  double interior_gain_ = 1.0;
+  std::size_t splice_ = 0;  // runs longer than 2 splice_ share their end profiles
+  std::map<std::size_t, std::vector<double>> by_length_;  // run length → gain
+};
 
 // A run of consecutive NaN samples.
 struct Gap {
