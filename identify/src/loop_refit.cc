@@ -11,6 +11,23 @@ namespace ccsrm::identify::internal {
 
 namespace {
 
+// The refit's gain in plain words: the residual's RMS over the noise before
+// and after, and the share of its excess over the noise removed (all of it
+// when the refit ends at or below the noise; a share above 100 % says only
+// that).
+std::string ExcessWords(double ms_before, double ms_after) {
+  const std::string from = Format("%.2f", std::sqrt(ms_before)) + "x";
+  const std::string to = Format("%.2f", std::sqrt(ms_after)) + "x the noise";
+  if (!(ms_before > 1.0)) return "the residual was at the noise already (" + from + ")";
+  if (ms_after <= 1.0) {
+    return "it brings the residual from " + from + " to " + to +
+           ": all of its excess over the noise";
+  }
+  return "it brings the residual from " + from + " to " + to + " (" +
+         Format("%.0f", 100.0 * (ms_before - ms_after) / (ms_before - 1.0)) +
+         " % of its excess over the noise)";
+}
+
 // Refits `cand` with the declared free parameters and its size parameters
 // free; discovered terms the refit cannot size are dropped and the rest
 // refitted.
@@ -173,8 +190,7 @@ void RefitAndJudge(LoopState* s, RoundState* rs, CandidateResult* target) {
   }
   why += cand.size_significant ? "; its size is distinguishable from 0"
                                : "; its size is indistinguishable from 0";
-  why += "; it removes " + Format("%.0f", 100.0 * cand.excess_share) +
-         " % of the residual's excess over the noise";
+  why += "; " + ExcessWords(ms_before, cand.mean_square_after);
   if (cand.partial) {
     why += ", below " + Format("%.0f", 100.0 * options.min_excess_share) +
            " %, while the residual stays at " + Format("%.1f", std::sqrt(cand.mean_square_after)) +

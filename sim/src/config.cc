@@ -322,6 +322,21 @@ void CheckArm(const ArmConfig& arm, const Checker& check) {
     check.Positive(p + "link_mass_kg", s.link_mass_kg);
     for (int k = 0; k < 3; ++k) check.Positive(p + "link_inertia_kgm2", s.link_inertia_kgm2[k]);
     check.Positive(p + "hole_circle_radius_m", s.hole_circle_radius_m);
+    // The holes lie on the link's disks, and no arm of this kind carries
+    // disks wider than its links are long (they hold their holes at 0.1-0.5
+    // of a link length): a hole circle beyond the link length is a unit slip,
+    // and disks that wide would leave every joint its cables pass almost no
+    // range (2 atan(d / 2R), model.h), which a run then blames on the motion.
+    if (s.hole_circle_radius_m > s.link_length_m) {
+      std::ostringstream what;
+      what << std::setprecision(3) << s.hole_circle_radius_m << " m is beyond the link length "
+           << s.link_length_m << " m: the holes would lie outside the link's disks (arms of this "
+           << "kind have 0.1-0.5 of a link length, the paper's 0.16-0.25), and disks that wide "
+           << "leave the joints these cables pass ±"
+           << 2.0 * std::atan(arm.joint_disk_gap_m / (2.0 * s.hole_circle_radius_m)) * 180.0 / kPi
+           << " deg: check the units";
+      check.Fail(p + "hole_circle_radius_m", what.str());
+    }
     if (static_cast<int>(s.connecting_pattern.size()) != s.links - 1) {
       check.Fail(p + "connecting_pattern", "needs links - 1 = " + std::to_string(s.links - 1) +
                                                " entries, found " +
@@ -555,16 +570,14 @@ std::vector<std::string> ArmWarnings(const Config& c, const LineMap* lines) {
     const std::string p = "arm.segments[" + std::to_string(i) + "].";
     // Hole circle against link length: arms of this kind put their holes at
     // 0.1-0.5 of a link's length from the axis (the paper's 0.16 and 0.25).
-    // Beyond one length the disks are wider than the links are long; below a
-    // fiftieth the cables have almost no lever on the joints.
+    // Below a fiftieth the cables have almost no lever on the joints.
     const double ratio = s.hole_circle_radius_m / s.link_length_m;
-    if (ratio > 1.0 || ratio < 0.02) {
+    if (ratio < 0.02) {  // beyond 1 is refused (CheckArm)
       warn(p + "hole_circle_radius_m",
            "hole circle radius " + text(s.hole_circle_radius_m) + " m is " + text(ratio) +
-               " times the link length " + text(s.link_length_m) + " m: " +
-               (ratio > 1.0 ? "disks wider than the links are long"
-                            : "the cables would have almost no lever on the joints") +
-               "; arms of this kind have 0.1-0.5 (the paper's arm 0.16-0.25): check the units");
+               " times the link length " + text(s.link_length_m) +
+               " m: the cables would have almost no lever on the joints; arms of this kind "
+               "have 0.1-0.5 (the paper's arm 0.16-0.25): check the units");
     }
     // Mass against size: the mean density of the link's envelope, a
     // cylinder of its length out to twice the hole circle (the disks reach

@@ -138,9 +138,12 @@ class BadInputTable : public ::testing::Test {
     Write(d / "samehole.yaml", EditedThreeSegment("hole_angle_deg: 160.0", "hole_angle_deg: 40.0"));
     Write(d / "halfplane.yaml",
           EditedThreeSegment("hole_angle_deg: 280.0", "hole_angle_deg: 100.0"));
-    // Issue 44: segment 3's hole circle (0.16 m) sets joint 1's range.
+    // Issue 44: segment 3's hole circle beyond its 0.08 m links (0.16 m, mm
+    // read as m), and one within them (0.075 m) that sets joint 1's range.
     Write(d / "wide3.yaml",
           EditedThreeSegment("hole_circle_radius_m: 0.015", "hole_circle_radius_m: 0.16"));
+    Write(d / "wider3.yaml",
+          EditedThreeSegment("hole_circle_radius_m: 0.015", "hole_circle_radius_m: 0.075"));
     fs::create_directory(d / "confdir");
     Write(d / "p.yaml", "mu: 0.2\n");
     Write(d / "proto.yaml",
@@ -373,8 +376,12 @@ const std::vector<BadInput>& Rows() {
        "simulate --config {d}/halfplane.yaml --duration 0.1 --out {d}/run2.h5",
        {"{d}/halfplane.yaml", "segment 2", "half-plane"}},
       {"configs",
-       "simulate --config {d}/wide3.yaml --case 1 --out {d}/run2.h5",
-       {"{d}/wide3.yaml", "past its 5.725 deg",
+       "config check {d}/wide3.yaml",
+       {"{d}/wide3.yaml", "hole_circle_radius_m", "beyond the link length 0.08 m",
+        "check the units"}},  // issue 44
+      {"configs",
+       "simulate --config {d}/wider3.yaml --case 1 --amplitude 15 --out {d}/run2.h5",
+       {"--amplitude", "past its 12.18 deg",
         "the hole circle of segment 3, whose cables pass joint 1"}},  // issue 44
       // Command-line values and parameter files.
       {"overrides",

@@ -240,6 +240,12 @@ TEST(Config, PhysicalValuesOutsideAnyArmAreRefused) {
       {"input_offset_m: 0.05", "input_offset_m: 5e4", "key 'driving_cables.input_offset_m'"},
       {"youngs_modulus_pa: 2.6e10        # E_c", "youngs_modulus_pa: 1e3",
        "key 'connecting_cables.youngs_modulus_pa': must be in [1e+06, 2e+12] Pa, found 1000"},
+      // Issue 44: holes outside a link's disks (a hole circle beyond the
+      // link length), with the range such disks would leave: 2 atan(d / 2R)
+      // = 2 atan(0.016 / 1) = 1.83 deg.
+      {"hole_circle_radius_m: 0.016", "hole_circle_radius_m: 0.5",
+       "key 'arm.segments[1].hole_circle_radius_m': 0.5 m is beyond the link length 0.1 m: the "
+       "holes would lie outside the link's disks"},
   };
   for (const auto& c : cases) EXPECT_THAT(ErrorOf(Edited(c.from, c.to)), HasSubstr(c.message));
 }
@@ -326,9 +332,6 @@ TEST(Config, ValuesFarOutsideSuchArmsAreWarnedWithTheReason) {
   const struct {
     std::string from, to, warning;
   } cases[] = {
-      {"hole_circle_radius_m: 0.020", "hole_circle_radius_m: 0.5",
-       "key 'arm.segments[1].hole_circle_radius_m': hole circle radius 0.5 m is 5.88 times the "
-       "link length 0.085 m: disks wider than the links are long"},
       {"hole_circle_radius_m: 0.015", "hole_circle_radius_m: 0.0015",
        "key 'arm.segments[2].hole_circle_radius_m': hole circle radius 0.0015 m is 0.0187 times "
        "the link length 0.08 m: the cables would have almost no lever"},
