@@ -41,8 +41,7 @@ std::string ModelAdequacy::Verdict() const {
   const ChannelAboveNoise& w = *Worst();
   return Format(
       "the model does NOT explain the data: %zu of %zu joint axes stand above their noise "
-      "(worst: %s joint %d %s, %.4f deg RMS against %.4f deg of noise, %.2fx); its intervals "
-      "assume a right model; `ccsrm loop` looks for what it lacks",
+      "(worst: %s joint %d %s, %.4f deg RMS against %.4f deg of noise, %.2fx)",
       above_noise.size(), channels, w.recording.c_str(), w.joint, w.axis == 0 ? "θx" : "θy",
       w.rms_deg, w.noise_deg, Ratio(w));
 }

@@ -655,6 +655,15 @@ std::string DesignSummary::FullReport() const {
     }
     out += "\n";
   }
+  // A name the table cut is given whole below it: a plan is its name.
+  bool cut = false;
+  for (const std::size_t k : ranking) cut |= candidates[k].name.size() > 28;
+  if (cut) {
+    out += "  plans in full:\n";
+    for (std::size_t r = 0; r < ranking.size(); ++r) {
+      out += "  " + Format("%-4zu", r + 1) + " " + candidates[ranking[r]].name + "\n";
+    }
+  }
   if (!options.prior_box.empty()) {
     std::string box;
     for (const PriorRange& r : options.prior_box) {

@@ -80,7 +80,11 @@ std::array<double, 2> IdentificationSummary::MisfitInterval(const ParameterEstim
 std::string IdentificationSummary::FullReport() const {
   std::ostringstream out;
   // The answer first: whether the model explains the data at all.
-  out << "model: " << adequacy.Verdict() << "\n";
+  out << "model: " << adequacy.Verdict()
+      << (adequacy.assessed && !adequacy.adequate()
+              ? "; its intervals assume a right model; `ccsrm loop` looks for what it lacks"
+              : "")
+      << "\n";
   out << BriefReport() << "\n";
   out << "  termination: " << TerminationName(termination) << " (" << message << ")\n";
   out << "  residuals: " << residuals << " (effective " << Cell("%.0f", effective_samples)
@@ -117,6 +121,11 @@ std::string IdentificationSummary::FullReport() const {
     out << line;
   }
   if (!covariance_available) out << "  no covariance: " << covariance_message << "\n";
+  if (misfit) {
+    out << "  x misfit: the interval widened by the worst axis's RMS over its noise; it allows "
+           "for the misfit's size, not for a bias (an effect the model lacks can move an "
+           "estimate beyond both intervals)\n";
+  }
   out << "\n  singular values of the scaled Jacobian:";
   for (double s : singular_values) out << " " << Cell("%.3g", s);
   out << "\n";

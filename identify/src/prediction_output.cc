@@ -67,7 +67,9 @@ std::string PredictionSummary::BriefReport() const {
 
 std::string PredictionSummary::FullReport() const {
   std::ostringstream out;
-  out << adequacy.Verdict() << "\n";
+  out << adequacy.Verdict()
+      << (adequacy.assessed && !adequacy.adequate() ? "; `ccsrm loop` looks for what it lacks" : "")
+      << "\n";
   out << BriefReport() << "\n";
   out << "  model: " << model.source << " (" << model.kind << "), " << model.values.size()
       << " parameter values";

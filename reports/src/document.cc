@@ -1,5 +1,6 @@
 #include "ccsrm/reports/document.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -56,20 +57,38 @@ h3 { font-size: 16px; margin: 18px 0 6px; }
 p { margin: 6px 0 10px; max-width: 80em; }
 p.notice { background: #fff6db; border-left: 4px solid #e0a800; padding: 6px 10px; }
 .tables { display: flex; flex-wrap: wrap; gap: 8px 48px; align-items: flex-start; }
-.table-block { width: min-content; min-width: 360px; max-width: 100%; }
+.table-block { width: fit-content; min-width: 360px; max-width: 100%; }
+.table-block .caption { contain: inline-size; }
 .table-wrap { overflow-x: auto; margin: 6px 0 4px; }
 table { border-collapse: collapse; font-size: 13.5px; }
 th, td { padding: 3px 10px; border-bottom: 1px solid #e6e6ea; text-align: left; }
 td { white-space: nowrap; }
-th { background: #eef0f4; font-weight: 600; vertical-align: bottom; min-width: 4.5em; }
+th { background: #eef0f4; font-weight: 600; vertical-align: bottom; min-width: 3.5em; }
 td.num { text-align: right; font-variant-numeric: tabular-nums; }
-td.wrap { white-space: normal; min-width: 14em; max-width: 36em; }
+td.wrap { white-space: normal; overflow-wrap: break-word; min-width: 9em; max-width: 36em; }
 tbody tr:nth-child(even) { background: #fafafc; }
 .caption { color: #555; font-size: 13px; margin: 2px 0 14px; }
 figure { margin: 10px 0 18px; }
 figure img { max-width: 100%; height: auto; border: 1px solid #e6e6ea; }
 figcaption { color: #444; font-size: 13.5px; margin-top: 4px; max-width: 80em; }
 )";
+
+// Escaped text that may wrap inside the names it holds: a <wbr> after each
+// '/', '_', '@' and '=' and each '.' before a letter (a file path, plan or
+// parameter name; not a number's decimal point), so that a column of them
+// can be narrower than its longest name without cutting a word anywhere
+// else, and without characters a copied name would carry.
+std::string Breakable(const std::string& text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    out += Escape(std::string(1, c));
+    const bool letter_next =
+        i + 1 < text.size() && std::isalpha(static_cast<unsigned char>(text[i + 1]));
+    if (c == '/' || c == '_' || c == '@' || c == '=' || (c == '.' && letter_next)) out += "<wbr>";
+  }
+  return out;
+}
 
 void WriteTable(const Table& table, std::ostream& out) {
   out << "<div class=\"table-block\">\n<h3>" << Escape(table.title)
@@ -84,7 +103,9 @@ void WriteTable(const Table& table, std::ostream& out) {
       out << (number                  ? "<td class=\"num\">"
               : table.columns[i].wrap ? "<td class=\"wrap\">"
                                       : "<td>")
-          << Escape(FormatCell(row[i], table.columns[i])) << "</td>";
+          << (table.columns[i].wrap ? Breakable(FormatCell(row[i], table.columns[i]))
+                                    : Escape(FormatCell(row[i], table.columns[i])))
+          << "</td>";
     }
     out << "</tr>\n";
   }

@@ -124,7 +124,10 @@ Section SummarySection(const FitFolder& fit) {
         verdict + (fit.adequate ? "."
                                 : ". The estimates and intervals below are those of the "
                                   "model as declared; each parameter also gives its interval "
-                                  "widened by the misfit."),
+                                  "widened by the misfit, which allows for the misfit's size "
+                                  "but not for a bias: an effect the model lacks can move an "
+                                  "estimate beyond both. `ccsrm loop` looks for what the model "
+                                  "lacks: quote no value before it is found."),
         !fit.adequate});
   }
   Table table = FitTable(fit);

@@ -205,8 +205,10 @@ Paragraph AnswerParagraph(const LoopFolder& loop) {
     if (!verdict.empty()) {
       verdict[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(verdict[0])));
     }
-    text += " " + verdict + ".";
     misfit = !loop.final_model->adequate;
+    text +=
+        " " + verdict +
+        (misfit ? "; what the loop could not explain is under \"What remains unexplained\"." : ".");
   }
   return Paragraph{text, misfit};
 }

@@ -46,7 +46,9 @@ Section SummarySection(const PredictionFolder& p) {
   if (!p.verdict.empty()) {
     std::string verdict = p.verdict;
     verdict[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(verdict[0])));
-    section.blocks.push_back(Paragraph{verdict + ".", !p.above_noise.empty()});
+    section.blocks.push_back(Paragraph{
+        verdict + (p.above_noise.empty() ? "." : ". `ccsrm loop` looks for what it lacks."),
+        !p.above_noise.empty()});
   }
   std::vector<std::string> names;
   for (const PredictionRecording& r : p.recordings) names.push_back(r.name);
