@@ -206,6 +206,7 @@ CandidateInformation EvaluateCandidate(const DesignCandidate& candidate,
     // No iteration: the Jacobian at the start, second order, is all that
     // is wanted.
     fit.max_iterations = 0;
+    fit.check_derivative_steps = false;  // the Fisher information at the step the fits take
     fit.converged_step_fraction = 0.0;
     fit.min_effective_chi2_decrease = 0.0;
     const IdentificationSummary at_prior = Identify(experiments, fit);

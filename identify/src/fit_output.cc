@@ -77,6 +77,36 @@ std::array<double, 2> IdentificationSummary::MisfitInterval(const ParameterEstim
   return {p.value - scale * (p.value - p.ci95_lower), p.value + scale * (p.ci95_upper - p.value)};
 }
 
+namespace {
+
+// Whether the angles were smooth in each free parameter at the final point:
+// its derivatives at the fit's step and a third of it agree.
+std::string DerivativeCheckLine(const IdentificationSummary& s) {
+  std::string rough, largest;
+  double worst = -1.0;
+  for (const ParameterEstimate& p : s.parameters) {
+    const double d = p.derivative_step_disagreement;
+    if (!p.free || !std::isfinite(d)) continue;
+    if (d > kDerivativeStepLimit)
+      rough += (rough.empty() ? "" : ", ") + p.name + Format(" %.1f %%", 100.0 * d);
+    if (d > worst) worst = d, largest = p.name + Format(" %.2f %%", 100.0 * d);
+  }
+  const std::string steps =
+      Format("relative steps %g and %.3g", s.relative_step, s.relative_step / 3.0);
+  if (worst < 0.0) return "  derivative check: not made";
+  if (rough.empty()) {
+    return "  derivative check: the derivatives at " + steps +
+           " agree for every free parameter (largest difference: " + largest + ")";
+  }
+  return "  derivative check: NOT smooth: the derivatives at " + steps + " differ for " + rough +
+         Format(" (more than %.0f %%): ", 100.0 * kDerivativeStepLimit) +
+         "the angles jump with these parameters here (a breakaway that happens or not, a "
+         "stick-slip cycle that gains or loses a slip); their estimates and intervals are not "
+         "to be trusted from these data";
+}
+
+}  // namespace
+
 std::string IdentificationSummary::FullReport() const {
   std::ostringstream out;
   // The answer first: whether the model explains the data at all.
@@ -95,7 +125,8 @@ std::string IdentificationSummary::FullReport() const {
       << (central_differences_throughout
               ? ", second order (central, or one-sided inside the bounds) throughout\n\n"
               : ", first-order forward while descending, second order (central, or "
-                "one-sided inside the bounds) at the final point\n\n");
+                "one-sided inside the bounds) at the final point\n");
+  out << DerivativeCheckLine(*this) << "\n";
   // When the model misses, the intervals assume what is false; beside
   // them, the interval widened by the misfit.
   const bool misfit = adequacy.assessed && !adequacy.adequate();
@@ -181,6 +212,7 @@ nlohmann::json ToJson(const IdentificationSummary& s) {
         {"value", p.value}, {"units", p.units}, {"free", p.free}, {"start", p.start}};
     if (p.free) {
       entry["std_error"] = p.identifiable ? Number(p.std_error) : nullptr;
+      entry["derivative_step_disagreement"] = Number(p.derivative_step_disagreement);
       entry["ci95"] = p.identifiable ? nlohmann::json{Number(p.ci95_lower), Number(p.ci95_upper)}
                                      : nlohmann::json(nullptr);
       const std::array<double, 2> wide = s.MisfitInterval(p);

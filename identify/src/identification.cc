@@ -179,6 +179,42 @@ class FitProblem {
         return true;
       }
     }
+    std::vector<DifferenceRun> runs;
+    if (!DifferenceJacobian(u, second_order, options_.relative_step, jacobian, &runs, failure)) {
+      return false;
+    }
+    const std::lock_guard<std::mutex> lock(mutex_);
+    jacobian_u_.assign(u, u + free_.size());
+    jacobian_second_order_ = second_order;
+    jacobian_ = *jacobian;
+    trial_runs_ = std::move(runs);
+    return true;
+  }
+
+  // The second-order Jacobian at `relative_step` instead of the fit's, for
+  // the check that the angles are smooth in each parameter (nothing cached).
+  // A measurement parameter's column is NaN: it re-records one run, exact
+  // at any step, and its trials are the fit's.
+  bool JacobianAtStep(const double* u, double relative_step, Eigen::MatrixXd* jacobian,
+                      std::string* failure) {
+    std::vector<DifferenceRun> runs;
+    return DifferenceJacobian(u, true, relative_step, jacobian, &runs, failure);
+  }
+
+  // From now on every Jacobian is second order (the final point's).  // From now on every Jacobian
+  // is second order (the final point's).
+  void UseSecondOrder() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    second_order_ = true;
+  }
+
+  // Jacobian at u by finite differences of `relative_step` (second order or
+  // first-order forward), reusing the cached trial runs of the last
+  // Jacobian at the same point; the runs it used in *runs.
+  bool DifferenceJacobian(const double* u, bool second_order, double relative_step,
+                          Eigen::MatrixXd* jacobian, std::vector<DifferenceRun>* runs_used,
+                          std::string* failure) {
+    const bool fit_step = relative_step == options_.relative_step;
     const Evaluation base = Evaluate(u);
     if (!base.ok) {
       *failure = base.failure;
@@ -190,14 +226,14 @@ class FitProblem {
     std::vector<internal::DifferencePlan> plans;
     std::vector<std::vector<double>> trials(free_.size());
     for (std::size_t i = 0; i < free_.size(); ++i) {
-      plans.push_back(PlanFor(i, p[i]));
+      plans.push_back(PlanFor(i, p[i], relative_step));
       if (free_[i].measurement) continue;  // recorded with the base runs
       if (second_order) {
         trials[i].assign(plans[i].trial_values.begin(), plans[i].trial_values.end());
       } else {
         // The same expression as the central plan's p + h, so that the final
         // second-order Jacobian finds these runs again.
-        const double h = options_.relative_step * free_[i].scale;
+        const double h = relative_step * free_[i].scale;
         trials[i] = {p[i] + h <= free_[i].upper ? p[i] + h : p[i] - h};
       }
     }
@@ -242,6 +278,10 @@ class FitProblem {
     std::size_t next = 0;  // into runs, in the order they were laid out
     for (std::size_t i = 0; i < free_.size(); ++i) {
       std::vector<Eigen::VectorXd> r;  // weighted residuals at each trial
+      if (free_[i].measurement && !fit_step) {
+        jacobian->col(static_cast<Eigen::Index>(i)).setConstant(kNaN);
+        continue;
+      }
       for (std::size_t t = 0; t < (free_[i].measurement ? 2 : trials[i].size()); ++t) {
         if (free_[i].measurement) {
           r.push_back(Residuals(base.measurement_trials[i][t]));
@@ -258,30 +298,22 @@ class FitProblem {
       } else {
         // dr/du = s dr/dp; h dr/dp = (w_b r(p) + w_0 r(t_0) + w_1 r(t_1)) / 2.
         const internal::DifferencePlan& plan = plans[i];
-        const double h = options_.relative_step * free_[i].scale;
+        const double h = relative_step * free_[i].scale;
         column = (plan.base_weight * base.residuals + plan.trial_weights[0] * r[0] +
                   plan.trial_weights[1] * r[1]) *
                  (free_[i].scale / (2.0 * h));
       }
       jacobian->col(static_cast<Eigen::Index>(i)) = column;
     }
-    const std::lock_guard<std::mutex> lock(mutex_);
-    jacobian_u_.assign(u, u + free_.size());
-    jacobian_second_order_ = second_order;
-    jacobian_ = *jacobian;
-    trial_runs_ = std::move(runs);
+    *runs_used = std::move(runs);
     return true;
   }
 
-  // From now on every Jacobian is second order (the final point's).
-  void UseSecondOrder() {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    second_order_ = true;
-  }
-
-  // The difference plan of free parameter i at value p_i.
-  internal::DifferencePlan PlanFor(std::size_t i, double p_i) const {
-    const double h = options_.relative_step * free_[i].scale;
+  // The difference plan of free parameter i at value p_i, at the fit's
+  // relative step unless another is given.
+  internal::DifferencePlan PlanFor(std::size_t i, double p_i, double relative_step = 0.0) const {
+    const double h =
+        (relative_step > 0.0 ? relative_step : options_.relative_step) * free_[i].scale;
     const std::optional<internal::DifferencePlan> plan =
         internal::PlanDifference(p_i, h, free_[i].lower, free_[i].upper);
     CCSRM_CHECK(plan.has_value());  // Identify checked the bounds' width
@@ -958,7 +990,20 @@ std::int64_t Minimise(FitProblem& problem, ceres::Problem& ceres_problem,
 struct Uncertainty {
   Eigen::MatrixXd covariance_u;  // free × free, scaled space, times σ_res²
   std::vector<bool> identifiable;
+  std::vector<double> derivative_step_disagreement;  // per free parameter; empty: not checked
 };
+
+// Per column: ||a - b|| / max(||a||, ||b||); NaN where b is NaN (not checked).
+std::vector<double> ColumnDisagreement(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  std::vector<double> out;
+  for (Eigen::Index i = 0; i < a.cols(); ++i) {
+    const double scale = std::max(a.col(i).norm(), b.col(i).norm());
+    out.push_back(!b.col(i).allFinite() ? kNaN
+                  : scale > 0.0         ? (a.col(i) - b.col(i)).norm() / scale
+                                        : 0.0);
+  }
+  return out;
+}
 
 // The residual statistics, singular values, unidentifiable directions and
 // covariance at the final point `u` (values p_final) into *summary.
@@ -992,6 +1037,12 @@ Uncertainty UncertaintyAt(FitProblem& problem, ceres::Problem& ceres_problem,
   if (problem.Jacobian(u->data(), &jacobian, &failure)) {
     summary->jacobian = jacobian;
     summary->weighted_residuals = final_eval.residuals;
+    Eigen::MatrixXd finer;
+    std::string finer_failure;
+    if (options.check_derivative_steps &&
+        problem.JacobianAtStep(u->data(), options.relative_step / 3.0, &finer, &finer_failure)) {
+      out.derivative_step_disagreement = ColumnDisagreement(jacobian, finer);
+    }
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian, Eigen::ComputeThinV);
     const Eigen::VectorXd sv = svd.singularValues();
     const Eigen::MatrixXd v = svd.matrixV();
@@ -1092,6 +1143,9 @@ void TabulateParameters(const std::vector<FreeParameter>& free, const std::vecto
           free[i].scale;
       est.ci95_lower = std::max(est.value - t975 * est.std_error, est.lower);
       est.ci95_upper = std::min(est.value + t975 * est.std_error, est.upper);
+    }
+    if (i < uncertainty.derivative_step_disagreement.size()) {
+      est.derivative_step_disagreement = uncertainty.derivative_step_disagreement[i];
     }
     summary->parameters.push_back(est);
   }

@@ -185,6 +185,7 @@ void BackwardStep(LoopState* s, int round, const std::string& winner_label, Loop
     }
     o.values = ValuesOf(current, fixed);
     for (const std::string& q : b.parameters) o.values.erase(q);
+    o.check_derivative_steps = false;  // only its cost is compared
     IdentificationSummary without = Identify(training, o);
     simulations += without.simulations;
     if (without.termination == IdentificationTermination::kFailed) {

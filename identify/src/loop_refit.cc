@@ -56,6 +56,9 @@ IdentificationSummary Refit(LoopState* s, RoundState* rs, CandidateResult& cand)
     o.values[q] = start;
     o.scales[q] = scale;
   }
+  // The refit is judged by its cost and intervals; the check that the
+  // angles are smooth in each parameter is the declared and final fits'.
+  o.check_derivative_steps = false;
   IdentificationSummary refit = Identify(training, o);
   simulations += refit.simulations;
   cand.simulations += refit.simulations;
