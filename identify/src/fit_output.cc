@@ -54,6 +54,12 @@ std::string UnidentifiableDirection::Describe() const {
 }
 
 std::string IdentificationSummary::BriefReport() const {
+  std::string rough;
+  for (const ParameterEstimate& p : parameters) {
+    if (p.free && p.derivative_step_disagreement > kDerivativeStepLimit) {
+      rough += (rough.empty() ? "" : ", ") + p.name;
+    }
+  }
   char text[512];
   std::snprintf(text, sizeof(text),
                 "identification %s after %d iterations (%lld simulations, %d threads, %.1f s): "
@@ -69,6 +75,7 @@ std::string IdentificationSummary::BriefReport() const {
                              "noise)",
                              adequacy.above_noise.size())
                           .c_str());
+  if (!rough.empty()) return text + ("; derivatives NOT smooth in " + rough);
   return text;
 }
 

@@ -61,6 +61,9 @@ FitParameter ReadParameter(const JsonReader& in, const json& entry, const std::s
     p.ci95_misfit_lower = interval[0];
     p.ci95_misfit_upper = interval[1];
   }
+  if (entry.contains("derivative_step_disagreement")) {
+    p.derivative_step_disagreement = in.NumberAt(entry, at, "derivative_step_disagreement", true);
+  }
   const std::array<double, 2> bounds = in.Pair(in.At(entry, at, "bounds"), at + ".bounds", false);
   p.lower = bounds[0];
   p.upper = bounds[1];

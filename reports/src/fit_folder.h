@@ -35,6 +35,9 @@ struct FitParameter {
   double ci95_misfit_lower = kUnknown, ci95_misfit_upper = kUnknown;
   double lower = kUnknown, upper = kUnknown;  // bounds of the fit
   bool at_bound = false;
+  // fit.json 'derivative_step_disagreement': its derivative at the fit's
+  // step against a third of it; unknown when not checked or written before.
+  double derivative_step_disagreement = kUnknown;
 };
 
 // Errors of fit.json's `errors`, `start_errors` or an experiment's

@@ -130,6 +130,23 @@ Section SummarySection(const FitFolder& fit) {
                                   "lacks: quote no value before it is found."),
         !fit.adequate});
   }
+  // Parameters the angles jump with: their intervals mean nothing.
+  std::string rough;
+  for (const FitParameter& p : fit.parameters) {
+    if (p.free && p.derivative_step_disagreement > 0.05) {
+      rough += (rough.empty() ? "" : ", ") + p.name + " (" +
+               Show(100.0 * p.derivative_step_disagreement, NumberFormat::Significant(3)) + " %)";
+    }
+  }
+  if (!rough.empty()) {
+    section.blocks.push_back(Paragraph{
+        "The derivatives are NOT smooth in " + rough +
+            ": at the final point they differ by that much between the fit's finite-difference "
+            "step and a third of it (more than 5 %). The angles jump with these parameters here "
+            "(a breakaway that happens or not, a stick-slip cycle that gains or loses a slip), "
+            "and their estimates and intervals are not to be trusted from these data.",
+        true});
+  }
   Table table = FitTable(fit);
   std::vector<std::string> names;
   for (const FitExperiment& e : fit.experiments) names.push_back(e.name);
