@@ -79,10 +79,13 @@ ModelAdequacy AssessModelAdequacy(const std::vector<const Experiment*>& recordin
         c.noise_deg = x.noise_deg[jj];
         c.rms_deg = std::sqrt(sum / n) * c.noise_deg;
         c.effective_samples = internal::EffectiveSampleSize({weighted});
+        c.noise_effective_samples =
+            jj < x.noise_effective_samples.size() ? x.noise_effective_samples[jj] : INFINITY;
         // A run that ended early leaves NaN: never noise.
-        c.p_value = std::isfinite(sum)
-                        ? gsl_cdf_chisq_Q(sum * c.effective_samples / n, c.effective_samples)
-                        : 0.0;
+        c.p_value = !std::isfinite(sum) ? 0.0
+                    : std::isfinite(c.noise_effective_samples)
+                        ? gsl_cdf_fdist_Q(sum / n, c.effective_samples, c.noise_effective_samples)
+                        : gsl_cdf_chisq_Q(sum * c.effective_samples / n, c.effective_samples);
         out.worst_ratio = std::isfinite(sum) ? std::max(out.worst_ratio, Ratio(c)) : INFINITY;
         large.push_back(!(c.rms_deg <= above_noise_ratio * c.noise_deg));
         tested.push_back(c);
@@ -108,6 +111,9 @@ nlohmann::json ToJson(const ModelAdequacy& a) {
                      {"rms_deg", c.rms_deg},
                      {"noise_deg", c.noise_deg},
                      {"effective_samples", c.effective_samples},
+                     {"noise_effective_samples", std::isfinite(c.noise_effective_samples)
+                                                     ? nlohmann::json(c.noise_effective_samples)
+                                                     : nlohmann::json(nullptr)},
                      {"p_value", c.p_value}});
   }
   return {{"assessed", a.assessed},

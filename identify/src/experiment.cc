@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <limits>
 
+#include "ccsrm/common/autocorrelation.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/mocap/recording.h"
 #include "ccsrm/mocap/signal.h"
@@ -37,9 +38,11 @@ std::optional<mocap::ZeroLagNoiseGain> LowPassNoiseGain(const Experiment& e) {
 // like the angles), so that it is the interior's noise; NaN when a joint has
 // fewer than 10 finite frames.
 std::vector<double> TwistScatterDeg(const datasets::Array& twist, std::size_t first_frame,
-                                    int joints, mocap::ZeroLagNoiseGain* gain) {
+                                    int joints, mocap::ZeroLagNoiseGain* gain,
+                                    std::vector<double>* effective_samples) {
   std::vector<double> out(static_cast<std::size_t>(joints),
                           std::numeric_limits<double>::quiet_NaN());
+  effective_samples->assign(static_cast<std::size_t>(joints), INFINITY);
   const std::size_t frames = twist.rows() - std::min(first_frame, twist.rows());
   for (int j = 0; j < joints; ++j) {
     const double* column = twist.values.data() + first_frame * twist.shape[1] + j;
@@ -53,11 +56,13 @@ std::vector<double> TwistScatterDeg(const datasets::Array& twist, std::size_t fi
     if (values.size() < 10) continue;
     const double median = Median(values);
     double sum = 0.0;
+    std::vector<double> deviation;
     for (std::size_t k = 0; k < values.size(); ++k) {
-      const double d = (values[k] - median) / scale[k];
-      sum += d * d;
+      deviation.push_back((values[k] - median) / scale[k]);
+      sum += deviation.back() * deviation.back();
     }
     out[static_cast<std::size_t>(j)] = std::sqrt(sum / static_cast<double>(values.size())) * kDeg;
+    (*effective_samples)[static_cast<std::size_t>(j)] = EffectiveSampleSize({deviation});
   }
   return out;
 }
@@ -193,17 +198,20 @@ void SetNoise(const datasets::ExperimentFile& file, std::size_t first,
               const ExperimentLoadOptions& options, mocap::ZeroLagNoiseGain* gain, Experiment* e) {
   const std::size_t joints = static_cast<std::size_t>(e->joints);
   e->noise_deg.assign(joints, kMocapNoiseFloorDeg);
+  e->noise_effective_samples.assign(joints, INFINITY);
   if (options.noise_deg) {
     e->noise_deg.assign(joints, *options.noise_deg);
     e->noise_source = "given";
   } else if (file.measured_joint_twist && file.measured_joint_twist->rank() == 2 &&
              file.measured_joint_twist->shape[1] == joints) {
+    std::vector<double> effective;
     const std::vector<double> scatter =
-        TwistScatterDeg(*file.measured_joint_twist, first, e->joints, gain);
+        TwistScatterDeg(*file.measured_joint_twist, first, e->joints, gain, &effective);
     bool any = false;
     for (std::size_t j = 0; j < joints; ++j) {
       if (std::isfinite(scatter[j])) {
         e->noise_deg[j] = std::max(scatter[j], options.min_noise_deg);
+        e->noise_effective_samples[j] = effective[j];
         any = true;
       }
     }

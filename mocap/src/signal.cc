@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <utility>
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/gsl_errors.h"
@@ -39,6 +40,25 @@ void FilterPass(const std::vector<BiquadSection>& sections, double* y, std::size
 
 // Value at x[0] of the least-squares line through x[0], x[step], ...,
 // x[(m-1)·step] (step = ±1): the end of a run with its noise averaged.
+// The runs [begin, end) of consecutive finite samples of x[0], x[stride],
+// ... x[(n-1)·stride], in order.
+std::vector<std::pair<std::size_t, std::size_t>> FiniteRuns(const double* x, std::size_t n,
+                                                            std::size_t stride) {
+  std::vector<std::pair<std::size_t, std::size_t>> runs;
+  std::size_t i = 0;
+  while (i < n) {
+    if (!std::isfinite(x[i * stride])) {
+      ++i;
+      continue;
+    }
+    std::size_t end = i;
+    while (end < n && std::isfinite(x[end * stride])) ++end;
+    runs.emplace_back(i, end);
+    i = end;
+  }
+  return runs;
+}
+
 double EndPivot(const double* x, std::size_t m, int step) {
   if (m < 2) return x[0];
   double sum_i = 0.0, sum_ii = 0.0, sum_x = 0.0, sum_ix = 0.0;
@@ -173,25 +193,14 @@ void ZeroLagLowPass(const std::vector<BiquadSection>& sections, double cutoff_hz
                     double sample_rate_hz, double* x, std::size_t n, std::size_t stride,
                     std::size_t min_run) {
   std::vector<double> run;
-  std::size_t i = 0;
-  while (i < n) {
-    if (!std::isfinite(x[i * stride])) {
-      ++i;
-      continue;
-    }
-    std::size_t end = i;
-    while (end < n && std::isfinite(x[end * stride])) ++end;
-    if (end - i < min_run) {
-      i = end;
-      continue;
-    }
-    run.resize(end - i);
-    for (std::size_t j = i; j < end; ++j) run[j - i] = x[j * stride];
+  for (const auto& [begin, end] : FiniteRuns(x, n, stride)) {
+    if (end - begin < min_run) continue;
+    run.resize(end - begin);
+    for (std::size_t j = begin; j < end; ++j) run[j - begin] = x[j * stride];
     FiltFilt(sections, run.data(), run.size(),
              FiltFiltPadding(cutoff_hz, sample_rate_hz, run.size()),
              FiltFiltEndWindow(cutoff_hz, sample_rate_hz, run.size()));
-    for (std::size_t j = i; j < end; ++j) x[j * stride] = run[j - i];
-    i = end;
+    for (std::size_t j = begin; j < end; ++j) x[j * stride] = run[j - begin];
   }
 }
 
@@ -274,21 +283,13 @@ const std::vector<double>& ZeroLagNoiseGain::RunGain(std::size_t n) {
 
 std::vector<double> ZeroLagNoiseGain::Relative(const double* x, std::size_t n, std::size_t stride) {
   std::vector<double> out(n, std::numeric_limits<double>::quiet_NaN());
-  std::size_t i = 0;
-  while (i < n) {
-    if (!std::isfinite(x[i * stride])) {
-      ++i;
-      continue;
-    }
-    std::size_t end = i;
-    while (end < n && std::isfinite(x[end * stride])) ++end;
-    if (end - i < min_run_) {
-      for (std::size_t j = i; j < end; ++j) out[j] = 1.0 / interior_gain_;
+  for (const auto& [begin, end] : FiniteRuns(x, n, stride)) {
+    if (end - begin < min_run_) {
+      for (std::size_t j = begin; j < end; ++j) out[j] = 1.0 / interior_gain_;
     } else {
-      const std::vector<double>& gain = RunGain(end - i);
-      for (std::size_t j = i; j < end; ++j) out[j] = gain[j - i] / interior_gain_;
+      const std::vector<double>& gain = RunGain(end - begin);
+      for (std::size_t j = begin; j < end; ++j) out[j] = gain[j - begin] / interior_gain_;
     }
-    i = end;
   }
   return out;
 }

@@ -7,6 +7,8 @@
 #include <random>
 #include <vector>
 
+#include "ccsrm/identify/adequacy.h"
+#include "ccsrm/identify/experiment.h"
 #include "statistics.h"
 
 namespace ccsrm::identify::internal {
@@ -112,3 +114,37 @@ TEST(AssessIdentifiability, JudgesErrorsRelativeToTheEstimate) {
 
 }  // namespace
 }  // namespace ccsrm::identify::internal
+
+namespace ccsrm::identify {
+namespace {
+
+// One joint, one recording: the measured angles 0, the simulated ones white
+// noise of `ratio` times the joint's noise (0.03 deg) over 2000 frames.
+ModelAdequacy JudgeWhiteResidual(double ratio, double noise_effective_samples) {
+  Experiment x;
+  x.name = "white";
+  x.joints = 1;
+  x.measured_rad = Eigen::MatrixXd::Zero(2000, 2);
+  x.noise_deg = {0.03};
+  x.noise_effective_samples = {noise_effective_samples};
+  Eigen::MatrixXd sim(2000, 2);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, ratio * 0.03 * M_PI / 180.0);
+  for (Eigen::Index f = 0; f < sim.rows(); ++f) sim(f, 0) = noise(rng), sim(f, 1) = noise(rng);
+  return AssessModelAdequacy({&x}, {&sim}, kAboveNoiseRatio, kAboveNoiseSignificance);
+}
+
+// A noise estimated from ten independent samples is known to a fifth or so:
+// a residual 1.8 times it over 2000 white frames is then no proof of a
+// misfit (an F of 2000 and 10 degrees of freedom at 3.24: p 0.03, above
+// 0.01 over the 2 channels), though a chi-square against a noise taken as
+// exact calls it one; four times it is a misfit either way.
+TEST(ModelAdequacy, ANoiseKnownFromFewSamplesIsNotTakenForAMisfit) {
+  EXPECT_TRUE(JudgeWhiteResidual(1.8, 10.0).adequate());
+  EXPECT_FALSE(JudgeWhiteResidual(1.8, INFINITY).adequate());
+  EXPECT_FALSE(JudgeWhiteResidual(4.0, 10.0).adequate());
+  EXPECT_TRUE(JudgeWhiteResidual(1.0, INFINITY).adequate());
+}
+
+}  // namespace
+}  // namespace ccsrm::identify

@@ -25,7 +25,12 @@ namespace ccsrm::identify {
 // must be below kAboveNoiseSignificance over the number of channels
 // (Bonferroni, family-wise; the loop's score_significance). On a few
 // seconds of 1 Hz-filtered mocap a channel has N_eff of about 7, and its RMS
-// alone scatters by a quarter around the noise.
+// alone scatters by a quarter around the noise. A noise estimated from the
+// recording (the twist's scatter, Experiment::noise_effective_samples) is
+// itself uncertain: 10 s of filtered twist hold 15 or so independent
+// samples, a noise known to a fifth. The mean square Σ r² / N is then the
+// ratio of two estimated variances, an F of (N_eff, the noise's N_eff)
+// degrees of freedom, and that is the test (a given noise: chi-square).
 inline constexpr double kAboveNoiseRatio = 1.5;
 inline constexpr double kAboveNoiseSignificance = 0.01;
 
@@ -36,8 +41,9 @@ struct ChannelAboveNoise {
   int axis = 0;   // 0 θx, 1 θy
   double rms_deg = 0.0;
   double noise_deg = 0.0;
-  double effective_samples = 0.0;  // N_eff of its residual
-  double p_value = 0.0;            // of its chi-square as noise
+  double effective_samples = 0.0;        // N_eff of its residual
+  double noise_effective_samples = 0.0;  // of its noise estimate; inf: given
+  double p_value = 0.0;                  // of its F (or chi-square) as noise
 };
 
 struct ModelAdequacy {

@@ -74,6 +74,11 @@ struct Experiment {
   // was measured. Empty (an experiment built in code): 1 everywhere.
   Eigen::MatrixXd relative_noise;
   std::string noise_source;  // "given", "joint twist scatter" or "default floor ..."
+  // Per joint, the independent samples its noise was estimated from (the
+  // twist's frames over their integrated autocorrelation time): how well
+  // the noise itself is known. Infinite for a given noise or the floor, and
+  // when empty (an experiment built in code).
+  std::vector<double> noise_effective_samples;
   // True when the file had no /measured/joint_angles and the mocap pipeline
   // computed them at load, with default settings.
   bool angles_from_pipeline = false;
