@@ -201,8 +201,7 @@ class FitProblem {
     return DifferenceJacobian(u, true, relative_step, jacobian, &runs, failure);
   }
 
-  // From now on every Jacobian is second order (the final point's).  // From now on every Jacobian
-  // is second order (the final point's).
+  // From now on every Jacobian is second order (the final point's).
   void UseSecondOrder() {
     const std::lock_guard<std::mutex> lock(mutex_);
     second_order_ = true;
