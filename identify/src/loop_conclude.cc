@@ -80,7 +80,10 @@ void ListAdditions(LoopState* state) {
 }
 
 // The final model's errors and evidence, and the joint axes whose residual
-// stays above the unexplained level.
+// stands above its noise: by the rule of the verdict every fit and
+// prediction gives (AssessModelAdequacy: beyond unexplained_noise_ratio and
+// beyond chance), so the loop never lists an axis its final model's verdict
+// calls explained.
 void FindUnexplained(LoopState* s) {
   const std::vector<Experiment>& training = s->training;
   const LoopOptions& options = s->options;
@@ -96,16 +99,29 @@ void FindUnexplained(LoopState* s) {
     summary.holdout_rms_after_deg = current_holdout.rms_deg;
     summary.holdout_after = current_holdout.errors;
   }
-  {
-    std::vector<Eigen::MatrixXd> fitted;
-    for (const ExperimentFit& f : current.experiments) fitted.push_back(f.simulated_rad);
-    if (!fitted.empty()) summary.final_evidence = DiagnoseResidual(training, fitted);
+  std::vector<Eigen::MatrixXd> fitted;
+  for (const ExperimentFit& f : current.experiments) fitted.push_back(f.simulated_rad);
+  if (fitted.empty()) return;
+  summary.final_evidence = DiagnoseResidual(training, fitted);
+  std::vector<const Experiment*> recordings;
+  std::vector<const Eigen::MatrixXd*> simulated;
+  for (std::size_t e = 0; e < training.size() && e < fitted.size(); ++e) {
+    recordings.push_back(&training[e]);
+    simulated.push_back(&fitted[e]);
   }
+  const ModelAdequacy adequacy = AssessModelAdequacy(
+      recordings, simulated, options.unexplained_noise_ratio, kAboveNoiseSignificance);
+  const auto above_noise = [&](const std::string& name, int joint, int axis) {
+    return std::any_of(adequacy.above_noise.begin(), adequacy.above_noise.end(),
+                       [&](const ChannelAboveNoise& c) {
+                         return c.recording == name && c.joint == joint && c.axis == axis;
+                       });
+  };
   // Where the residual remains.
   for (const ChannelDiagnostics& ch : summary.final_evidence.channels) {
-    if (!(ch.rms_deg > options.unexplained_noise_ratio * ch.noise_deg)) continue;
-    UnexplainedChannel u;
     const ExperimentDiagnostics& ed = summary.final_evidence.experiments[ch.experiment];
+    if (!above_noise(ed.name, ch.joint, ch.axis)) continue;
+    UnexplainedChannel u;
     u.experiment = ed.name;
     u.joint = ch.joint;
     u.axis = ch.axis;
@@ -162,15 +178,17 @@ LoopSummary Conclude(LoopState* s) {
   }
   if (declared_ok) {
     if (summary.unexplained.empty()) {
-      conclusion << " The residual is at the noise floor: every joint and axis within "
-                 << Format("%g", options.unexplained_noise_ratio) << "x its noise.";
+      conclusion << " The residual is at the noise floor: no joint axis stands above its noise "
+                    "(beyond "
+                 << Format("%g", options.unexplained_noise_ratio) << "x it and beyond chance).";
     } else {
       const UnexplainedChannel& u = summary.unexplained.front();
       conclusion << " Unexplained residual remains in " << summary.unexplained.size()
-                 << " joint axes (above " << Format("%g", options.unexplained_noise_ratio)
-                 << "x their noise); the largest: " << u.experiment << " joint " << u.joint
-                 << (u.axis == 0 ? " θx " : " θy ") << Format("%.4f", u.rms_deg) << " deg against "
-                 << Format("%.4f", u.noise_deg) << ", worst in " << u.worst_phase << ".";
+                 << " joint axes (beyond " << Format("%g", options.unexplained_noise_ratio)
+                 << "x their noise and beyond chance); the largest: " << u.experiment << " joint "
+                 << u.joint << (u.axis == 0 ? " θx " : " θy ") << Format("%.4f", u.rms_deg)
+                 << " deg against " << Format("%.4f", u.noise_deg) << ", worst in " << u.worst_phase
+                 << ".";
     }
   }
   summary.conclusion = conclusion.str();

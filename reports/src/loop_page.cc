@@ -856,10 +856,11 @@ Table UnexplainedTable(const LoopFolder& loop) {
   table.id = "unexplained";
   table.title = "Joint axes the final model does not explain";
   table.caption =
-      "loop.json 'unexplained': every experiment, joint and axis whose RMS residual exceeds its "
-      "measurement noise by more than the loop's ratio (LoopOptions::unexplained_noise_ratio, "
-      "1.5 by default), largest ratio first, with the phase of the protocol where it is "
-      "largest.";
+      "loop.json 'unexplained': every experiment, joint and axis whose residual stands above its "
+      "measurement noise by the rule of the final model's verdict (RMS beyond the loop's ratio, "
+      "LoopOptions::unexplained_noise_ratio, 1.5 by default, and beyond chance), largest ratio "
+      "first, with the phase of the protocol where it is largest. RMS and noise here weigh each "
+      "frame by its noise (a recording's ends count less); the fit's tables give them raw.";
   table.columns = {{"experiment", "experiment", "", kRms},
                    {"joint", "joint", "", kCount},
                    {"axis", "axis", "", kRms},

@@ -94,9 +94,10 @@
 // and the partial-explanation rule included. Reported as a formula per
 // segment's joints and axis (LoopSummary::discovered_terms).
 //
-// At the end, every (experiment, joint, axis) whose RMS residual exceeds
-// unexplained_noise_ratio (1.5) times its noise is reported as
-// unexplained, with the phase of the protocol where it is largest.
+// At the end, every (experiment, joint, axis) whose residual stands above its
+// noise by the verdict's rule (adequacy.h: RMS beyond unexplained_noise_ratio,
+// 1.5, times its noise and beyond chance) is reported as unexplained, with
+// the phase of the protocol where it is largest.
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -159,7 +160,8 @@ struct LoopOptions {
   double min_delta_bic = 10.0;
   double holdout_z = 2.0;
   double tie_delta_bic = 2.0;
-  // A channel is unexplained above this RMS over its noise. Default 1.5.
+  // A channel is unexplained above this RMS over its noise (and beyond
+  // chance: AssessModelAdequacy). Default 1.5.
   double unexplained_noise_ratio = 1.5;
   // The partial-explanation rule (above): a candidate after whose refit the
   // residual stays above unexplained_noise_ratio times the noise must
