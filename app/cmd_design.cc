@@ -134,6 +134,12 @@ void AddDesignCommand(CLI::App& root) {
                   "How many of the best plans at the prior --prior-box evaluates at its corners")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--check-top", a->job.design.checked_candidates,
+                  "How many of the best plans, in rank order, have their derivatives at the "
+                  "prior checked at a third of the step (as a fit checks its own) until one is "
+                  "smooth; a plan that is not ranks last (0: no check)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--config", a->job.config_path,
                   "Arm configuration (YAML); default: the bundled paper.yaml");
   cmd->add_option("--case", a->job.case_number,

@@ -97,6 +97,7 @@ bool DesignOptions::IsValid(std::string* error) const {
   }
   if (prior_box.size() > 6) return fail("prior_box: at most 6 ranges (64 corners)");
   if (robust_candidates < 1) return fail("robust_candidates must be >= 1");
+  if (checked_candidates < 0) return fail("checked_candidates must be >= 0");
   return true;
 }
 
@@ -153,8 +154,11 @@ class CandidateBackend final : public SimulationBackend {
 
 // One candidate with the parameters of its experiments' configurations;
 // `first_experiment`: the index of its first experiment in DesignExperiments.
+// `check_derivatives`: the Jacobian again at a third of the step
+// (DesignOptions::checked_candidates).
 CandidateInformation EvaluateCandidate(const DesignCandidate& candidate,
-                                       const DesignOptions& options, std::size_t first_experiment) {
+                                       const DesignOptions& options, std::size_t first_experiment,
+                                       bool check_derivatives = false) {
   CandidateInformation info;
   info.name = candidate.name;
   info.protocol_yaml = candidate.protocol_yaml;
@@ -206,7 +210,9 @@ CandidateInformation EvaluateCandidate(const DesignCandidate& candidate,
     // No iteration: the Jacobian at the start, second order, is all that
     // is wanted.
     fit.max_iterations = 0;
-    fit.check_derivative_steps = false;  // the Fisher information at the step the fits take
+    // The Fisher information at the step the fits take; checked at a third
+    // of it on request.
+    fit.check_derivative_steps = check_derivatives;
     fit.converged_step_fraction = 0.0;
     fit.min_effective_chi2_decrease = 0.0;
     const IdentificationSummary at_prior = Identify(experiments, fit);
@@ -218,6 +224,13 @@ CandidateInformation EvaluateCandidate(const DesignCandidate& candidate,
       info.samples = static_cast<std::size_t>(j.rows());
       info.fisher_relative = options.effective_sample_fraction * j.transpose() * j;
       info.completed = true;
+      if (check_derivatives) {
+        for (const std::string& name : options.free_parameters) {
+          const ParameterEstimate* estimate = at_prior.Find(name);
+          info.derivative_step_disagreement.push_back(
+              estimate != nullptr ? estimate->derivative_step_disagreement : kInf);
+        }
+      }
     }
   }
   const std::size_t p = options.free_parameters.size();
@@ -307,6 +320,45 @@ void CheckDesign(const std::vector<DesignCandidate>& candidates, const DesignOpt
   }
 }
 
+namespace {
+
+// The best plans' derivatives at the prior, in rank order, until one is
+// smooth or options.checked_candidates were checked; those not smooth rank
+// last (DesignOptions::checked_candidates). A checked plan is evaluated
+// again with the check: the same runs and Fisher information, and the
+// finer step's.
+void CheckDerivatives(const std::vector<DesignCandidate>& candidates, const DesignOptions& options,
+                      const std::vector<std::size_t>& first, DesignSummary* summary) {
+  int checked = 0;
+  for (const std::size_t k : summary->ranking) {
+    if (checked == options.checked_candidates) break;
+    CandidateInformation& info = summary->candidates[k];
+    if (!info.completed) continue;
+    const CandidateInformation again = EvaluateCandidate(candidates[k], options, first[k], true);
+    ++checked;
+    info.simulations += again.simulations;
+    summary->simulations += again.simulations;
+    info.derivative_step_disagreement = again.completed
+                                            ? again.derivative_step_disagreement
+                                            : std::vector<double>(info.parameters.size(), kInf);
+    if (info.derivatives_smooth()) break;
+  }
+  std::stable_partition(summary->ranking.begin(), summary->ranking.end(), [&](std::size_t k) {
+    const CandidateInformation& c = summary->candidates[k];
+    return !c.derivatives_checked() || c.derivatives_smooth();
+  });
+}
+
+}  // namespace
+
+bool CandidateInformation::derivatives_smooth() const {
+  if (!derivatives_checked()) return false;
+  for (const double d : derivative_step_disagreement) {
+    if (!(d <= kDerivativeStepLimit)) return false;
+  }
+  return true;
+}
+
 DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
                               const DesignOptions& options) {
   CheckDesign(candidates, options);
@@ -376,6 +428,7 @@ DesignSummary EvaluateDesigns(const std::vector<DesignCandidate>& candidates,
           return by_worst(a, b);
         });
   }
+  CheckDerivatives(candidates, options, first, &summary);
   summary.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
   return summary;
@@ -665,6 +718,31 @@ std::string DesignSummary::FullReport() const {
       out += "  " + Format("%-4zu", r + 1) + " " + candidates[ranking[r]].name + "\n";
     }
   }
+  for (const std::size_t k : ranking) {
+    const CandidateInformation& c = candidates[k];
+    if (!c.derivatives_checked()) continue;
+    std::string largest, rough;
+    double worst = -1.0;
+    for (std::size_t i = 0; i < c.parameters.size(); ++i) {
+      const double d = c.derivative_step_disagreement[i];
+      if (!(d <= kDerivativeStepLimit)) {
+        rough += (rough.empty() ? "" : ", ") + c.parameters[i] + " " +
+                 (std::isfinite(d) ? Format("%.3g %%", 100.0 * d) : std::string("not computed"));
+      } else if (d > worst) {
+        worst = d;
+        largest = c.parameters[i] + " " + Format("%.3g %%", 100.0 * d);
+      }
+    }
+    out += "  derivatives at the prior (relative steps " + Format("%.3g", options.relative_step) +
+           " and a third of it, as a fit checks its own), " + c.name + ": " +
+           (c.derivatives_smooth()
+                ? "smooth (largest disagreement " + largest + ")\n"
+                : "NOT smooth in " + rough + " (limit " +
+                      Format("%.0f", 100.0 * kDerivativeStepLimit) +
+                      " %): a fit of its recordings would not give these errors (the angles "
+                      "jump with the parameters there, as in stick-slip: docs/model-notes.md, "
+                      "issue 43); ranked last\n");
+  }
   if (!options.prior_box.empty()) {
     std::string box;
     for (const PriorRange& r : options.prior_box) {
@@ -732,6 +810,11 @@ nlohmann::json ToJson(const DesignSummary& s) {
                          {"worst_relative_std_error", number(corner.worst_relative_std_error)},
                          {"worst_parameter", corner.worst_parameter}});
     }
+    nlohmann::json disagreement = nullptr;  // not checked
+    if (c.derivatives_checked()) {
+      disagreement = nlohmann::json::array();
+      for (const double d : c.derivative_step_disagreement) disagreement.push_back(number(d));
+    }
     nlohmann::json fisher = nlohmann::json::array();
     for (Eigen::Index i = 0; i < c.fisher_relative.rows(); ++i) {
       nlohmann::json row = nlohmann::json::array();
@@ -758,6 +841,9 @@ nlohmann::json ToJson(const DesignSummary& s) {
          {"fisher_relative", fisher},
          {"corners", corners},
          {"robust_worst_relative_std_error", number(c.robust_worst_relative_std_error)},
+         {"derivative_step_disagreement", disagreement},
+         {"derivatives_smooth",
+          c.derivatives_checked() ? nlohmann::json(c.derivatives_smooth()) : nullptr},
          {"simulations", c.simulations}});
   }
   nlohmann::json box = nlohmann::json::array();
@@ -776,6 +862,7 @@ nlohmann::json ToJson(const DesignSummary& s) {
           {"relative_step", s.options.relative_step},
           {"prior_box", box},
           {"robust_candidates", s.options.robust_candidates},
+          {"checked_candidates", s.options.checked_candidates},
           {"ranking", s.ranking},
           {"threads", s.threads},
           {"simulations", s.simulations},

@@ -39,7 +39,8 @@ std::string ResultOptions(const DesignJobOptions& job, const DesignOptions& o) {
       " planes=" + numbers(s.planes_deg) + " figures=" +
       numbers({s.budget_s, s.hold_s, o.noise_deg, o.effective_sample_fraction, o.frame_rate_hz,
                o.low_pass_hz, static_cast<double>(job.case_number),
-               static_cast<double>(o.robust_candidates), static_cast<double>(s.opposed_segments)});
+               static_cast<double>(o.robust_candidates), static_cast<double>(s.opposed_segments),
+               static_cast<double>(o.checked_candidates)});
   return text;
 }
 

@@ -49,6 +49,19 @@ DesignCandidateRow ReadCandidate(const JsonReader& in, const json& entry, const 
     c.worst_direction.emplace_back(in.Text(direction[k], d, "name"),
                                    in.NumberAt(direction[k], d, "component"));
   }
+  if (entry.contains("derivative_step_disagreement") &&
+      !entry["derivative_step_disagreement"].is_null()) {
+    const json& d = in.List(entry, at, "derivative_step_disagreement");
+    if (d.size() != free_count) {
+      in.Fail(at + ".derivative_step_disagreement", "expected one entry per free parameter");
+    }
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      c.derivative_step_disagreement.push_back(
+          d[i].is_null()
+              ? kUnknown
+              : in.Number(d[i], JsonReader::Index(at + ".derivative_step_disagreement", i)));
+    }
+  }
   const json& corners = in.List(entry, at, "corners");
   for (std::size_t k = 0; k < corners.size(); ++k) {
     const std::string d = JsonReader::Index(at + ".corners", k);

@@ -43,6 +43,10 @@ struct DesignCandidateRow {
   std::vector<std::pair<std::string, double>> worst_direction;
   std::vector<DesignCorner> corners;
   double robust_worst_relative_std_error = kUnknown;
+  // Per free parameter, its derivative's change between relative steps r
+  // and r/3 at the prior; empty: not checked (or a design.json before the
+  // check). NaN: not computed.
+  std::vector<double> derivative_step_disagreement;
   double simulations = 0;
 };
 

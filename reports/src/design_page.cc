@@ -29,6 +29,9 @@ using internal::Show;
 const NumberFormat kPercent = NumberFormat::Significant(3);
 
 double Percent(double x) { return 100.0 * x; }  // NaN stays NaN: "–"
+// identify's kDerivativeStepLimit: a derivative that moves more between
+// relative steps r and r/3 is not smooth (the fit page uses the same).
+constexpr double kDerivativeLimit = 0.05;
 
 bool Proposed(const DesignCandidateRow& c) { return !c.protocol_yaml.empty(); }
 
@@ -104,6 +107,38 @@ Section SummarySection(const DesignFolder& d) {
       "These are first-order predictions: a fit of real recordings realises them as far as its "
       "noise is the one assumed (docs/design.md, Validation).";
   section.blocks.push_back(Paragraph{text, false});
+  for (const std::size_t k : d.ranking) {
+    const DesignCandidateRow& c = d.candidates[k];
+    if (c.derivative_step_disagreement.empty()) continue;
+    std::string rough, largest;
+    double worst = -1.0;
+    for (std::size_t i = 0; i < c.derivative_step_disagreement.size() && i < d.free.size(); ++i) {
+      const double x = c.derivative_step_disagreement[i];
+      if (!(x <= kDerivativeLimit)) {
+        rough += (rough.empty() ? "" : ", ") + d.free[i] + " " +
+                 (std::isnan(x) ? std::string("(not computed)")
+                                : Show(Percent(x), NumberFormat::Significant(3)) + " %");
+      } else if (x > worst) {
+        worst = x;
+        largest = d.free[i] + ", " + Show(Percent(x), NumberFormat::Significant(3)) + " %";
+      }
+    }
+    const std::string checked =
+        "Plan " + Shown(c.name) +
+        "'s derivatives at the prior were checked as a fit checks its own (relative steps " +
+        Show(d.relative_step, NumberFormat::Significant(2)) + " and a third of it): ";
+    if (rough.empty()) {
+      section.blocks.push_back(
+          Paragraph{checked + "smooth (largest disagreement " + largest + ").", false});
+    } else {
+      section.blocks.push_back(Paragraph{
+          checked + "NOT smooth in " + rough +
+              " (limit 5 %). The angles jump with the parameters there (as in stick-slip at "
+              "static friction well above kinetic: docs/model-notes.md), so a fit of its "
+              "recordings would not give its predicted errors; it is ranked last.",
+          true});
+    }
+  }
   for (const DesignCandidateRow& c : d.candidates) {
     if (!c.completed) {
       section.blocks.push_back(

@@ -90,6 +90,10 @@ fs::path WriteDesignFolder(const std::string& name) {
     best.corners.push_back(corner);
   }
   best.robust_worst_relative_std_error = 0.00452;
+  // The best plan's derivatives checked and smooth; the paper's checked and
+  // not (ranked last).
+  best.derivative_step_disagreement = {0.0084, 0.0021};
+  s.candidates[0].derivative_step_disagreement = {0.104, 0.0021};
   s.ranking = {1, 0};
   s.threads = 2;
   s.simulations = 30;
@@ -124,6 +128,8 @@ TEST(DesignPage, ShowsEveryNumberOfTheDesignAndDrawsTheProposedMotion) {
   EXPECT_EQ(report["tables"]["corners"]["rows"].size(), 2u);
   // 0.186 / 0.00311: the factor the summary states.
   EXPECT_THAT(html, HasSubstr("59.8 times smaller"));
+  EXPECT_THAT(html, HasSubstr("smooth (largest disagreement mu_c, 0.84 %)"));
+  EXPECT_THAT(html, HasSubstr("NOT smooth in mu_c 10.4 %"));
   // Errors side by side, which parameter each informs, the planned θx
   // (the motion has no θy), cable speeds and lengths.
   EXPECT_EQ(summary.figures, 5);
@@ -165,6 +171,13 @@ TEST(DesignPage, BrokenDesignFoldersAreNamedInOneLine) {
   design["ranking"] = {1, 1};
   WriteTextFileAtomically((ranking / "design.json").string(), design.dump());
   EXPECT_THAT(ErrorOf(ranking), HasSubstr("key 'ranking': expected each candidate's index once"));
+
+  const fs::path check = WriteDesignFolder("check");
+  design = json::parse(ReadTextFile((check / "design.json").string()));
+  design["candidates"][0]["derivative_step_disagreement"] = {0.1};
+  WriteTextFileAtomically((check / "design.json").string(), design.dump());
+  EXPECT_THAT(ErrorOf(check), HasSubstr("key 'candidates[0].derivative_step_disagreement': "
+                                        "expected one entry per free parameter"));
 
   const fs::path csv = WriteDesignFolder("csv");
   std::string text = ReadTextFile((csv / "proposed.inputs.csv").string());

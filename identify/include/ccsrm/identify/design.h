@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "ccsrm/identify/identification.h"
 #include "ccsrm/identify/runs.h"
 #include "ccsrm/identify/simulation_backend.h"
 #include "ccsrm/sim/config.h"
@@ -99,6 +100,19 @@ struct DesignOptions {
   // Empty (default): the prior alone.
   std::vector<PriorRange> prior_box;
   int robust_candidates = 3;
+  // The predicted errors are those of a fit only where the joint angles are
+  // smooth in the free parameters at the prior; with static friction well
+  // above kinetic, fast motions run into stick–slip and are not (docs/
+  // model-notes.md, issue 43). So the best plans, in rank order, have their
+  // derivatives checked as a fit checks its own (IdentificationOptions::
+  // check_derivative_steps: the Jacobian again at a third of relative_step,
+  // two runs per experiment and free parameter more): a plan whose
+  // derivative for a free parameter moves by more than kDerivativeStepLimit
+  // (5 %) is not smooth there, and ranks after every other plan. Checking
+  // stops at the first smooth plan or after checked_candidates plans.
+  // Default 1: the plan the design recommends, and the next ones only while
+  // it is not smooth. 0: no check.
+  int checked_candidates = 1;
 
   // False with the reason naming the field: no free parameter, an unknown or
   // repeated name, noise_deg or frame_rate_hz not positive,
@@ -106,7 +120,8 @@ struct DesignOptions {
   // low_pass_hz negative or not below half the frame rate, low_pass_order
   // outside 1..8, low_pass_min_run_frames < 2,
   // threads < 1, a prior_box range not finite or not lower < upper, a name
-  // given twice, more than 6 ranges, robust_candidates < 1.
+  // given twice, more than 6 ranges, robust_candidates < 1,
+  // checked_candidates < 0.
   bool IsValid(std::string* error) const;
 };
 
@@ -156,7 +171,17 @@ struct CandidateInformation {
   // and those corners (worst_relative_std_error when there are none).
   std::vector<CornerInformation> corners;
   double robust_worst_relative_std_error = 0.0;
+  // Per free parameter, how far its derivative at the prior moves between
+  // relative steps r and r/3 (ParameterEstimate::derivative_step_
+  // disagreement); empty when not checked (DesignOptions::
+  // checked_candidates).
+  std::vector<double> derivative_step_disagreement;
   std::int64_t simulations = 0;
+
+  bool derivatives_checked() const { return !derivative_step_disagreement.empty(); }
+  // Checked, and every free parameter's derivative within
+  // kDerivativeStepLimit.
+  bool derivatives_smooth() const;
 };
 
 struct DesignSummary {
