@@ -319,5 +319,33 @@ TEST(Identification, DescendsOnForwardDifferencesAndReportsASecondOrderJacobian)
   EXPECT_EQ(forward.Find("T_p")->std_error, central.Find("T_p")->std_error);
 }
 
+// Where the angles jump with a parameter, the fit says its derivatives are
+// not smooth rather than give intervals as if they were: the paper's
+// stick-slip law in the holes (events: a node sticks or slips by a
+// threshold) moves its switches past frames as mu_c changes, and mu_c's
+// differences at r and r/3 disagree by about 10 % on this motion (the design
+// test's plan of the same runs; docs/model-notes.md rows 20 and 24). At the
+// fast reversals with static friction at 0.30 above kinetic 0.18 the
+// default law does the same (85-104 %: issue 43's notes), at a run too long
+// for this suite.
+TEST(Identification, SaysItsDerivativesAreNotSmoothWhereTheAnglesJump) {
+  sim::Config events = Nominal();
+  events.solver.hole_friction = sim::HoleFrictionModel::kEvents;
+  sim::ArmParameters truth = Truth();
+  truth.mu = truth.mu_s = 0.21;  // hole friction, which these recordings lack
+  events.parameters = truth;     // the fit's nominal values
+  const Experiment e = MakeExperiment(Record(truth, 0.03, 7, events), "events.h5", {});
+  IdentificationOptions o;
+  o.free_parameters = {"mu_c"};
+  o.max_iterations = 0;
+  o.threads = 2;
+  const IdentificationSummary s = Identify({e}, o);
+  const ParameterEstimate* mu_c = s.Find("mu_c");
+  ASSERT_NE(mu_c, nullptr);
+  EXPECT_GT(mu_c->derivative_step_disagreement, kDerivativeStepLimit);
+  EXPECT_THAT(s.BriefReport(), HasSubstr("derivatives NOT smooth in mu_c"));
+  EXPECT_THAT(s.FullReport(), HasSubstr("derivative check: NOT smooth"));
+}
+
 }  // namespace
 }  // namespace ccsrm::identify
