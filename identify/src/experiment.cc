@@ -33,6 +33,18 @@ std::optional<mocap::ZeroLagNoiseGain> LowPassNoiseGain(const Experiment& e) {
                                  static_cast<std::size_t>(f.min_run_frames));
 }
 
+// e->relative_noise from `gain` (null: no low-pass, 1 everywhere).
+void FillRelativeNoise(mocap::ZeroLagNoiseGain* gain, Experiment* e) {
+  const Eigen::MatrixXd& measured = e->measured_rad;
+  e->relative_noise = Eigen::MatrixXd::Ones(measured.rows(), measured.cols());
+  if (gain == nullptr) return;
+  for (Eigen::Index c = 0; c < measured.cols(); ++c) {
+    const std::vector<double> relative =
+        gain->Relative(measured.col(c).data(), static_cast<std::size_t>(measured.rows()));
+    e->relative_noise.col(c) = Eigen::Map<const Eigen::VectorXd>(relative.data(), measured.rows());
+  }
+}
+
 // Per joint: RMS about the median of the measured twist [deg], each frame's
 // deviation over the low-pass's relative noise there (the twist was filtered
 // like the angles), so that it is the interior's noise; NaN when a joint has
@@ -269,8 +281,8 @@ Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::s
     e.pipeline_report = processed->result.summary.BriefReport();
   }
   SetRecordedLowPass(file, path, &e);
-  SetRelativeNoise(&e);
   std::optional<mocap::ZeroLagNoiseGain> gain = LowPassNoiseGain(e);
+  FillRelativeNoise(gain ? &*gain : nullptr, &e);
   SetNoise(file, first, options, gain ? &*gain : nullptr, &e);
   return e;
 }
@@ -294,15 +306,8 @@ void Experiment::AsMeasured(Eigen::MatrixXd* angles_rad) const {
 }
 
 void SetRelativeNoise(Experiment* e) {
-  const Eigen::MatrixXd& measured = e->measured_rad;
-  e->relative_noise = Eigen::MatrixXd::Ones(measured.rows(), measured.cols());
   std::optional<mocap::ZeroLagNoiseGain> gain = LowPassNoiseGain(*e);
-  if (!gain) return;
-  for (Eigen::Index c = 0; c < measured.cols(); ++c) {
-    const std::vector<double> relative =
-        gain->Relative(measured.col(c).data(), static_cast<std::size_t>(measured.rows()));
-    e->relative_noise.col(c) = Eigen::Map<const Eigen::VectorXd>(relative.data(), measured.rows());
-  }
+  FillRelativeNoise(gain ? &*gain : nullptr, e);
 }
 
 Experiment LoadExperiment(const std::string& path, const ExperimentLoadOptions& options) {

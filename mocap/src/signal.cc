@@ -38,8 +38,6 @@ void FilterPass(const std::vector<BiquadSection>& sections, double* y, std::size
   }
 }
 
-// Value at x[0] of the least-squares line through x[0], x[step], ...,
-// x[(m-1)·step] (step = ±1): the end of a run with its noise averaged.
 // The runs [begin, end) of consecutive finite samples of x[0], x[stride],
 // ... x[(n-1)·stride], in order.
 std::vector<std::pair<std::size_t, std::size_t>> FiniteRuns(const double* x, std::size_t n,
@@ -59,6 +57,8 @@ std::vector<std::pair<std::size_t, std::size_t>> FiniteRuns(const double* x, std
   return runs;
 }
 
+// Value at x[0] of the least-squares line through x[0], x[step], ...,
+// x[(m-1)·step] (step = ±1): the end of a run with its noise averaged.
 double EndPivot(const double* x, std::size_t m, int step) {
   if (m < 2) return x[0];
   double sum_i = 0.0, sum_ii = 0.0, sum_x = 0.0, sum_ix = 0.0;
@@ -295,20 +295,14 @@ std::vector<double> ZeroLagNoiseGain::Relative(const double* x, std::size_t n, s
 }
 
 std::vector<Gap> FindGaps(const double* x, std::size_t n, std::size_t stride) {
+  // What lies between the finite runs.
   std::vector<Gap> gaps;
-  std::size_t i = 0;
-  while (i < n) {
-    if (std::isfinite(x[i * stride])) {
-      ++i;
-      continue;
-    }
-    Gap gap{i, 0};
-    while (i < n && !std::isfinite(x[i * stride])) {
-      ++gap.length;
-      ++i;
-    }
-    gaps.push_back(gap);
+  std::size_t next = 0;
+  for (const auto& [begin, end] : FiniteRuns(x, n, stride)) {
+    if (begin > next) gaps.push_back({next, begin - next});
+    next = end;
   }
+  if (next < n) gaps.push_back({next, n - next});
   return gaps;
 }
 
