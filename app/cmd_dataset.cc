@@ -8,11 +8,13 @@
 #include <string>
 #include <variant>
 
+#include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/number_text.h"
 #include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/datasets/inspect.h"
 #include "ccsrm/mocap/lab_recording.h"
+#include "ccsrm/mocap/pose_log.h"
 #include "ccsrm/sim_io/experiment_check.h"
 #include "commands.h"
 #include "output_kinds.h"
@@ -101,6 +103,57 @@ void AddDatasetCommands(CLI::App& root) {
       std::printf("%s\n", datasets::ToJson(summary).dump(2).c_str());
     } else {
       std::printf("%s", datasets::ToText(summary).c_str());
+    }
+  });
+
+  CLI::App* tendon_map = dataset->add_subcommand(
+      "tendon-map",
+      "Identify which actuator drives which tendon, with its sign and the reading at which it "
+      "engages, from a pose log that pulls one tendon at a time (CSV/TSV: time, pattern "
+      "label, actuator readings, tip position; docs/tdcr-recordings.md)");
+  struct TendonMapArgs {
+    std::string log, out;
+    mocap::PoseLogColumns columns;
+    mocap::TendonMapOptions options;
+    std::string axis = "z";
+  };
+  auto t = std::make_shared<TendonMapArgs>();
+  tendon_map->add_option("--log", t->log, "The pose log (CSV or TSV)")->required();
+  tendon_map
+      ->add_option("--tendons-per-segment", t->options.tendons_per_segment,
+                   "Tendons per segment, evenly spread around the backbone")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 15));
+  tendon_map->add_option("--axis", t->axis, "The arm's axis in the capture frame: x, y or z")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"x", "y", "z"}));
+  tendon_map
+      ->add_option("--actuator-prefix", t->columns.actuator_prefix,
+                   "Columns whose names start with this are the actuators' readings")
+      ->capture_default_str();
+  tendon_map->add_option("--label-column", t->columns.label, "Column of the pattern labels")
+      ->capture_default_str();
+  tendon_map->add_option("--time-column", t->columns.time, "Column of the time [s]")
+      ->capture_default_str();
+  tendon_map
+      ->add_option("--min-rows", t->options.min_rows,
+                   "A pattern of fewer rows is not a pull (a hold, a label's tail)")
+      ->capture_default_str()
+      ->check(CLI::Range(3, 1000000));
+  tendon_map->add_option("--out", t->out, "Write the map (ccsrm-tendon-map/1 YAML)");
+  tendon_map->callback([t] {
+    if (!t->out.empty()) {
+      CheckOut(t->out, YamlFileOutput(mocap::kTendonMapSchema, "tendon map"), {t->log});
+    }
+    t->options.axis = t->axis == "x" ? 0 : t->axis == "y" ? 1 : 2;
+    const mocap::PoseLog log = mocap::ReadPoseLog(t->log, t->columns);
+    const mocap::TendonMap map = mocap::IdentifyTendonMap(log, t->options);
+    std::printf("%s: %zu rows, %zu actuator columns; %zu tendons pulled one at a time\n%s",
+                t->log.c_str(), log.time_s.size(), log.actuator_columns.size(), map.tendons.size(),
+                map.Report().c_str());
+    if (!t->out.empty()) {
+      WriteTextFileAtomically(t->out, map.ToYaml(t->log));
+      std::printf("  output: %s\n", t->out.c_str());
     }
   });
 

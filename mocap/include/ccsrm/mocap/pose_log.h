@@ -1,0 +1,111 @@
+#pragma once
+// A lab's log of settled poses (issue 46): one row per commanded pose, the
+// actuators' readings and a tracked point (the tip marker), each row with
+// the label of the pattern it belongs to, as the tendon-driven robot's
+// recordings of ../shared/data/tdcr/ are written. And which actuator drives
+// which tendon, identified from a log that pulls one tendon at a time
+// (`ccsrm dataset tendon-map`): docs/tdcr-recordings.md says what such a
+// log holds.
+#include <Eigen/Core>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace ccsrm::mocap {
+
+inline constexpr const char* kTendonMapSchema = "ccsrm-tendon-map/1";
+
+// The columns of a pose log, by header name.
+struct PoseLogColumns {
+  std::string time = "timestamp";       // [s]
+  std::string label = "pattern_label";  // "" or absent from the header: no labels
+  // Every column whose name starts with this is an actuator's reading.
+  std::string actuator_prefix = "servo_";
+  std::array<std::string, 3> tip = {"tip_x", "tip_y", "tip_z"};
+};
+
+struct PoseLog {
+  std::string source_name;
+  std::vector<std::size_t> lines;             // file line of each row
+  std::vector<double> time_s;                 // as logged
+  std::vector<std::string> labels;            // per row; empty strings without a label column
+  std::vector<std::string> actuator_columns;  // header names, in file order
+  Eigen::MatrixXd actuators;                  // rows × actuators, in the columns' units
+  Eigen::MatrixXd tip;                        // rows × 3, in the log's units
+};
+
+// Parses a CSV (comma) or TSV (tab in the header) pose log: '#' and blank
+// lines skipped, the first other line the header. Throws InputError naming
+// the file, the line and the column: a named column missing from the
+// header, no actuator column, a cell that is not a finite number, time not
+// increasing, fewer than 2 rows.
+PoseLog ParsePoseLog(const std::string& text, const std::string& source_name,
+                     const PoseLogColumns& columns = {});
+PoseLog ReadPoseLog(const std::string& path, const PoseLogColumns& columns = {});
+
+struct TendonMapOptions {
+  // Tendons per segment, spread evenly around the backbone. Default 3.
+  int tendons_per_segment = 3;
+  // The arm's axis in the capture frame (0 x, 1 y, 2 z): the tip's motion
+  // across it is the bending. Default 2.
+  int axis = 2;
+  // A pattern of fewer rows is not a pull (a label's tail, a hold).
+  // Default 5.
+  int min_rows = 5;
+};
+
+// One tendon as the log shows it.
+struct TendonPull {
+  std::string label;   // the pattern that pulls it
+  std::string column;  // the actuator column that drives it
+  // +1 when the reading grows as the tendon is pulled in, −1 when it
+  // shrinks.
+  int sign = 1;
+  // The reading at which the tendon starts to bend the arm while pulled in
+  // (below it the tendon is slack), from a hinge fit of the tip's travel
+  // across the axis against the reading over the pull up to its peak.
+  double engagement = 0.0;
+  // Tip travel across the axis per unit of reading beyond the engagement
+  // [the log's tip units per reading unit], and the hinge fit's RMS.
+  double tip_per_unit = 0.0;
+  double fit_rms = 0.0;
+  // Direction the tip moves towards when the tendon is pulled, about the
+  // axis (from the first of the two other capture axes towards the
+  // second), in (−180, 180] deg: the tip's path from the pattern's last row
+  // back to its farthest one.
+  double azimuth_deg = 0.0;
+  int segment = 0;    // identified, 1 = proximal
+  int index = 0;      // within the segment, 0-based, by increasing azimuth
+  int labelled = -1;  // the tendon "tendon<K>" in the label names; −1: none
+};
+
+struct TendonMap {
+  int tendons_per_segment = 3;
+  std::vector<TendonPull> tendons;  // segment by segment, index by index
+  // RMS over every segment of its azimuth gaps' deviation from
+  // 360 / tendons_per_segment [deg]: how evenly the grouping spreads them.
+  double spacing_rms_deg = 0.0;
+  // Tendons whose label names the same tendon as identified
+  // ((segment − 1)·n + index), of those whose label names one.
+  int labels_agreeing = 0;
+  int labels_naming = 0;
+
+  // The table and the labels' agreement, for a terminal.
+  std::string Report() const;
+  // ccsrm-tendon-map/1 YAML.
+  std::string ToYaml(const std::string& source) const;
+};
+
+// Identifies the map from a log in which each pattern pulls one tendon
+// (every pattern of at least min_rows rows): its actuator (the column that
+// best follows the tip's travel across the axis), sign, engagement and
+// direction; then which tendons form a segment (the grouping whose
+// directions are closest to evenly spaced) and which segment is which (under
+// position control a proximal tendon moves the tip most per unit of pull).
+// Throws InputError naming the log: a number of pulls that is not a
+// multiple of tendons_per_segment, two pulls on one column, a pull that
+// does not move the tip, invalid options.
+TendonMap IdentifyTendonMap(const PoseLog& log, const TendonMapOptions& options = {});
+
+}  // namespace ccsrm::mocap
