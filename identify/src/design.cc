@@ -665,6 +665,36 @@ std::string PlannedMotionCsv(const sim::Config& prior, const std::string& protoc
   return csv;
 }
 
+namespace {
+
+// A checked plan's line of the report: smooth, with its largest
+// disagreement, or the parameters it is not smooth in.
+std::string DerivativeCheckLine(const CandidateInformation& c, const DesignOptions& options) {
+  std::string largest, rough;
+  double worst = -1.0;
+  for (std::size_t i = 0; i < c.parameters.size(); ++i) {
+    const double d = c.derivative_step_disagreement[i];
+    if (!(d <= kDerivativeStepLimit)) {
+      rough += (rough.empty() ? "" : ", ") + c.parameters[i] + " " +
+               (std::isfinite(d) ? Format("%.3g %%", 100.0 * d) : std::string("not computed"));
+    } else if (d > worst) {
+      worst = d;
+      largest = c.parameters[i] + " " + Format("%.3g %%", 100.0 * d);
+    }
+  }
+  return "  derivatives at the prior (relative steps " + Format("%.3g", options.relative_step) +
+         " and a third of it, as a fit checks its own), " + c.name + ": " +
+         (c.derivatives_smooth()
+              ? "smooth (largest disagreement " + largest + ")\n"
+              : "NOT smooth in " + rough + " (limit " +
+                    Format("%.0f", 100.0 * kDerivativeStepLimit) +
+                    " %): a fit of its recordings would not give these errors (the angles jump "
+                    "with the parameters there, as in stick-slip: docs/model-notes.md, issue "
+                    "43); ranked last\n");
+}
+
+}  // namespace
+
 std::string DesignSummary::FullReport() const {
   std::string out;
   out +=
@@ -719,29 +749,7 @@ std::string DesignSummary::FullReport() const {
     }
   }
   for (const std::size_t k : ranking) {
-    const CandidateInformation& c = candidates[k];
-    if (!c.derivatives_checked()) continue;
-    std::string largest, rough;
-    double worst = -1.0;
-    for (std::size_t i = 0; i < c.parameters.size(); ++i) {
-      const double d = c.derivative_step_disagreement[i];
-      if (!(d <= kDerivativeStepLimit)) {
-        rough += (rough.empty() ? "" : ", ") + c.parameters[i] + " " +
-                 (std::isfinite(d) ? Format("%.3g %%", 100.0 * d) : std::string("not computed"));
-      } else if (d > worst) {
-        worst = d;
-        largest = c.parameters[i] + " " + Format("%.3g %%", 100.0 * d);
-      }
-    }
-    out += "  derivatives at the prior (relative steps " + Format("%.3g", options.relative_step) +
-           " and a third of it, as a fit checks its own), " + c.name + ": " +
-           (c.derivatives_smooth()
-                ? "smooth (largest disagreement " + largest + ")\n"
-                : "NOT smooth in " + rough + " (limit " +
-                      Format("%.0f", 100.0 * kDerivativeStepLimit) +
-                      " %): a fit of its recordings would not give these errors (the angles "
-                      "jump with the parameters there, as in stick-slip: docs/model-notes.md, "
-                      "issue 43); ranked last\n");
+    if (candidates[k].derivatives_checked()) out += DerivativeCheckLine(candidates[k], options);
   }
   if (!options.prior_box.empty()) {
     std::string box;
