@@ -168,7 +168,7 @@ TEST(Design, ChecksTheBestPlansDerivativesAsAFitChecksItsOwn) {
   // the two runs per experiment and free parameter of the finer step on top
   // of its evaluation again.
   DesignOptions checked = Options();
-  checked.checked_candidates = 1;  // the default
+  checked.checked_candidates = 1;
   const DesignSummary smooth = EvaluateDesigns(plans, checked);
   const CandidateInformation& best = smooth.candidates[smooth.ranking.front()];
   ASSERT_TRUE(best.derivatives_checked());

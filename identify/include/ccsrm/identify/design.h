@@ -110,9 +110,10 @@ struct DesignOptions {
   // derivative for a free parameter moves by more than kDerivativeStepLimit
   // (5 %) is not smooth there, and ranks after every other plan. Checking
   // stops at the first smooth plan or after checked_candidates plans.
-  // Default 1: the plan the design recommends, and the next ones only while
-  // it is not smooth. 0: no check.
-  int checked_candidates = 1;
+  // Default 3: the plan the design recommends, and the next ones only while
+  // it is not (at the paper's friction one check, at static friction well
+  // above kinetic up to three). 0: no check.
+  int checked_candidates = 3;
 
   // False with the reason naming the field: no free parameter, an unknown or
   // repeated name, noise_deg or frame_rate_hz not positive,
