@@ -1,5 +1,7 @@
 #include "ccsrm/mocap/pose_log.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -178,10 +180,12 @@ TendonPull IdentifyPull(const PoseLog& log, std::size_t begin, std::size_t end,
   pull.engagement = hinge.x0 * pull.sign;
   pull.tip_per_unit = hinge.slope;
   pull.fit_rms = hinge.rms;
-  // Direction: from the pattern's last row back to its farthest.
+  // Direction: from the pattern's last row back to its farthest; from its
+  // first when it ends near its farthest (a pull not released).
   Eigen::Index far = 0;
-  travel.maxCoeff(&far);
-  const Eigen::Vector2d towards = across.row(far) - across.row(n - 1);
+  const double farthest = travel.maxCoeff(&far);
+  Eigen::Vector2d towards = across.row(far) - across.row(n - 1);
+  if (towards.norm() < 0.5 * farthest) towards = across.row(far);
   pull.azimuth_deg = Wrap180(std::atan2(towards.y(), towards.x()) * kDeg);
   static const std::regex kTendon("tendon(\\d+)");
   std::smatch m;
@@ -363,19 +367,28 @@ std::string TendonMap::Report() const {
 }
 
 std::string TendonMap::ToYaml(const std::string& source) const {
-  std::ostringstream out;
-  out << "schema: " << kTendonMapSchema << "\n";
-  out << "# Identified by ccsrm dataset tendon-map from " << source << "\n";
-  out << "tendons_per_segment: " << tendons_per_segment << "\n";
-  out << "spacing_rms_deg: " << spacing_rms_deg << "\n";
-  out << "tendons:\n";
+  YAML::Emitter out;
+  out << YAML::Comment("Identified by ccsrm dataset tendon-map from " + source);
+  out << YAML::BeginMap;
+  out << YAML::Key << "schema" << YAML::Value << kTendonMapSchema;
+  out << YAML::Key << "tendons_per_segment" << YAML::Value << tendons_per_segment;
+  out << YAML::Key << "spacing_rms_deg" << YAML::Value << spacing_rms_deg;
+  out << YAML::Key << "tendons" << YAML::Value << YAML::BeginSeq;
   for (const TendonPull& t : tendons) {
-    out << "  - {segment: " << t.segment << ", index: " << t.index << ", column: \"" << t.column
-        << "\", sign: " << t.sign << ", engagement: " << t.engagement
-        << ", tip_per_unit: " << t.tip_per_unit << ", azimuth_deg: " << t.azimuth_deg
-        << ", fit_rms: " << t.fit_rms << ", pattern: \"" << t.label << "\"}\n";
+    out << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "segment" << YAML::Value << t.segment;
+    out << YAML::Key << "index" << YAML::Value << t.index;
+    out << YAML::Key << "column" << YAML::Value << YAML::DoubleQuoted << t.column;
+    out << YAML::Key << "sign" << YAML::Value << t.sign;
+    out << YAML::Key << "engagement" << YAML::Value << t.engagement;
+    out << YAML::Key << "tip_per_unit" << YAML::Value << t.tip_per_unit;
+    out << YAML::Key << "azimuth_deg" << YAML::Value << t.azimuth_deg;
+    out << YAML::Key << "fit_rms" << YAML::Value << t.fit_rms;
+    out << YAML::Key << "pattern" << YAML::Value << YAML::DoubleQuoted << t.label;
+    out << YAML::EndMap;
   }
-  return out.str();
+  out << YAML::EndSeq << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
 }
 
 }  // namespace ccsrm::mocap

@@ -73,7 +73,8 @@ struct TendonPull {
   // Direction the tip moves towards when the tendon is pulled, about the
   // axis (from the first of the two other capture axes towards the
   // second), in (−180, 180] deg: the tip's path from the pattern's last row
-  // back to its farthest one.
+  // back to its farthest one (from its first, when the pull is not released
+  // by half).
   double azimuth_deg = 0.0;
   int segment = 0;    // identified, 1 = proximal
   int index = 0;      // within the segment, 0-based, by increasing azimuth
