@@ -224,13 +224,18 @@ std::vector<double> ArmDynamics::ErrorScales() const {
   // The smoothed hole friction is a function of the slip speed across a stick
   // band of v_eps (1e-6 m/s): the slip speeds are resolved to a tenth of it,
   // or the friction force follows the step sequence rather than the state.
-  // The presliding law slides, at its limit, only on loading (s_dot sgn(xi)
-  // > 0, joined over v_eps): slip-speed noise beyond v_eps at a node held at
-  // its limit would ratchet it along, so it needs the same resolution.
+  // The presliding law's force is its displacement's; the slip speed enters
+  // only its yield, which slides at the limit on loading (s_dot sgn(xi) > 0,
+  // joined over v_eps): slip-speed noise beyond v_eps at a node held at its
+  // limit would ratchet it along, so it needs v_eps. (A tenth of it, as
+  // before issue 43, left the 60 s hold drift and the paper's case 2 as they
+  // were, and held fast motions' steps 1.8x shorter.)
   if (solver_.hole_friction == HoleFrictionModel::kSmoothed ||
       solver_.hole_friction == HoleFrictionModel::kPresliding) {
+    const double resolution =
+        solver_.hole_friction == HoleFrictionModel::kSmoothed ? 0.1 : 1.0;  // of v_eps
     const double slip_scale =
-        0.1 * solver_.stick_velocity_tolerance_mps / solver_.absolute_tolerance;
+        resolution * solver_.stick_velocity_tolerance_mps / solver_.absolute_tolerance;
     for (const HoleNodeRef& hole : layout_.holes()) {
       double& s = scale[n_ + model_.node_offset(hole.cable, hole.node) + 3];
       s = std::min(s, slip_scale);
