@@ -32,11 +32,17 @@ void RunConfigCheck(const std::string& path) {
     std::string pattern;
     for (auto k : s.connecting_pattern) {
       pattern += pattern.empty() ? "" : "-";
-      pattern += k == sim::ConnectingKind::kSmallS ? "small" : "large";
+      pattern += sim::ConnectingWord(k);
     }
     std::printf("  %s: %d links of %.4g m, %.4g kg, holes at r = %.4g m, pattern %s\n",
                 s.name.c_str(), s.links, s.link_length_m, s.link_mass_kg, s.hole_circle_radius_m,
                 pattern.c_str());
+    if (s.backbone.present()) {
+      std::printf("    elastic backbone: E I = %.4g N m^2, %.4g N m/rad per joint (k_b = %.4g)\n",
+                  s.backbone.bending_stiffness_nm2(),
+                  c.parameters.k_b * s.backbone.bending_stiffness_nm2() / s.link_length_m,
+                  c.parameters.k_b);
+    }
   }
   std::printf("  driving cables: %zu (%d hole nodes)\n", c.arm.driving.cables.size(), holes);
   std::string parameters;

@@ -145,8 +145,8 @@ void AddParameters(py::module_& m) {
       });
 
   m.def("parameter_table", &sim::Parameters,
-        "The model's parameters (SPEC 6's nine, then v_s, v_c_s, tau_f, tau_c_f, xi_f, xi_c) "
-        "with units and bounds.");
+        "The model's parameters (SPEC 6's nine, then v_s, v_c_s, tau_f, tau_c_f, xi_f, xi_c, "
+        "k_b, c_b) with units and bounds.");
 
   py::class_<sim::EffectInfo>(m, "EffectInfo", "One effect of the effect library (SPEC 7).")
       .def_readonly("name", &sim::EffectInfo::name)

@@ -25,6 +25,8 @@ constexpr double kDegToRad = kPi / 180.0;
 constexpr const char* kSchema = "ccsrm-config/1";
 // The YAML words of HoleFrictionModel, in its order.
 const std::vector<std::string> kHoleFrictionWords = {"events", "smoothed", "off", "presliding"};
+// In ConnectingKind's order.
+const std::vector<std::string> kConnectingWords = {"small", "large", "none"};
 // The YAML words of ConduitFrictionModel, in its order.
 const std::vector<std::string> kConduitFrictionWords = {"modified_coulomb", "presliding"};
 // The YAML words of RungeKuttaStepper, in its order (GSL's names).
@@ -342,11 +344,30 @@ void CheckArm(const ArmConfig& arm, const Checker& check) {
                                                " entries, found " +
                                                std::to_string(s.connecting_pattern.size()));
     }
-    check.Positive(p + "small_s.cable_length_m", s.small_s.cable_length_m);
-    check.Positive(p + "small_s.pulley_radius_m", s.small_s.pulley_radius_m);
-    check.Positive(p + "large_s.cable_length_m", s.large_s.cable_length_m);
-    check.Positive(p + "large_s.pulley_radius_m", s.large_s.pulley_radius_m);
-    check.InRange(p + "large_s.wrap_angle_deg", s.large_s.wrap_angle_rad / kDegToRad, 0.0, 720.0);
+    if (s.uses(ConnectingKind::kSmallS)) {
+      check.Positive(p + "small_s.cable_length_m", s.small_s.cable_length_m);
+      check.Positive(p + "small_s.pulley_radius_m", s.small_s.pulley_radius_m);
+    }
+    if (s.uses(ConnectingKind::kLargeS)) {
+      check.Positive(p + "large_s.cable_length_m", s.large_s.cable_length_m);
+      check.Positive(p + "large_s.pulley_radius_m", s.large_s.pulley_radius_m);
+      check.InRange(p + "large_s.wrap_angle_deg", s.large_s.wrap_angle_rad / kDegToRad, 0.0, 720.0);
+    }
+    // A joint with neither a connecting mechanism on either side nor a
+    // backbone would be free: its segment's cables alone cannot hold a chain
+    // of joints (they bend it, they do not set how).
+    if (s.uses(ConnectingKind::kNone) && !s.backbone.present()) {
+      check.Fail(p + "connecting_pattern",
+                 "'none' needs an elastic backbone (arm.segments[].backbone) to hold its joints");
+    }
+    if (s.backbone.present()) {
+      check.Positive(p + "backbone.outer_diameter_m", s.backbone.outer_diameter_m);
+      check.InRange(p + "backbone.inner_diameter_m", s.backbone.inner_diameter_m, 0.0,
+                    s.backbone.outer_diameter_m);
+      if (!(s.backbone.inner_diameter_m < s.backbone.outer_diameter_m)) {
+        check.Fail(p + "backbone.inner_diameter_m", "must be below outer_diameter_m");
+      }
+    }
   }
   const DrivingCableConfig& d = arm.driving;
   check.Positive("driving_cables.youngs_modulus_pa", d.youngs_modulus_pa);
@@ -432,10 +453,18 @@ void CheckArmRanges(const ArmConfig& arm, const Checker& check) {
     in(p + "link_mass_kg", s.link_mass_kg, kLinkMass);
     for (int k = 0; k < 3; ++k) in(p + "link_inertia_kgm2", s.link_inertia_kgm2[k], kLinkInertia);
     in(p + "hole_circle_radius_m", s.hole_circle_radius_m, kDiskSize);
-    in(p + "small_s.cable_length_m", s.small_s.cable_length_m, kConnectingCableLength);
-    in(p + "small_s.pulley_radius_m", s.small_s.pulley_radius_m, kDiskSize);
-    in(p + "large_s.cable_length_m", s.large_s.cable_length_m, kConnectingCableLength);
-    in(p + "large_s.pulley_radius_m", s.large_s.pulley_radius_m, kDiskSize);
+    if (s.uses(ConnectingKind::kSmallS)) {
+      in(p + "small_s.cable_length_m", s.small_s.cable_length_m, kConnectingCableLength);
+      in(p + "small_s.pulley_radius_m", s.small_s.pulley_radius_m, kDiskSize);
+    }
+    if (s.uses(ConnectingKind::kLargeS)) {
+      in(p + "large_s.cable_length_m", s.large_s.cable_length_m, kConnectingCableLength);
+      in(p + "large_s.pulley_radius_m", s.large_s.pulley_radius_m, kDiskSize);
+    }
+    if (s.backbone.present()) {
+      in(p + "backbone.youngs_modulus_pa", s.backbone.youngs_modulus_pa, kYoungsModulus);
+      in(p + "backbone.outer_diameter_m", s.backbone.outer_diameter_m, kDiskSize);
+    }
   }
   const DrivingCableConfig& d = arm.driving;
   in("driving_cables.youngs_modulus_pa", d.youngs_modulus_pa, kYoungsModulus);
@@ -740,6 +769,20 @@ int ArmConfig::segment_of_link(int link) const {
   return -1;
 }
 
+double BackboneGeometry::bending_stiffness_nm2() const {
+  const double d4 = std::pow(outer_diameter_m, 4) - std::pow(inner_diameter_m, 4);
+  return youngs_modulus_pa * kPi * d4 / 64.0;
+}
+
+bool SegmentConfig::uses(ConnectingKind kind) const {
+  return std::find(connecting_pattern.begin(), connecting_pattern.end(), kind) !=
+         connecting_pattern.end();
+}
+
+const std::string& ConnectingWord(ConnectingKind kind) {
+  return kConnectingWords.at(static_cast<std::size_t>(kind));
+}
+
 const std::string& HoleFrictionWord(HoleFrictionModel model) {
   return kHoleFrictionWords.at(static_cast<std::size_t>(model));
 }
@@ -777,19 +820,33 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
       seg.link_mass_kg = s.Number("link_mass_kg");
       seg.link_inertia_kgm2 = s.Vector3("link_inertia_kgm2");
       seg.hole_circle_radius_m = s.Number("hole_circle_radius_m");
-      for (int kind : s.WordList("connecting_pattern", {"small", "large"})) {
-        seg.connecting_pattern.push_back(kind == 0 ? ConnectingKind::kSmallS
-                                                   : ConnectingKind::kLargeS);
+      for (int kind : s.WordList("connecting_pattern", kConnectingWords)) {
+        seg.connecting_pattern.push_back(static_cast<ConnectingKind>(kind));
       }
-      MapReader small = s.Section("small_s");
-      seg.small_s.cable_length_m = small.Number("cable_length_m");
-      seg.small_s.pulley_radius_m = small.Number("pulley_radius_m");
-      small.Finish();
-      MapReader large = s.Section("large_s");
-      seg.large_s.cable_length_m = large.Number("cable_length_m");
-      seg.large_s.pulley_radius_m = large.Number("pulley_radius_m");
-      seg.large_s.wrap_angle_rad = large.Number("wrap_angle_deg") * kDegToRad;
-      large.Finish();
+      // A mechanism's geometry is needed where the pattern has it.
+      if (seg.uses(ConnectingKind::kSmallS) || s.Has("small_s")) {
+        MapReader small = s.Section("small_s");
+        seg.small_s.cable_length_m = small.Number("cable_length_m");
+        seg.small_s.pulley_radius_m = small.Number("pulley_radius_m");
+        small.Finish();
+      }
+      if (seg.uses(ConnectingKind::kLargeS) || s.Has("large_s")) {
+        MapReader large = s.Section("large_s");
+        seg.large_s.cable_length_m = large.Number("cable_length_m");
+        seg.large_s.pulley_radius_m = large.Number("pulley_radius_m");
+        seg.large_s.wrap_angle_rad = large.Number("wrap_angle_deg") * kDegToRad;
+        large.Finish();
+      }
+      if (s.Has("backbone")) {
+        MapReader rod = s.Section("backbone");
+        seg.backbone.youngs_modulus_pa = rod.Number("youngs_modulus_pa");
+        seg.backbone.outer_diameter_m = rod.Number("outer_diameter_m");
+        seg.backbone.inner_diameter_m = rod.OptionalNumber("inner_diameter_m", 0.0);
+        if (!(seg.backbone.youngs_modulus_pa > 0.0)) {
+          rod.Fail("youngs_modulus_pa", rod.Node("youngs_modulus_pa"), "must be > 0");
+        }
+        rod.Finish();
+      }
       c.arm.segments.push_back(seg);
     });
     arm.Finish();
@@ -820,6 +877,17 @@ Config ParseConfig(const std::string& yaml_text, const std::string& source_name)
     has_conduit_stribeck = k.Has("stribeck_velocity_mps");
     ReadParameters(k, &c.parameters);
     k.Finish();
+  }
+  // The elastic backbone's parameters: optional, as an arm without one
+  // (every CCSRM) has nothing for them to act on.
+  if (top.Has("backbone")) {
+    MapReader b = top.Section("backbone");
+    ReadParameters(b, &c.parameters);
+    b.Finish();
+  } else {
+    for (const ParameterInfo& p : Parameters()) {
+      if (p.config_key.rfind("backbone.", 0) == 0) c.parameters.*p.field = p.absent_value;
+    }
   }
   {
     MapReader s = top.Section("solver");
@@ -926,18 +994,28 @@ std::string ToYaml(const Config& c) {
     vec3(s.link_inertia_kgm2);
     out << YAML::Key << "hole_circle_radius_m" << YAML::Value << s.hole_circle_radius_m;
     out << YAML::Key << "connecting_pattern" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-    for (ConnectingKind k : s.connecting_pattern)
-      out << (k == ConnectingKind::kSmallS ? "small" : "large");
+    for (ConnectingKind k : s.connecting_pattern) out << ConnectingWord(k);
     out << YAML::EndSeq;
-    out << YAML::Key << "small_s" << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "cable_length_m" << YAML::Value << s.small_s.cable_length_m;
-    out << YAML::Key << "pulley_radius_m" << YAML::Value << s.small_s.pulley_radius_m;
-    out << YAML::EndMap;
-    out << YAML::Key << "large_s" << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "cable_length_m" << YAML::Value << s.large_s.cable_length_m;
-    out << YAML::Key << "pulley_radius_m" << YAML::Value << s.large_s.pulley_radius_m;
-    out << YAML::Key << "wrap_angle_deg" << YAML::Value << s.large_s.wrap_angle_rad / kDegToRad;
-    out << YAML::EndMap;
+    if (s.uses(ConnectingKind::kSmallS)) {
+      out << YAML::Key << "small_s" << YAML::Value << YAML::BeginMap;
+      out << YAML::Key << "cable_length_m" << YAML::Value << s.small_s.cable_length_m;
+      out << YAML::Key << "pulley_radius_m" << YAML::Value << s.small_s.pulley_radius_m;
+      out << YAML::EndMap;
+    }
+    if (s.uses(ConnectingKind::kLargeS)) {
+      out << YAML::Key << "large_s" << YAML::Value << YAML::BeginMap;
+      out << YAML::Key << "cable_length_m" << YAML::Value << s.large_s.cable_length_m;
+      out << YAML::Key << "pulley_radius_m" << YAML::Value << s.large_s.pulley_radius_m;
+      out << YAML::Key << "wrap_angle_deg" << YAML::Value << s.large_s.wrap_angle_rad / kDegToRad;
+      out << YAML::EndMap;
+    }
+    if (s.backbone.present()) {
+      out << YAML::Key << "backbone" << YAML::Value << YAML::BeginMap;
+      out << YAML::Key << "youngs_modulus_pa" << YAML::Value << s.backbone.youngs_modulus_pa;
+      out << YAML::Key << "outer_diameter_m" << YAML::Value << s.backbone.outer_diameter_m;
+      out << YAML::Key << "inner_diameter_m" << YAML::Value << s.backbone.inner_diameter_m;
+      out << YAML::EndMap;
+    }
     out << YAML::EndMap;
   }
   out << YAML::EndSeq << YAML::EndMap;
@@ -963,6 +1041,14 @@ std::string ToYaml(const Config& c) {
   out << YAML::Key << "cross_section_m2" << YAML::Value << cc.cross_section_m2;
   WriteParameters("connecting_cables", c.parameters, &out);
   out << YAML::EndMap;
+  // Only for an arm with a backbone, so that every other writes back as before.
+  bool has_backbone = false;
+  for (const SegmentConfig& s : c.arm.segments) has_backbone |= s.backbone.present();
+  if (has_backbone) {
+    out << YAML::Key << "backbone" << YAML::Value << YAML::BeginMap;
+    WriteParameters("backbone", c.parameters, &out);
+    out << YAML::EndMap;
+  }
 
   const SolverConfig& s = c.solver;
   out << YAML::Key << "solver" << YAML::Value << YAML::BeginMap;

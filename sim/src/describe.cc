@@ -28,7 +28,10 @@ bool SameSegment(const SegmentConfig& a, const SegmentConfig& b) {
          Same(a.small_s.pulley_radius_m, b.small_s.pulley_radius_m) &&
          Same(a.large_s.cable_length_m, b.large_s.cable_length_m) &&
          Same(a.large_s.pulley_radius_m, b.large_s.pulley_radius_m) &&
-         Same(a.large_s.wrap_angle_rad, b.large_s.wrap_angle_rad);
+         Same(a.large_s.wrap_angle_rad, b.large_s.wrap_angle_rad) &&
+         Same(a.backbone.youngs_modulus_pa, b.backbone.youngs_modulus_pa) &&
+         Same(a.backbone.outer_diameter_m, b.backbone.outer_diameter_m) &&
+         Same(a.backbone.inner_diameter_m, b.backbone.inner_diameter_m);
 }
 
 std::string Number(double value) {

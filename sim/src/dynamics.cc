@@ -312,6 +312,7 @@ bool ArmDynamics::Evaluate(double t, const double* y, double* ydot) {
   AddHoleFriction(q, qd, y + memory_offset());   // eqs. 8-12, stick-slip
   ComputeJointAngles();                          // eqs. 23-29
   AddConnectingMoments(t, y + memory_offset());  // eqs. 38-53
+  AddBackboneMoments();                          // an elastic backbone (BackboneGeometry)
   AddEffectLoads(t, qd);                         // effects/effect.h
   ApplyJointMoments(q);                          // eqs. 54-58
   AddLinkInertia(q, qd);                         // eqs. 30-34
@@ -698,15 +699,46 @@ void ArmDynamics::AddEffectLoads(double t, const double* qd) {
   for (const Effect* effect : load_effects_) effect->AddLoads(effect_loads_.get());
 }
 
+// An elastic backbone's bending moments, M = -k theta - c theta_dot on
+// every joint and axis of its segments (k = k_b E I / l, c = c_b). Its
+// energy k theta^2 / 2 is elastic, c theta_dot^2 dissipated. Model smoothing
+// as for the connecting springs (smooth_connecting_elasticity): the moment
+// sees the acceleration part of its average over h, (h^2/6) k + (h/2) c on
+// the joint's inertia, which caps the joints' bending modes (a stiff rod on
+// light disks) near sqrt(6)/h.
+void ArmDynamics::AddBackboneMoments() {
+  const double h = solver_.smoothing_step_s;
+  for (int j = 1; j <= model_.num_joints(); ++j) {
+    const double k = parameters_.k_b * model_.backbone_stiffness_nmprad(j);
+    if (k == 0.0) continue;
+    const double c = parameters_.c_b;
+    for (int axis = 0; axis < 2; ++axis) {
+      const double angle = theta_[j - 1][axis], rate = theta_dot_[j - 1][axis];
+      joint_moment_[j - 1][axis] += -k * angle - c * rate;
+      elastic_ += 0.5 * k * angle * angle;
+      dissipation_ += c * rate * rate;
+      if (solver_.smooth_connecting_elasticity && h > 0.0) {
+        AddJointSmoothingMass(j, axis, k * h * h / 6.0 + c * h / 2.0);
+      }
+    }
+  }
+}
+
 void ArmDynamics::AddEffectJointMoment(int joint, int axis, double moment, double damping) {
   joint_moment_[joint - 1][axis] += moment;
   const double h = solver_.smoothing_step_s;
   if (!(damping > 0.0) || !(h > 0.0)) return;
   // Model smoothing of the damping (as for the conduit friction, model
   // notes row 6): the moment sees theta_dot + (h/2) theta_dd, which adds
-  // (h/2) damping J^T J to the mass, J the joint rate's row over the
-  // quaternions of links joint - 1 and joint. The joint's orientation row
-  // (eq. 37) spans exactly those columns, so its block holds the entries.
+  // (h/2) damping to the joint's inertia.
+  AddJointSmoothingMass(joint, axis, 0.5 * h * damping);
+}
+
+// mass J^T J into the mass matrix, J the joint rate's row over the
+// quaternions of links joint - 1 and joint, and the power of the smoothing
+// moment -mass theta_dd booked as dissipation. The joint's orientation row
+// (eq. 37) spans exactly those columns, so its block holds the entries.
+void ArmDynamics::AddJointSmoothingMass(int joint, int axis, double mass) {
   const int r = m_ - 4 * model_.num_joints() + 4 * (joint - 1) + 3;
   const ConstraintRowLayout& cols = layout_.rows()[r];
   const int first_link = joint > 1 ? joint - 1 : joint;
@@ -717,7 +749,6 @@ void ArmDynamics::AddEffectJointMoment(int joint, int axis, double moment, doubl
   for (int link = first_link, l = 0; link <= joint; ++link, ++l) {
     jac.segment<4>(4 * l) = JointRateRow(joint, link, axis);
   }
-  const double mass = 0.5 * h * damping;
   double* values = system_.values();
   const int* block = layout_.row_block(r);
   for (int a = 0, k = 0; a < width; ++a)

@@ -109,6 +109,7 @@ class ArmDynamics {
   void AddPreslidingFriction(int h, int s_col, double t_before, double v, const double* memory);
   void ComputeJointAngles();
   void AddConnectingMoments(double t, const double* memory);
+  void AddBackboneMoments();
   void AddEffectLoads(double t, const double* qd);
   void ApplyJointMoments(const double* q);
   void AddLinkInertia(const double* q, const double* qd);
@@ -128,6 +129,8 @@ class ArmDynamics {
   // Joint-space moment on joint `joint`'s `axis` from an effect, with the
   // model smoothing of its damping (EffectLoads::AddJointMoment).
   void AddEffectJointMoment(int joint, int axis, double moment, double damping);
+  // Model smoothing's `mass` [kg m^2] on joint `joint`'s angle `axis`.
+  void AddJointSmoothingMass(int joint, int axis, double mass);
 
   // Phi, its Baumgarte right-hand side b and (with_jacobian) Phi_q of every
   // row (eqs. 35-37, 61-63); needs the link rotations.

@@ -23,7 +23,12 @@ ArmModel::ArmModel(const ArmConfig& arm_config) : arm_(arm_config) {
       link.inertia_kgm2 = seg.link_inertia_kgm2;
       links_.push_back(link);
     }
+    for (int k = 0; k < seg.links; ++k) {
+      backbone_stiffness_nmprad_.push_back(
+          seg.backbone.present() ? seg.backbone.bending_stiffness_nm2() / seg.link_length_m : 0.0);
+    }
     for (int k = 0; k + 1 < seg.links; ++k) {
+      if (seg.connecting_pattern[k] == ConnectingKind::kNone) continue;
       ConnectingPairModel pair;
       pair.kind = seg.connecting_pattern[k];
       pair.joint_i = first_link + k;

@@ -202,6 +202,13 @@ const std::vector<ParameterInfo>& Parameters() {
        "presliding displacement of the large-S conduits: elastic travel of a couple before its "
        "friction reaches the limit (conduit_friction: presliding)",
        &P::xi_c, 1e-5},
+      // A scale on the rod's nominal E I / l: a superelastic rod's modulus
+      // is known to tens of per cent (austenite 40-90 GPa) and the lumped
+      // joints stand for a continuous rod, so two decades either side.
+      {"k_b", "backbone.stiffness_scale", "1", 0.01, 100.0,
+       "scale on the elastic backbone's bending stiffness E I / l per joint", &P::k_b, 1.0},
+      {"c_b", "backbone.damping_nmsprad", "N m s/rad", 0.0, 10.0,
+       "damping of each elastic backbone joint and axis", &P::c_b, 0.0},
   };
   return parameters;
 }

@@ -145,10 +145,11 @@ TEST(Generate, RejectsUnknownParametersAndBadValuesWithOneLine) {
       RunCcsrm("generate --config " + Paper() + " --set mu_x=0.1 --out /tmp/ccsrm_never.h5");
   EXPECT_EQ(unknown.status, 2);
   EXPECT_EQ(ccsrm::testing::CountLines(unknown.err), 1) << unknown.err;
-  EXPECT_THAT(unknown.err,
-              HasSubstr("unknown parameter 'mu_x' (known: mu, mu_s, mu_c, mu_c_s, "
-                        "beta, c_sc, c_lc, T_p, T_d0, v_s, v_c_s, tau_f, tau_c_f, xi_f, xi_c; "
-                        "effects' parameters as <effect>.<parameter>"));
+  EXPECT_THAT(
+      unknown.err,
+      HasSubstr("unknown parameter 'mu_x' (known: mu, mu_s, mu_c, mu_c_s, "
+                "beta, c_sc, c_lc, T_p, T_d0, v_s, v_c_s, tau_f, tau_c_f, xi_f, xi_c, k_b, c_b; "
+                "effects' parameters as <effect>.<parameter>"));
   const Outcome bounds =
       RunCcsrm("generate --config " + Paper() + " --set mu=3 --out /tmp/ccsrm_never.h5");
   EXPECT_EQ(bounds.status, 2);

@@ -29,9 +29,9 @@ std::string ErrorOf(const std::function<void()>& f) {
 TEST(Parameters, SpecNamesInOrderEachMappedToItsConfigField) {
   std::vector<std::string> names;
   for (const ParameterInfo& p : Parameters()) names.push_back(p.name);
-  EXPECT_EQ(names,
-            (std::vector<std::string>{"mu", "mu_s", "mu_c", "mu_c_s", "beta", "c_sc", "c_lc", "T_p",
-                                      "T_d0", "v_s", "v_c_s", "tau_f", "tau_c_f", "xi_f", "xi_c"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"mu", "mu_s", "mu_c", "mu_c_s", "beta", "c_sc", "c_lc",
+                                             "T_p", "T_d0", "v_s", "v_c_s", "tau_f", "tau_c_f",
+                                             "xi_f", "xi_c", "k_b", "c_b"}));
   const ArmParameters c = Paper().parameters;
   EXPECT_EQ(GetParameter(c, "mu"), c.mu);
   EXPECT_EQ(GetParameter(c, "T_d0"), 100.0);
@@ -61,10 +61,15 @@ TEST(Parameters, OutOfBoundsValueGetsOneMessageFromEveryDoor) {
     // A configuration file: the parameter's key in its cable section.
     const std::string key = p.config_key.substr(p.config_key.find('.') + 1);
     const std::string section = p.config_key.substr(0, p.config_key.find('.'));
-    const std::size_t at = text.find("\n  " + key + ":", text.find(section + ":"));
-    ASSERT_NE(at, std::string::npos) << p.config_key;
-    const std::size_t end = text.find('\n', at + 1);
+    // An optional section the paper's arm has no use for (backbone) is
+    // added.
     std::string edited = text;
+    if (text.find("\n" + section + ":") == std::string::npos) {
+      edited += section + ":\n  " + key + ": 1\n";
+    }
+    const std::size_t at = edited.find("\n  " + key + ":", edited.find(section + ":"));
+    ASSERT_NE(at, std::string::npos) << p.config_key;
+    const std::size_t end = edited.find('\n', at + 1);
     edited.replace(at, end - at, "\n  " + key + ": " + std::to_string(value));
     const std::string from_config = ErrorOf([&] { ParseConfig(edited, "arm.yaml"); });
     EXPECT_THAT(from_config, HasSubstr("key '" + p.config_key + "': " + expected));
@@ -97,10 +102,12 @@ TEST(Parameters, AssignmentsParseAndBadOnesNameTheProblem) {
   EXPECT_EQ(ParseParameterAssignment("mu=0.18", "--set"), std::make_pair(std::string("mu"), 0.18));
   EXPECT_THAT(ErrorOf([] { ParseParameterAssignment("mu", "--set"); }),
               HasSubstr("--set: 'mu': expected name=value"));
-  EXPECT_THAT(ErrorOf([] { ParseParameterAssignment("nu=1", "--set"); }),
-              HasSubstr("unknown parameter 'nu' (known: mu, mu_s, mu_c, mu_c_s, beta, c_sc, c_lc, "
-                        "T_p, T_d0, v_s, v_c_s, tau_f, tau_c_f, xi_f, xi_c; effects' parameters as "
-                        "<effect>.<parameter>"));
+  EXPECT_THAT(
+      ErrorOf([] { ParseParameterAssignment("nu=1", "--set"); }),
+      HasSubstr(
+          "unknown parameter 'nu' (known: mu, mu_s, mu_c, mu_c_s, beta, c_sc, c_lc, "
+          "T_p, T_d0, v_s, v_c_s, tau_f, tau_c_f, xi_f, xi_c, k_b, c_b; effects' parameters as "
+          "<effect>.<parameter>"));
   EXPECT_THAT(ErrorOf([] { ParseParameterAssignment("mu=0.1x", "--set"); }),
               HasSubstr("value '0.1x' is not a number"));
   // Numbers a double cannot hold say so, not that they are no number.

@@ -39,8 +39,9 @@ enum class ConduitFrictionModel { kModifiedCoulomb, kPresliding };
 enum class RungeKuttaStepper { kCashKarp, kFehlberg };
 
 // Kind of cable-constrained synchronous rotating mechanism between two
-// adjacent joints of a segment.
-enum class ConnectingKind { kSmallS, kLargeS };
+// adjacent joints of a segment; kNone: no mechanism (a segment whose joints
+// are held by an elastic backbone instead, BackboneGeometry).
+enum class ConnectingKind { kSmallS, kLargeS, kNone };
 
 // Small "S": a linear torsional spring-damper (eqs. 38-43).
 struct SmallSGeometry {
@@ -55,6 +56,20 @@ struct LargeSGeometry {
   double wrap_angle_rad = 0.0;   // Theta_lc
 };
 
+// An elastic backbone rod through the centres of a segment's disks (a
+// tendon-driven continuum robot's superelastic rod): every joint of the
+// segment bends against k_b E I / l per axis, l = link_length_m (the rod
+// between two joints), I = pi (D^4 - d^4) / 64, and is damped by c_b
+// (ArmParameters). The universal joints have no torsion, so the rod's G J
+// has nothing to act on. Absent: youngs_modulus_pa = 0.
+struct BackboneGeometry {
+  double youngs_modulus_pa = 0.0;  // E
+  double outer_diameter_m = 0.0;   // D
+  double inner_diameter_m = 0.0;   // d: 0 for a solid rod
+  bool present() const { return youngs_modulus_pa > 0.0; }
+  double bending_stiffness_nm2() const;  // E I [N m^2]
+};
+
 struct SegmentConfig {
   std::string name;
   int links = 0;
@@ -63,8 +78,10 @@ struct SegmentConfig {
   Eigen::Vector3d link_inertia_kgm2 = Eigen::Vector3d::Zero();  // diagonal, link frame
   double hole_circle_radius_m = 0.0;
   std::vector<ConnectingKind> connecting_pattern;  // links - 1 entries
-  SmallSGeometry small_s;
-  LargeSGeometry large_s;
+  SmallSGeometry small_s;                          // needed when the pattern has a small S
+  LargeSGeometry large_s;                          // needed when the pattern has a large S
+  BackboneGeometry backbone;
+  bool uses(ConnectingKind kind) const;
 };
 
 struct DrivingCableRoute {
@@ -123,7 +140,8 @@ struct SolverConfig {
   bool smooth_connecting_friction = true;
   // Extends model smoothing to the connecting-cable springs and dampers (see
   // docs/model-notes.md): their torsional modes (150-300 Hz against the link
-  // inertia) otherwise cap explicit steps near 1.7 ms.
+  // inertia) otherwise cap explicit steps near 1.7 ms. An elastic backbone's
+  // joints likewise (row 29).
   bool smooth_connecting_elasticity = true;
   // Extends model smoothing to the presliding laws' relaxation to their
   // limit (docs/model-notes.md row 28): sliding fast, it runs at |v|/xi_ss
@@ -194,6 +212,8 @@ struct Config {
 // Config::warnings.
 Config ParseConfig(const std::string& yaml_text, const std::string& source_name);
 
+// The YAML word of a connecting_pattern entry ("small", "large", "none").
+const std::string& ConnectingWord(ConnectingKind kind);
 // The YAML word of a hole friction treatment ("events", "smoothed", ...).
 const std::string& HoleFrictionWord(HoleFrictionModel model);
 // The YAML word of a ConduitFrictionModel ("modified_coulomb", "presliding").

@@ -99,6 +99,11 @@ class ArmModel {
   // contact between disks, so a plan beyond it is refused and a run that
   // reaches it stops (docs/model-notes.md row 27).
   double joint_range_rad(int joint) const { return joint_range_rad_[joint - 1]; }
+  // E I / l [N m/rad] of the elastic backbone at joint `joint` (its
+  // segment's, BackboneGeometry), before the scale k_b; 0 without one.
+  double backbone_stiffness_nmprad(int joint) const {
+    return backbone_stiffness_nmprad_[joint - 1];
+  }
   // The hole circle radius R [m] that sets joint i's range.
   double joint_disk_radius_m(int joint) const { return joint_disk_radius_m_[joint - 1]; }
 
@@ -117,6 +122,7 @@ class ArmModel {
   std::vector<std::vector<int>> node_offsets_;
   std::vector<int> link_offsets_;
   std::vector<double> joint_range_rad_, joint_disk_radius_m_;
+  std::vector<double> backbone_stiffness_nmprad_;  // per joint, index joint - 1
   int num_coordinates_ = 0;
   std::shared_ptr<const internal::SparseLayout> sparse_layout_;  // immutable, shared by copies
 };

@@ -62,6 +62,11 @@ struct ArmParameters {
   // elastically in its conduit before its friction reaches the limit, under
   // solver.conduit_friction: presliding (no effect otherwise) [m].
   double xi_c = 0.0;
+  // Elastic backbone (BackboneGeometry): a scale on every backbone joint's
+  // bending stiffness E I / l [1], and its damping per joint and axis
+  // [N m s/rad]. No effect on an arm without a backbone.
+  double k_b = 0.0;
+  double c_b = 0.0;
 
   // Effects (ccsrm/sim/effects.h): the physics the paper's model lacks, each
   // off by default. An effect is on once enabled (EnableEffect, a
@@ -133,7 +138,7 @@ struct ParameterInfo {
 
 // The model's named parameters: SPEC 6's nine in its order (mu, mu_s, mu_c,
 // mu_c_s, beta, c_sc, c_lc, T_p, T_d0), then v_s, v_c_s, tau_f, tau_c_f,
-// xi_f, xi_c.
+// xi_f, xi_c, k_b, c_b.
 // Every entry has a field.
 const std::vector<ParameterInfo>& Parameters();
 
