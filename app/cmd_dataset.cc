@@ -2,15 +2,18 @@
 // ccsrm dataset assemble --markers rec.c3d --actuators log.csv --actuator-map map.yaml
 //   --config arm.yaml [--rigid-bodies rb.yaml] [--static-trial FILE]
 //   [--sync trigger|estimate|estimate-kinematic|offset=S] [--params prior.yaml] --out exp.h5
+// ccsrm dataset tendon-map --log pulls.csv [--out map.yaml] [--actuator-map actuators.yaml]
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/number_text.h"
+#include "ccsrm/common/output_policy.h"
 #include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/datasets/inspect.h"
 #include "ccsrm/mocap/lab_recording.h"
@@ -112,7 +115,7 @@ void AddDatasetCommands(CLI::App& root) {
       "engages, from a pose log that pulls one tendon at a time (CSV/TSV: time, pattern "
       "label, actuator readings, tip position; docs/tdcr-recordings.md)");
   struct TendonMapArgs {
-    std::string log, out;
+    std::string log, out, actuator_map, unit = "mm";
     mocap::PoseLogColumns columns;
     mocap::TendonMapOptions options;
     std::string axis = "z";
@@ -141,9 +144,23 @@ void AddDatasetCommands(CLI::App& root) {
       ->capture_default_str()
       ->check(CLI::Range(3, 1000000));
   tendon_map->add_option("--out", t->out, "Write the map (ccsrm-tendon-map/1 YAML)");
+  tendon_map->add_option(
+      "--actuator-map", t->actuator_map,
+      "Write the map as the actuators' (ccsrm-actuators/1 YAML: column, sign and "
+      "zero of every cable, tendon k as cable k)");
+  tendon_map->add_option("--unit", t->unit, "Unit of the actuators' readings (m or mm)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"m", "mm"}));
   tendon_map->callback([t] {
     if (!t->out.empty()) {
       CheckOut(t->out, YamlFileOutput(mocap::kTendonMapSchema, "tendon map"), {t->log});
+    }
+    if (!t->actuator_map.empty()) {
+      // Neither the log nor the other output.
+      std::vector<std::string> not_these = {t->log};
+      if (!t->out.empty()) not_these.push_back(t->out);
+      CheckOutputPath(t->actuator_map, "--actuator-map",
+                      YamlFileOutput("ccsrm-actuators/1", "actuator map"), not_these);
     }
     t->options.axis = t->axis == "x" ? 0 : t->axis == "y" ? 1 : 2;
     const mocap::PoseLog log = mocap::ReadPoseLog(t->log, t->columns);
@@ -154,6 +171,11 @@ void AddDatasetCommands(CLI::App& root) {
     if (!t->out.empty()) {
       WriteTextFileAtomically(t->out, map.ToYaml(t->log));
       std::printf("  output: %s\n", t->out.c_str());
+    }
+    if (!t->actuator_map.empty()) {
+      WriteTextFileAtomically(t->actuator_map,
+                              map.ActuatorMapYaml(t->log, t->columns.time, t->unit));
+      std::printf("  actuator map: %s\n", t->actuator_map.c_str());
     }
   });
 

@@ -156,7 +156,7 @@ ActuatorMap ParseActuatorMap(const std::string& yaml_text, const std::string& fi
     if (!node.IsMap()) Fail(file, node, path, "expected a mapping with 'column' and 'signal'");
     ExpectKeys(file, node, path,
                {"column", "signal", "unit", "drum_radius_m", "gear_ratio", "sign",
-                "counts_per_turn", "wrap_counts"});
+                "counts_per_turn", "wrap_counts", "zero"});
     CableColumn c;
     c.column = String(file, Require(file, node, path, "column"), path + ".column");
     claim(node["column"], path + ".column", c.column);
@@ -171,7 +171,10 @@ ActuatorMap ParseActuatorMap(const std::string& yaml_text, const std::string& fi
           Fail(file, node[key], path + "." + key, "only for signal: motor_angle");
         }
       }
+      if (const YAML::Node v = node["zero"]) c.zero = Number(file, v, path + ".zero");
     } else {
+      // A motor angle's zero is its first logged value.
+      if (node["zero"]) Fail(file, node["zero"], path + ".zero", "only for signal: length_change");
       c.unit = OneOf(file, unit, path + ".unit", {"rad", "deg", "counts"});
       c.drum_radius_m =
           Positive(file, Require(file, node, path, "drum_radius_m"), path + ".drum_radius_m");
@@ -357,7 +360,7 @@ ActuatorLog ParseActuatorLog(const std::string& text, const std::string& source_
     std::vector<double>& v = raw[k];
     if (c.signal == CableSignal::kLengthChange) {
       const double scale = c.sign * (c.unit == "mm" ? 1e-3 : 1.0);
-      for (std::size_t i = 0; i < n; ++i) log.length_change_m(i, k) = scale * v[i];
+      for (std::size_t i = 0; i < n; ++i) log.length_change_m(i, k) = scale * (v[i] - c.zero);
       continue;
     }
     if (c.unit == "counts" && c.wrap_counts > 0.0) {

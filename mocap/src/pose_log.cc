@@ -391,4 +391,28 @@ std::string TendonMap::ToYaml(const std::string& source) const {
   return std::string(out.c_str()) + "\n";
 }
 
+std::string TendonMap::ActuatorMapYaml(const std::string& source, const std::string& time_column,
+                                       const std::string& unit) const {
+  YAML::Emitter out;
+  out << YAML::Comment("The actuators identified by ccsrm dataset tendon-map from " + source +
+                       "; cable k: tendon k (segment by segment, by increasing azimuth)");
+  out << YAML::BeginMap;
+  out << YAML::Key << "schema" << YAML::Value << "ccsrm-actuators/1";
+  out << YAML::Key << "time" << YAML::Value << YAML::Flow << YAML::BeginMap;
+  out << YAML::Key << "column" << YAML::Value << YAML::DoubleQuoted << time_column;
+  out << YAML::Key << "unit" << YAML::Value << "s" << YAML::EndMap;
+  out << YAML::Key << "cables" << YAML::Value << YAML::BeginSeq;
+  for (const TendonPull& t : tendons) {
+    out << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "column" << YAML::Value << YAML::DoubleQuoted << t.column;
+    out << YAML::Key << "signal" << YAML::Value << "length_change";
+    out << YAML::Key << "unit" << YAML::Value << unit;
+    out << YAML::Key << "sign" << YAML::Value << t.sign;
+    out << YAML::Key << "zero" << YAML::Value << t.engagement;
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
 }  // namespace ccsrm::mocap

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/mocap/actuator_log.h"
 #include "ccsrm/mocap/pose_log.h"
 #include "shared_data.h"
 
@@ -98,6 +99,47 @@ TEST(TendonMap, RecoversWhichActuatorDrivesWhichTendonWithItsSignAndZero) {
   const std::string yaml = map.ToYaml("pulls.csv");
   EXPECT_THAT(yaml, HasSubstr("schema: ccsrm-tendon-map/1"));
   EXPECT_THAT(yaml, HasSubstr("column: \"servo_2_mm\", sign: -1"));
+}
+
+TEST(TendonMap, WritesTheActuatorsMapThatReadsEachTendonFromItsEngagement) {
+  // As a ccsrm-actuators/1 map, cable k = tendon k: read through it, every
+  // cable's pulled-in length is the tendon's true pull beyond its true
+  // engagement, whatever column drives it and which way it counts (to the
+  // engagement's accuracy, 0.05 of a unit as above).
+  const Robot robot;
+  const std::string text = PullLog(robot);
+  const PoseLog log = ParsePoseLog(text, "pulls.csv");
+  const TendonMap map = IdentifyTendonMap(log);
+  ActuatorMap actuators =
+      ParseActuatorMap(map.ActuatorMapYaml("pulls.csv", "timestamp", "mm"), "actuators.yaml");
+  ASSERT_EQ(actuators.cables.size(), 9u);
+  EXPECT_EQ(actuators.time_column, "timestamp");
+  actuators.max_gap_s = 20.0;  // settled poses with unrecorded transitions, not a stream
+  const ActuatorLog read = ParseActuatorLog(text, "pulls.csv", actuators, "actuators.yaml");
+  ASSERT_EQ(read.length_change_m.rows(), static_cast<Eigen::Index>(log.time_s.size()));
+  for (int k = 0; k < 9; ++k) {
+    const std::string column = "servo_" + std::to_string(robot.column[k]) + "_mm";
+    EXPECT_EQ(actuators.cables[static_cast<std::size_t>(k)].column, column) << k;
+    int c = 0;
+    while (log.actuator_columns[static_cast<std::size_t>(c)] != column) ++c;
+    for (Eigen::Index i = 0; i < read.length_change_m.rows(); ++i) {
+      const double pull_mm = robot.sign[k] * log.actuators(i, c) - robot.engagement[k];
+      EXPECT_NEAR(read.length_change_m(i, k), 1e-3 * pull_mm, 0.05e-3) << k << " row " << i;
+    }
+  }
+}
+
+TEST(ActuatorMap, AZeroIsALengthsOwn) {
+  const std::string motor =
+      "schema: ccsrm-actuators/1\ntime: {column: t, unit: s}\ncables:\n"
+      "  - {column: m1, signal: motor_angle, unit: deg, drum_radius_m: 0.01, zero: 3}\n";
+  try {
+    ParseActuatorMap(motor, "a.yaml");
+    ADD_FAILURE() << "a motor angle's zero accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("a.yaml: line 4, key 'cables[0].zero': only for signal: "
+                                    "length_change"));
+  }
 }
 
 std::string ErrorOf(const std::string& text) {

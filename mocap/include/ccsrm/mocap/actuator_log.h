@@ -34,6 +34,10 @@ struct CableColumn {
   // +1 when the logged quantity grows as the cable is pulled in, −1 when it
   // shrinks (a motor mounted the other way round). Applies to lengths too.
   int sign = 1;
+  // Lengths only: the reading at which the cable is just taut, in the log's
+  // unit (`ccsrm dataset tendon-map` identifies it): pulled-in length =
+  // sign × (reading − zero). Default 0.
+  double zero = 0.0;
   // Unit "counts" only: encoder counts per motor turn (> 0), and the modulus
   // at which the counter wraps (65536 for a 16-bit counter; 0 = it does
   // not). A wrapped counter is unwrapped by taking every step between two

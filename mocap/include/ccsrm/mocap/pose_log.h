@@ -96,6 +96,13 @@ struct TendonMap {
   std::string Report() const;
   // ccsrm-tendon-map/1 YAML.
   std::string ToYaml(const std::string& source) const;
+  // The same as a ccsrm-actuators/1 map (datasets/README.md): cable k is
+  // the k-th tendon here (segment by segment, by increasing azimuth: the
+  // order of a configuration whose hole angles are the capture frame's), a
+  // length_change in `unit` ("m" or "mm", the log's) with its sign and
+  // zero (the engagement); `time_column` in seconds.
+  std::string ActuatorMapYaml(const std::string& source, const std::string& time_column,
+                              const std::string& unit) const;
 };
 
 // Identifies the map from a log in which each pattern pulls one tendon
