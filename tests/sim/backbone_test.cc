@@ -19,12 +19,11 @@
 namespace ccsrm::sim {
 namespace {
 
-using test_support::BalanceAfter;
 using test_support::EnergyBalance;
 using test_support::OptionsFor;
 using test_support::PullAndHold;
+using test_support::PullAndHoldBalance;
 using test_support::SmallArm;
-using test_support::SwitchOffDissipation;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
@@ -127,19 +126,7 @@ TEST(Backbone, RodBooksItsEnergy) {
   // model smoothing's work is booked as dissipated, so kinetic + elastic +
   // dissipated stays put once the input holds (as for the connecting
   // springs, ArmDynamics.EnergyBookkeepingHoldsWithModelSmoothing).
-  Config c = BackboneArm(4);
-  SwitchOffDissipation(&c.parameters);
-  c.solver.relative_tolerance = 1e-8;
-  c.solver.absolute_tolerance = 1e-11;
-  c.solver.output_rate_hz = 1000.0;
-  const ArmModel model(c.arm);
-  const CableInputs inputs = PullAndHold(model, 2, 0.5e-3, 0.02, 0.2);
-  const SimulationResult result = Simulate(model, c.parameters, inputs, OptionsFor(c, 0.2));
-  ASSERT_TRUE(result.summary.completed()) << result.summary.message;
-  const EnergyBalance e = BalanceAfter(result.trajectory, 0.03);
-  std::printf(
-      "rod: kinetic up to %.3e J, elastic swing %.3e J, smoothing took %.3e J, drift %.3e J\n",
-      e.kinetic_max, e.elastic_swing, e.dissipated, e.drift);
+  const EnergyBalance e = PullAndHoldBalance("rod", BackboneArm(4), [](Config*) {});
   ASSERT_GT(e.kinetic_max, 1e-7);
   ASSERT_GT(e.elastic_swing, 1e-7);
   EXPECT_LT(e.drift, 0.01 * std::max(e.kinetic_max, std::abs(e.dissipated)));

@@ -24,6 +24,7 @@ using test_support::BalanceAfter;
 using test_support::EnergyBalance;
 using test_support::OptionsFor;
 using test_support::PullAndHold;
+using test_support::PullAndHoldBalance;
 using test_support::SmallArm;
 using test_support::SwitchOffDissipation;
 
@@ -218,32 +219,11 @@ TEST(ArmDynamics, ConnectingCableSmoothingChangesJointAnglesLittle) {
   }
 }
 
-// SmallArm(4) with dissipation off except what `edit` switches on, cable 3
-// pulled in by 0.5 mm over 20 ms and held to 0.2 s at tight tolerances; the
-// energy balance once the input holds (after 30 ms), printed under `label`.
-template <typename Edit>
-EnergyBalance PullAndHoldBalance(const char* label, Edit edit) {
-  Config c = SmallArm(4);
-  SwitchOffDissipation(&c.parameters);
-  edit(&c);
-  c.solver.relative_tolerance = 1e-8;
-  c.solver.absolute_tolerance = 1e-11;
-  c.solver.output_rate_hz = 1000.0;
-  const ArmModel model(c.arm);
-  const CableInputs inputs = PullAndHold(model, 2, 0.5e-3, 0.02, 0.2);
-  const SimulationResult result = Simulate(model, c.parameters, inputs, OptionsFor(c, 0.2));
-  EXPECT_TRUE(result.summary.completed()) << result.summary.message;
-  const EnergyBalance e = BalanceAfter(result.trajectory, 0.03);
-  std::printf("%s: kinetic up to %.3e J, friction and smoothing took %.3e J, drift %.3e J\n", label,
-              e.kinetic_max, e.dissipated, e.drift);
-  return e;
-}
-
 TEST(ArmDynamics, EnergyBookkeepingHoldsWithModelSmoothing) {
   // With smoothing on (driving and connecting cables) but no friction or
   // damping, whatever the smoothing takes out is booked as dissipated, so
   // kinetic + elastic + dissipated stays put.
-  const EnergyBalance e = PullAndHoldBalance("model smoothing", [](Config*) {});
+  const EnergyBalance e = PullAndHoldBalance("model smoothing", SmallArm(4), [](Config*) {});
   ASSERT_GT(e.kinetic_max, 1e-7);
   EXPECT_LT(e.drift, 0.01 * std::max(e.kinetic_max, std::abs(e.dissipated)));
 }
@@ -254,7 +234,7 @@ TEST(ArmDynamics, PreslidingFrictionBooksItsEnergy) {
   // out is dissipated, so kinetic + elastic + dissipated stays put once the
   // input holds. (Exact at constant k; k follows the tensions, whose
   // ringing leaves the small k_dot xi^2 / 2 unbooked.)
-  const EnergyBalance e = PullAndHoldBalance("presliding holes", [](Config* c) {
+  const EnergyBalance e = PullAndHoldBalance("presliding holes", SmallArm(4), [](Config* c) {
     c->parameters.mu = c->parameters.mu_s = 0.21;
     c->solver.hole_friction = HoleFrictionModel::kPresliding;
   });
@@ -268,7 +248,7 @@ TEST(ArmDynamics, ConduitPreslidingFrictionBooksItsEnergy) {
   // conduits' presliding energy K eta^2 / r is elastic, what the couples
   // slide and the smoothing take out is dissipated, so kinetic + elastic +
   // dissipated stays put once the input holds.
-  const EnergyBalance e = PullAndHoldBalance("presliding conduits", [](Config* c) {
+  const EnergyBalance e = PullAndHoldBalance("presliding conduits", SmallArm(4), [](Config* c) {
     c->parameters.mu_c = c->parameters.mu_c_s = 0.21;
     c->solver.hole_friction = HoleFrictionModel::kOff;
     c->solver.conduit_friction = ConduitFrictionModel::kPresliding;
