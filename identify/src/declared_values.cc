@@ -14,6 +14,9 @@ std::vector<LoopCandidateSpec> DeclaredValueCandidates(const sim::ArmConfig& arm
   };
   std::vector<LoopCandidateSpec> out;
   for (const sim::ParameterInfo& p : sim::DeclaredValueParameters(arm.size())) {
+    // A value the arm does not have (a mechanism its pattern does not use,
+    // on a backbone segment) has nothing to correct.
+    if (sim::DeclaredValue(arm, p.name) == 0.0) continue;
     const std::string block = block_of(p.name);
     if (out.empty() || out.back().block != block) {
       // A new block: its own entry first, then its members.

@@ -29,7 +29,9 @@ struct LoopCandidateSpec {
 constexpr const char* kDeclaredCandidates = "declared";
 
 // The declared-value blocks and members of `arm`: "declared:arm" and its
-// members, then "declared:segment<k>" and its members, k = 1..segments.
+// members, then "declared:segment<k>" and its members, k = 1..segments;
+// values the arm does not have (0: a mechanism its segment does not use)
+// left out.
 std::vector<LoopCandidateSpec> DeclaredValueCandidates(const sim::ArmConfig& arm);
 
 // "segment 2 link length" for "declared.segment2.link_length".

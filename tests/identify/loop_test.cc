@@ -17,7 +17,9 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/identify/diagnostics.h"
 #include "ccsrm/identify/loop.h"
+#include "ccsrm/sim/config.h"
 #include "ccsrm/sim/effects.h"
+#include "declared_values.h"
 #include "loop_recordings.h"
 #include "synthetic_experiment.h"
 
@@ -163,6 +165,26 @@ TEST(LoopOptions, RefusesUnknownAndDeclaredCandidates) {
   o.fit.free_parameters = {"T_p", "joint_moment.segment1_x_angle"};
   EXPECT_FALSE(o.IsValid(&error));
   EXPECT_THAT(error, HasSubstr("joint_moment, which already has a free parameter"));
+}
+
+TEST(LoopOptions, DeclaredValuesAreThoseTheArmHas) {
+  // The paper's arm has every declared value; the tendon-driven robot's
+  // backbone segments have no small or large S, whose radii and wrap angle
+  // are then no candidates (a correction of nothing changes nothing).
+  auto names = [](const std::string& config) {
+    std::vector<std::string> out;
+    const sim::Config c = sim::LoadConfig(std::string(CCSRM_SOURCE_DIR) + "/configs/" + config);
+    for (const auto& spec : internal::DeclaredValueCandidates(c.arm)) out.push_back(spec.name);
+    return out;
+  };
+  const std::vector<std::string> paper = names("paper.yaml");
+  EXPECT_THAT(paper, ::testing::Contains("declared.segment2.large_s_wrap_angle"));
+  EXPECT_EQ(paper.size(), 4u + 1u + 2u * (1u + 7u));  // arm block + 4, per segment block + 7
+  const std::vector<std::string> robot = names("ftdcr_v4.yaml");
+  for (const std::string& name : robot) {
+    EXPECT_EQ(name.find("_s_"), std::string::npos) << name;
+  }
+  EXPECT_THAT(robot, ::testing::Contains("declared.segment3.link_length"));
 }
 
 TEST(Loop, FindsAnUndeclaredMocapOffsetAndReachesTheNoise) {
