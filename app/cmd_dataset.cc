@@ -3,6 +3,8 @@
 //   --config arm.yaml [--rigid-bodies rb.yaml] [--static-trial FILE]
 //   [--sync trigger|estimate|estimate-kinematic|offset=S] [--params prior.yaml] --out exp.h5
 // ccsrm dataset tendon-map --log pulls.csv [--out map.yaml] [--actuator-map actuators.yaml]
+// ccsrm dataset import-pose-log --log poses.csv --actuator-map actuators.yaml --config arm.yaml
+//   --out exp.h5 [--rows A-B] [--tip-unit mm] [--tip-marker-mm X,Y,Z] [--name NAME]
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -56,6 +58,22 @@ void ParseSync(const std::string& sync, mocap::LabRecordingRequest* request) {
   }
 }
 
+// --rows A-B: the log's data rows A to B (1-based, inclusive).
+void ParseRows(const std::string& text, mocap::PoseLogImportRequest* request) {
+  const std::size_t dash = text.find('-');
+  double first = 0.0, last = 0.0;
+  const bool parsed = dash != std::string::npos &&
+                      ParseNumberText(text.substr(0, dash), &first).empty() &&
+                      ParseNumberText(text.substr(dash + 1), &last).empty();
+  if (!parsed || first < 1.0 || last < first || first != std::floor(first) ||
+      last != std::floor(last)) {
+    ThrowInputError("dataset import-pose-log", "--rows",
+                    "expected A-B, whole numbers with 1 <= A <= B, found '" + text + "'");
+  }
+  request->first_row = static_cast<std::size_t>(first);
+  request->last_row = static_cast<std::size_t>(last);
+}
+
 // Parse -> mocap::AssembleLabRecording -> check, write, print.
 void RunAssemble(AssembleArgs a) {
   mocap::LabRecordingRequest& request = a.request;
@@ -78,6 +96,58 @@ void RunAssemble(AssembleArgs a) {
   }
   std::printf("  output: %s (%zu frames, %zu cables, source recorded)\n", a.out.c_str(),
               experiment.mocap_time.size(), experiment.input_length_change.shape[1]);
+}
+
+// ccsrm dataset import-pose-log: parse -> mocap::ImportPoseLog -> check, write, print.
+void AddImportPoseLog(CLI::App* dataset) {
+  CLI::App* import_log = dataset->add_subcommand(
+      "import-pose-log",
+      "Make a ccsrm-dataset/1 experiment of settled poses from a lab's pose log (CSV/TSV: "
+      "time, pattern label, actuator readings, a tracked tip position): the readings through "
+      "an actuator map (e.g. tendon-map --actuator-map's) as the cables' pulled-in lengths, "
+      "the tip as a marker on the last link, in the capture frame");
+  struct ImportArgs {
+    mocap::PoseLogImportRequest request;
+    std::string out, rows;
+    std::vector<double> tip_marker_mm = {0.0, 0.0, 0.0};
+  };
+  auto im = std::make_shared<ImportArgs>();
+  mocap::PoseLogImportRequest& q = im->request;
+  import_log->add_option("--log", q.log, "The pose log (CSV or TSV)")->required();
+  import_log
+      ->add_option("--actuator-map", q.actuator_map,
+                   "Which column drives which cable, its sign, zero and unit, and the time "
+                   "column (ccsrm-actuators/1 YAML)")
+      ->required();
+  import_log->add_option("--config", q.config, "Arm configuration (YAML)")->required();
+  import_log->add_option("--out", im->out, "Output experiment (.h5)")->required();
+  import_log->add_option("--rows", im->rows,
+                         "The rows to import, A-B (1-based, inclusive, the log's data rows); "
+                         "default: all");
+  import_log->add_option("--label-column", q.columns.label, "Column of the pattern labels")
+      ->capture_default_str();
+  import_log->add_option("--tip-unit", q.tip_unit, "Unit of the tip columns (m or mm)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"m", "mm"}));
+  import_log
+      ->add_option("--tip-marker-mm", im->tip_marker_mm,
+                   "The tip marker in the last link's frame, from the centre of its distal end "
+                   "[mm]: X,Y,Z")
+      ->delimiter(',')
+      ->expected(3);
+  import_log->add_option("--name", q.name, "Experiment name (default: the log's stem)");
+  import_log->callback([im] {
+    mocap::PoseLogImportRequest request = im->request;
+    if (!im->rows.empty()) ParseRows(im->rows, &request);
+    for (int k = 0; k < 3; ++k) request.tip_from_link_end_m[k] = 1e-3 * im->tip_marker_mm[k];
+    CheckOut(im->out, datasets::ExperimentFileOutput(),
+             {request.log, request.actuator_map, request.config});
+    const mocap::ImportedPoseLog imported = mocap::ImportPoseLog(request);
+    sim_io::CheckExperimentAgainstConfig(imported.experiment, request.log);
+    datasets::WriteExperimentFile(im->out, imported.experiment);
+    std::printf("%s  output: %s (settled poses, source recorded)\n", imported.report.c_str(),
+                im->out.c_str());
+  });
 }
 
 }  // namespace
@@ -178,6 +248,8 @@ void AddDatasetCommands(CLI::App& root) {
       std::printf("  actuator map: %s\n", t->actuator_map.c_str());
     }
   });
+
+  AddImportPoseLog(dataset);
 
   CLI::App* assemble = dataset->add_subcommand(
       "assemble",

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <set>
 #include <string>
 #include <utility>
@@ -66,6 +67,21 @@ void VisitArrays(Experiment& experiment, Visit&& visit) {
   if (experiment.measured_joint_twist) {
     visit("/measured/joint_twist", "rad", *experiment.measured_joint_twist);
   }
+}
+
+// The value of an optional root attribute naming one of an enum's values
+// (`Name` gives each one's text), the first when it is absent.
+template <typename Enum, typename Name>
+Enum ReadOptionalEnumAttribute(const internal::FileReader& reader, const std::string& attribute,
+                               std::initializer_list<Enum> values, Name name) {
+  if (!reader.HasRootAttribute(attribute)) return *values.begin();
+  const std::string text = reader.ReadStringAttribute(attribute);
+  std::string expected;
+  for (Enum value : values) {
+    if (text == name(value)) return value;
+    expected += std::string(expected.empty() ? "" : " or ") + "'" + name(value) + "'";
+  }
+  reader.Fail("attribute '" + attribute + "' is '" + text + "'", "expected " + expected);
 }
 
 ExperimentSource ParseSource(const internal::FileReader& reader, const std::string& text) {
@@ -132,6 +148,14 @@ const char* ExperimentSourceName(ExperimentSource source) {
   return source == ExperimentSource::kRecorded ? "recorded" : "generated";
 }
 
+const char* RecordedMotionName(RecordedMotion motion) {
+  return motion == RecordedMotion::kContinuous ? "continuous" : "settled_poses";
+}
+
+const char* MarkerFrameName(MarkerFrame frame) {
+  return frame == MarkerFrame::kWorld ? "world" : "capture";
+}
+
 std::string MarkerBeyondCaptureVolume(const std::vector<double>& xyz,
                                       const std::vector<std::string>& names) {
   const std::size_t markers = names.size();
@@ -168,6 +192,11 @@ void ValidateExperimentFile(const ExperimentFile& experiment, const std::string&
   }
   internal::ExpectUniqueNames(file, "/mocap/marker_names", experiment.marker_names);
   ExpectWithinCaptureVolume(experiment, file);
+  if (!experiment.input_labels.empty() && experiment.input_labels.size() != samples) {
+    ThrowInputError(file, "/input/labels",
+                    "expected N=" + std::to_string(samples) + " labels (from /input/time), found " +
+                        std::to_string(experiment.input_labels.size()));
+  }
   if (const auto& a = experiment.clock_alignment) {
     if (a->method != "trigger" && a->method != "estimate" && a->method != "offset") {
       ThrowInputError(file, "clock_alignment",
@@ -245,6 +274,12 @@ void WriteExperimentFile(const std::string& path, const ExperimentFile& experime
       writer.WriteStringAttribute("protocol_yaml", experiment.protocol_yaml);
     if (!experiment.inputs_file.empty())
       writer.WriteStringAttribute("inputs_file", experiment.inputs_file);
+    if (experiment.motion != RecordedMotion::kContinuous) {
+      writer.WriteStringAttribute("motion", RecordedMotionName(experiment.motion));
+    }
+    if (experiment.marker_frame != MarkerFrame::kWorld) {
+      writer.WriteStringAttribute("marker_frame", MarkerFrameName(experiment.marker_frame));
+    }
     if (const auto& a = experiment.clock_alignment) {
       writer.WriteStringAttribute("clock_alignment", a->method);
       writer.WriteStringAttribute("actuator_log", a->actuator_log);
@@ -259,6 +294,9 @@ void WriteExperimentFile(const std::string& path, const ExperimentFile& experime
     VisitArrays(experiment, [&](const std::string& dataset, const char* units, const Array& array) {
       writer.WriteArray(dataset, array, units);
     });
+    if (!experiment.input_labels.empty()) {
+      writer.WriteStrings("/input/labels", experiment.input_labels);
+    }
     writer.WriteStrings("/mocap/marker_names", experiment.marker_names);
     for (const RigidBody& body : experiment.rigid_bodies) {
       writer.WriteStrings(BodyPath(body) + "/marker_names", body.marker_names);
@@ -287,6 +325,11 @@ ExperimentFile ReadExperimentFile(const std::string& path) {
   // Files written before protocols were recorded have neither.
   experiment.protocol_yaml = reader.ReadOptionalStringAttribute("protocol_yaml");
   experiment.inputs_file = reader.ReadOptionalStringAttribute("inputs_file");
+  experiment.motion = ReadOptionalEnumAttribute(
+      reader, "motion", {RecordedMotion::kContinuous, RecordedMotion::kSettledPoses},
+      RecordedMotionName);
+  experiment.marker_frame = ReadOptionalEnumAttribute(
+      reader, "marker_frame", {MarkerFrame::kWorld, MarkerFrame::kCapture}, MarkerFrameName);
   if (reader.HasRootAttribute("clock_alignment")) {
     ClockAlignment a;
     a.method = reader.ReadStringAttribute("clock_alignment");
@@ -310,6 +353,9 @@ ExperimentFile ReadExperimentFile(const std::string& path) {
   VisitArrays(experiment, [&](const std::string& dataset, const char* units, Array& array) {
     array = reader.ReadArray(dataset, units);
   });
+  if (reader.Exists("/input/labels")) {
+    experiment.input_labels = reader.ReadStrings("/input/labels");
+  }
   experiment.marker_names = reader.ReadStrings("/mocap/marker_names");
   for (RigidBody& body : experiment.rigid_bodies) {
     body.marker_names = reader.ReadStrings(BodyPath(body) + "/marker_names");
@@ -337,6 +383,9 @@ std::vector<DatasetSummary> DescribeDatasets(const ExperimentFile& experiment) {
   VisitArrays(experiment, [&](const std::string& path, const char* units, const Array& array) {
     datasets.push_back({path, array.shape, units, "float64"});
   });
+  if (!experiment.input_labels.empty()) {
+    datasets.push_back({"/input/labels", {experiment.input_labels.size()}, "", "string"});
+  }
   datasets.push_back({"/mocap/marker_names", {experiment.marker_names.size()}, "", "string"});
   for (const RigidBody& body : experiment.rigid_bodies) {
     datasets.push_back(

@@ -86,6 +86,12 @@ void SummariseExperiment(const ExperimentFile& experiment, FileSummary* summary)
       {"description", experiment.description}, {"source", ExperimentSourceName(experiment.source)},
       {"created", experiment.created},         {"config_yaml", LineCount(experiment.config_yaml)},
   };
+  if (experiment.motion != RecordedMotion::kContinuous) {
+    summary->attributes.emplace_back("motion", RecordedMotionName(experiment.motion));
+  }
+  if (experiment.marker_frame != MarkerFrame::kWorld) {
+    summary->attributes.emplace_back("marker_frame", MarkerFrameName(experiment.marker_frame));
+  }
   if (const auto& a = experiment.clock_alignment) {
     char text[160];
     std::snprintf(text, sizeof(text), "%s: offset %.6f ± %.6f s, drift %.2f ± %.2f ppm",

@@ -59,6 +59,15 @@ void AddData(py::module_& m) {
       .def_readonly("config_yaml", &ExperimentFile::config_yaml)
       .def_readonly("protocol_yaml", &ExperimentFile::protocol_yaml)
       .def_readonly("inputs_file", &ExperimentFile::inputs_file)
+      .def_property_readonly(
+          "motion", [](const ExperimentFile& e) { return datasets::RecordedMotionName(e.motion); },
+          "'continuous' or 'settled_poses' (each row a settled pose of a pose log).")
+      .def_property_readonly(
+          "marker_frame",
+          [](const ExperimentFile& e) { return datasets::MarkerFrameName(e.marker_frame); },
+          "'world' or 'capture' (placement relative to the arm unknown).")
+      .def_readonly("input_labels", &ExperimentFile::input_labels,
+                    "N pattern labels of the inputs ([] when the file has none).")
       .def_readonly("marker_names", &ExperimentFile::marker_names)
       .def_property_readonly(
           "input_time",

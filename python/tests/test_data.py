@@ -16,6 +16,37 @@ def test_dataset_arrays(experiment):
     assert f == d.mocap_time.size and m == len(d.marker_names) and three == 3
     assert d.measured_joint_angles is None  # a generated file has markers only
     assert not d.input_time.flags.writeable
+    # A motion sampled in time, markers in W, no pattern labels.
+    assert d.motion == "continuous" and d.marker_frame == "world" and d.input_labels == []
+
+
+def test_pose_log_import(exe, tmp_path):
+    """A pose log through an actuator map: settled poses of a tracked tip."""
+    from conftest import SOURCE_DIR
+    columns = [f"servo_{k}_mm" for k in range(1, 10)]
+    rows = ["timestamp,pattern_label," + ",".join(columns) + ",tip_x,tip_y,tip_z"]
+    for i in range(6):
+        label = "seg1_dir0" if i < 4 else "seg1_dir0_hold"
+        readings = [0.5 * i if k == 0 else -0.2 for k in range(9)]
+        tip = [-3.0 * i, 0.5, 188.0 - 0.1 * i]
+        rows.append(f"{100 + 0.57 * i:.2f},{label}," + ",".join(map(str, readings + tip)))
+    (tmp_path / "poses.csv").write_text("\n".join(rows) + "\n")
+    cables = "".join(f'  - {{column: "{c}", signal: length_change, unit: mm, zero: -0.5}}\n'
+                     for c in columns)
+    (tmp_path / "actuators.yaml").write_text(
+        'schema: ccsrm-actuators/1\ntime: {column: "timestamp", unit: s}\ncables:\n' + cables)
+    out = tmp_path / "poses.h5"
+    run_ccsrm(exe, "dataset", "import-pose-log", "--log", str(tmp_path / "poses.csv"),
+              "--actuator-map", str(tmp_path / "actuators.yaml"),
+              "--config", str(SOURCE_DIR / "configs" / "ftdcr_v4.yaml"), "--out", str(out))
+    d = ccsrm.read_dataset(str(out))
+    assert d.motion == "settled_poses" and d.marker_frame == "capture"
+    assert d.input_labels == ["seg1_dir0"] * 4 + ["seg1_dir0_hold"] * 2
+    # Pulled in = reading - zero, in m; the tip in m.
+    np.testing.assert_allclose(d.input_length_change[:, 0], (0.5 * np.arange(6) + 0.5) * 1e-3)
+    np.testing.assert_allclose(d.input_length_change[:, 1], 0.3e-3)
+    np.testing.assert_allclose(d.mocap_markers[:, 0, 2], (188.0 - 0.1 * np.arange(6)) * 1e-3)
+    np.testing.assert_allclose(d.input_time, 0.57 * np.arange(6), atol=1e-9)
 
 
 def test_c3d_round_trip(experiment, tmp_path):

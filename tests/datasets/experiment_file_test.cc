@@ -175,6 +175,40 @@ TEST(ExperimentFileRoundTrip, MeasuredLinkPoseAndTwistExtensionsRoundTrip) {
               AllOf(StartsWith(path + ": /measured/joint_twist: "), HasSubstr("expected J=2")));
 }
 
+// Issue 46: a pose log's experiment says its rows are settled poses, its
+// markers in the capture frame, and labels each input sample with its pattern.
+TEST(ExperimentFileRoundTrip, SettledPosesInTheCaptureFrameWithLabelsRoundTrip) {
+  const fs::path dir = FreshDir("exp_settled_poses");
+  const std::string path = (dir / "exp.h5").string();
+  ExperimentFile experiment = MakeExperimentFile();
+  WriteExperimentFile(path, experiment);
+  ExperimentFile back = ReadExperimentFile(path);
+  // Absent, as in every file written before them: a continuous motion in W.
+  EXPECT_EQ(back.motion, RecordedMotion::kContinuous);
+  EXPECT_EQ(back.marker_frame, MarkerFrame::kWorld);
+  EXPECT_TRUE(back.input_labels.empty());
+
+  experiment.motion = RecordedMotion::kSettledPoses;
+  experiment.marker_frame = MarkerFrame::kCapture;
+  const std::size_t n = experiment.input_time.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    experiment.input_labels.push_back(i < n / 2 ? "seg1_dir0" : "seg1_dir0_hold");
+  }
+  WriteExperimentFile(path, experiment);
+  back = ReadExperimentFile(path);
+  EXPECT_EQ(back.motion, RecordedMotion::kSettledPoses);
+  EXPECT_EQ(back.marker_frame, MarkerFrame::kCapture);
+  EXPECT_EQ(back.input_labels, experiment.input_labels);
+
+  SetRootString(path, "motion", "stream");
+  EXPECT_EQ(InputErrorMessage([&] { ReadExperimentFile(path); }),
+            path + ": attribute 'motion' is 'stream': expected 'continuous' or 'settled_poses'");
+  experiment.input_labels.pop_back();
+  EXPECT_EQ(InputErrorMessage([&] { WriteExperimentFile(path, experiment); }),
+            path + ": /input/labels: expected N=" + std::to_string(n) +
+                " labels (from /input/time), found " + std::to_string(n - 1));
+}
+
 // Issue 33: joint angles cut to fewer joints than the twist and the link poses
 // they were written with are the odd one out, and the message names them.
 TEST(ExperimentFileRead, AnglesCutToFewerJointsAreBlamedNotTheTwist) {

@@ -13,8 +13,11 @@
 #include <vector>
 
 #include "ccsrm/common/error.h"
+#include "ccsrm/datasets/experiment_file.h"
 #include "ccsrm/mocap/actuator_log.h"
 #include "ccsrm/mocap/pose_log.h"
+#include "ccsrm/sim_io/experiment_check.h"
+#include "mocap_test_util.h"
 #include "shared_data.h"
 
 namespace ccsrm::mocap {
@@ -215,6 +218,145 @@ TEST(TendonMap, IdentifiesTheTendonDrivenRobotsMapFromItsPulls) {
   // Under position control a proximal tendon moves the tip most.
   EXPECT_GT(map.tendons[0].tip_per_unit + map.tendons[1].tip_per_unit,
             map.tendons[6].tip_per_unit + map.tendons[7].tip_per_unit);
+}
+
+// --- A pose log made an experiment (dataset import-pose-log) -------------------
+
+std::string RobotConfigPath() { return std::string(CCSRM_SOURCE_DIR) + "/configs/ftdcr_v4.yaml"; }
+
+// The synthetic robot's pulls and the map identified from them, on disk.
+struct PullFiles {
+  std::filesystem::path dir;
+  std::string log, map;
+  PoseLog poses;
+};
+
+PullFiles WritePullFiles(const std::string& name) {
+  PullFiles f;
+  f.dir = testing::FreshTempDir(name);
+  const std::string text = PullLog(Robot());
+  f.log = (f.dir / "pulls.csv").string();
+  f.map = (f.dir / "actuators.yaml").string();
+  testing::WriteFile(f.log, text);
+  f.poses = ParsePoseLog(text, f.log);
+  testing::WriteFile(f.map, IdentifyTendonMap(f.poses).ActuatorMapYaml(f.log, "timestamp", "mm"));
+  return f;
+}
+
+TEST(PoseLogImport, MakesSettledPosesOfATrackedTipFromTheLogThroughItsMap) {
+  const Robot robot;
+  const PullFiles f = WritePullFiles("pose_log_import");
+  PoseLogImportRequest request;
+  request.log = f.log;
+  request.actuator_map = f.map;
+  request.config = RobotConfigPath();
+  request.first_row = 3;
+  request.last_row = 40;
+  request.tip_from_link_end_m = Eigen::Vector3d(0.0, 0.0, 8e-3);
+  const ImportedPoseLog imported = ImportPoseLog(request);
+  std::printf("%s", imported.report.c_str());
+  const datasets::ExperimentFile& e = imported.experiment;
+  ASSERT_EQ(e.input_time.size(), 38u);
+  EXPECT_EQ(e.motion, datasets::RecordedMotion::kSettledPoses);
+  EXPECT_EQ(e.marker_frame, datasets::MarkerFrame::kCapture);
+  EXPECT_EQ(e.source, datasets::ExperimentSource::kRecorded);
+  EXPECT_EQ(e.name, "pulls");
+  ASSERT_EQ(e.input_labels.size(), 38u);
+  EXPECT_EQ(e.input_labels[0], f.poses.labels[2]);
+  ASSERT_EQ(e.input_length_change.shape, (std::vector<std::size_t>{38, 9}));
+  for (std::size_t i = 0; i < 38; ++i) {
+    const Eigen::Index row = static_cast<Eigen::Index>(i + 2);
+    // Time from the first imported row, as logged.
+    EXPECT_DOUBLE_EQ(e.input_time.values[i], f.poses.time_s[i + 2] - f.poses.time_s[2]);
+    EXPECT_EQ(e.mocap_time.values[i], e.input_time.values[i]);
+    // Cable k is tendon k: its true pull beyond its true engagement (the
+    // engagement's accuracy, 0.05 mm, as above), in metres.
+    for (int k = 0; k < 9; ++k) {
+      int c = 0;
+      const std::string column = "servo_" + std::to_string(robot.column[k]) + "_mm";
+      while (f.poses.actuator_columns[static_cast<std::size_t>(c)] != column) ++c;
+      const double pull_mm = robot.sign[k] * f.poses.actuators(row, c) - robot.engagement[k];
+      EXPECT_NEAR(e.input_length_change.values[i * 9 + k], 1e-3 * pull_mm, 0.05e-3) << k;
+    }
+    for (int x = 0; x < 3; ++x) {
+      EXPECT_DOUBLE_EQ(e.mocap_markers.values[i * 3 + x], 1e-3 * f.poses.tip(row, x));
+    }
+  }
+  // The tip marker: on the last of the 30 links, 8 mm beyond the centre of
+  // its distal end (the link is 6.4 mm long: z' = 3.2 + 8 mm).
+  ASSERT_EQ(e.rigid_bodies.size(), 1u);
+  EXPECT_EQ(e.rigid_bodies[0].name, "link30");
+  EXPECT_EQ(e.marker_names, (std::vector<std::string>{"tip"}));
+  EXPECT_NEAR(e.rigid_bodies[0].local_position.values[2], 11.2e-3, 1e-12);
+
+  // Through the file and the door every experiment comes through.
+  const std::string out = (f.dir / "pulls.h5").string();
+  datasets::WriteExperimentFile(out, e);
+  const datasets::ExperimentFile back = datasets::ReadExperimentFile(out);
+  EXPECT_TRUE(sim_io::CheckExperimentAgainstConfig(back, out).has_value());
+  EXPECT_EQ(back.input_labels, e.input_labels);
+  EXPECT_EQ(back.motion, datasets::RecordedMotion::kSettledPoses);
+}
+
+TEST(PoseLogImport, BadRequestsAreNamedInOneLine) {
+  const PullFiles f = WritePullFiles("pose_log_import_bad");
+  PoseLogImportRequest request;
+  request.log = f.log;
+  request.actuator_map = f.map;
+  request.config = RobotConfigPath();
+  request.first_row = 30;
+  request.last_row = 400;
+  const std::size_t rows = f.poses.time_s.size();
+  EXPECT_EQ(testing::InputErrorOf([&] { ImportPoseLog(request); }),
+            f.log + ": rows: 30 to 400 selected, the log has " + std::to_string(rows) +
+                " rows: at least 2 rows within them are needed");
+  // The paper's arm has 6 driving cables, the map 9.
+  request.first_row = request.last_row = 0;
+  request.config = std::string(CCSRM_SOURCE_DIR) + "/configs/paper.yaml";
+  EXPECT_EQ(
+      testing::InputErrorOf([&] { ImportPoseLog(request); }),
+      f.map + ": cables: maps 9 cable(s), the arm (" + request.config + ") has 6 driving cables");
+  // Tip columns declared metres: the tip 188 m away is beyond any capture
+  // volume, refused when the experiment is checked.
+  request.config = RobotConfigPath();
+  request.tip_unit = "m";
+  const ImportedPoseLog imported = ImportPoseLog(request);
+  EXPECT_THAT(testing::InputErrorOf(
+                  [&] { sim_io::CheckExperimentAgainstConfig(imported.experiment, f.log); }),
+              HasSubstr("beyond any capture volume"));
+}
+
+// The robot's training log after its pulls (rows 135 on: the first 134 are
+// tendon_pull.csv, docs/tdcr-recordings.md), through the map identified
+// from its pulls: at rest every tendon is within a millimetre of taut and
+// the tip 188 mm up the capture frame's z; the largest pulls are those the
+// file documents (up to 9.6 mm beyond the reading's zero).
+TEST(PoseLogImport, ImportsTheTendonDrivenRobotsTrainingPoses) {
+  CCSRM_SHARED_FILE_OR_SKIP(pulls, "data/tdcr/ftdcr_v4/tendon_pull.csv");
+  CCSRM_SHARED_FILE_OR_SKIP(train, "data/tdcr/ftdcr_v4/train.csv");
+  const std::filesystem::path dir = testing::FreshTempDir("pose_log_import_robot");
+  PoseLogImportRequest request;
+  request.log = train;
+  request.actuator_map = (dir / "actuators.yaml").string();
+  request.config = RobotConfigPath();
+  request.first_row = 135;
+  testing::WriteFile(
+      request.actuator_map,
+      IdentifyTendonMap(ReadPoseLog(pulls)).ActuatorMapYaml(pulls, "timestamp", "mm"));
+  const ImportedPoseLog imported = ImportPoseLog(request);
+  std::printf("%s", imported.report.c_str());
+  const datasets::ExperimentFile& e = imported.experiment;
+  ASSERT_EQ(e.input_time.size(), 1620u - 134u);
+  EXPECT_EQ(e.input_labels.front().rfind("rep1_seg1", 0), 0u) << e.input_labels.front();
+  for (int k = 0; k < 9; ++k) {
+    EXPECT_NEAR(e.input_length_change.values[static_cast<std::size_t>(k)], 0.0, 1e-3) << k;
+  }
+  EXPECT_NEAR(e.mocap_markers.values[2], 0.188, 0.002);
+  const auto [low, high] =
+      std::minmax_element(e.input_length_change.values.begin(), e.input_length_change.values.end());
+  EXPECT_LT(*high, 11e-3);
+  EXPECT_GT(*low, -11e-3);
+  EXPECT_TRUE(sim_io::CheckExperimentAgainstConfig(e, train).has_value());
 }
 
 }  // namespace

@@ -23,6 +23,26 @@ enum class ExperimentSource { kRecorded, kGenerated };
 // "recorded" / "generated", the values of the root attribute `source`.
 const char* ExperimentSourceName(ExperimentSource source);
 
+// Extension, root attribute `motion`: what a row of the record is.
+enum class RecordedMotion {
+  // A continuous motion sampled in time (every file written before the
+  // attribute; the attribute is then absent).
+  kContinuous,
+  // "settled_poses": each row a pose held after its command settled (a
+  // lab's pose log, issue 46): the time between rows is not the arm's, and
+  // a replay is a sequence of static equilibria, not a dynamic run.
+  kSettledPoses,
+};
+const char* RecordedMotionName(RecordedMotion motion);  // "continuous" / "settled_poses"
+
+// Extension, root attribute `marker_frame`: the frame /mocap/markers are in.
+enum class MarkerFrame {
+  kWorld,    // the arm's world frame W (SPEC §2); the attribute is then absent
+  kCapture,  // "capture": the capture system's own, placed relative to W by
+             // an unknown rigid motion (a fit of tracked points estimates it)
+};
+const char* MarkerFrameName(MarkerFrame frame);  // "world" / "capture"
+
 // A marker cluster fixed to one body, under /mocap/rigid_bodies/<name>.
 struct RigidBody {
   // "base" for the ground (link 0), "link1", "link2", ... for the links.
@@ -69,10 +89,17 @@ struct ExperimentFile {
   // clock_offset_s, clock_offset_uncertainty_s, clock_drift_ppm,
   // clock_drift_uncertainty_ppm, clock_alignment_note; written when set).
   std::optional<ClockAlignment> clock_alignment;
+  // Extensions (root attributes `motion` and `marker_frame`, written when not
+  // the default).
+  RecordedMotion motion = RecordedMotion::kContinuous;
+  MarkerFrame marker_frame = MarkerFrame::kWorld;
 
   // --- Datasets --------------------------------------------------------------
-  Array input_time;                       // /input/time, N, s: strictly increasing, finite, N >= 1.
-  Array input_length_change;              // /input/length_change, N × C, m (positive = pulled).
+  Array input_time;           // /input/time, N, s: strictly increasing, finite, N >= 1.
+  Array input_length_change;  // /input/length_change, N × C, m (positive = pulled).
+  // Extension, optional: /input/labels, N strings, the label of the command
+  // pattern each input sample belongs to (a pose log's); empty: none.
+  std::vector<std::string> input_labels;
   Array mocap_time;                       // /mocap/time, F, s: strictly increasing, finite, F >= 1.
   Array mocap_markers;                    // /mocap/markers, F × M × 3, m; NaN where not seen.
   std::vector<std::string> marker_names;  // /mocap/marker_names, M unique names.

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "ccsrm/datasets/experiment_file.h"
+
 namespace ccsrm::mocap {
 
 inline constexpr const char* kTendonMapSchema = "ccsrm-tendon-map/1";
@@ -115,5 +117,42 @@ struct TendonMap {
 // multiple of tendons_per_segment, two pulls on one column, a pull that
 // does not move the tip, invalid options.
 TendonMap IdentifyTendonMap(const PoseLog& log, const TendonMapOptions& options = {});
+
+// A pose log made an experiment (`ccsrm dataset import-pose-log`): the
+// actuators' readings through an actuator map (ccsrm-actuators/1, e.g. the
+// one `tendon-map --actuator-map` writes) as the cables' pulled-in lengths,
+// the tracked point as the one marker of a rigid body on the arm's last
+// link, the pattern labels as /input/labels; marked as settled poses
+// (motion "settled_poses": no gap limit, each row a static equilibrium) in
+// the capture frame (marker_frame "capture": its placement is a fit's).
+struct PoseLogImportRequest {
+  std::string log;           // the pose log (CSV/TSV)
+  std::string actuator_map;  // ccsrm-actuators/1 YAML: its time column is the log's
+  std::string config;        // the arm (ccsrm-config/1 YAML)
+  PoseLogColumns columns;    // the label and tip columns (the time is the map's)
+  // Unit of the tip columns: "mm" or "m". Default "mm".
+  std::string tip_unit = "mm";
+  // The tracked point in the last link's body frame, from the centre of its
+  // distal end (z' = +L/2) [m]. Default: that centre.
+  Eigen::Vector3d tip_from_link_end_m = Eigen::Vector3d::Zero();
+  // The data rows to import, 1-based and inclusive, counted as the log's
+  // rows (not its file lines); 0: from the first, to the last.
+  std::size_t first_row = 0;
+  std::size_t last_row = 0;
+  std::string name;  // the experiment's name; default: the log's stem
+};
+
+struct ImportedPoseLog {
+  datasets::ExperimentFile experiment;
+  std::string report;  // a few lines for a terminal: what was read and made
+};
+
+// Reads the log twice, through the map (the lengths) and as a pose log (the
+// labels and the tip), checks the lengths against the arm (sim::
+// CheckRecordedInputsOnArm) and makes the experiment. Throws InputError
+// naming the file and the field: a map of another number of cables than the
+// arm's, rows out of range, a tip unit not m or mm, the map's time column
+// not the log's.
+ImportedPoseLog ImportPoseLog(const PoseLogImportRequest& request);
 
 }  // namespace ccsrm::mocap
