@@ -98,6 +98,79 @@ void RunAssemble(AssembleArgs a) {
               experiment.mocap_time.size(), experiment.input_length_change.shape[1]);
 }
 
+// ccsrm dataset tendon-map: parse -> mocap::IdentifyTendonMap -> print, write.
+void AddTendonMap(CLI::App* dataset) {
+  CLI::App* tendon_map = dataset->add_subcommand(
+      "tendon-map",
+      "Identify which actuator drives which tendon, with its sign and the reading at which it "
+      "engages, from a pose log that pulls one tendon at a time (CSV/TSV: time, pattern "
+      "label, actuator readings, tip position; docs/tdcr-recordings.md)");
+  struct TendonMapArgs {
+    std::string log, out, actuator_map, unit = "mm";
+    mocap::PoseLogColumns columns;
+    mocap::TendonMapOptions options;
+    std::string axis = "z";
+  };
+  auto t = std::make_shared<TendonMapArgs>();
+  tendon_map->add_option("--log", t->log, "The pose log (CSV or TSV)")->required();
+  tendon_map
+      ->add_option("--tendons-per-segment", t->options.tendons_per_segment,
+                   "Tendons per segment, evenly spread around the backbone")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 15));
+  tendon_map->add_option("--axis", t->axis, "The arm's axis in the capture frame: x, y or z")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"x", "y", "z"}));
+  tendon_map
+      ->add_option("--actuator-prefix", t->columns.actuator_prefix,
+                   "Columns whose names start with this are the actuators' readings")
+      ->capture_default_str();
+  tendon_map->add_option("--label-column", t->columns.label, "Column of the pattern labels")
+      ->capture_default_str();
+  tendon_map->add_option("--time-column", t->columns.time, "Column of the time [s]")
+      ->capture_default_str();
+  tendon_map
+      ->add_option("--min-rows", t->options.min_rows,
+                   "A pattern of fewer rows is not a pull (a hold, a label's tail)")
+      ->capture_default_str()
+      ->check(CLI::Range(3, 1000000));
+  tendon_map->add_option("--out", t->out, "Write the map (ccsrm-tendon-map/1 YAML)");
+  tendon_map->add_option(
+      "--actuator-map", t->actuator_map,
+      "Write the map as the actuators' (ccsrm-actuators/1 YAML: column, sign and "
+      "zero of every cable, tendon k as cable k)");
+  tendon_map->add_option("--unit", t->unit, "Unit of the actuators' readings (m or mm)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"m", "mm"}));
+  tendon_map->callback([t] {
+    if (!t->out.empty()) {
+      CheckOut(t->out, YamlFileOutput(mocap::kTendonMapSchema, "tendon map"), {t->log});
+    }
+    if (!t->actuator_map.empty()) {
+      // Neither the log nor the other output.
+      std::vector<std::string> not_these = {t->log};
+      if (!t->out.empty()) not_these.push_back(t->out);
+      CheckOutputPath(t->actuator_map, "--actuator-map",
+                      YamlFileOutput("ccsrm-actuators/1", "actuator map"), not_these);
+    }
+    t->options.axis = t->axis == "x" ? 0 : t->axis == "y" ? 1 : 2;
+    const mocap::PoseLog log = mocap::ReadPoseLog(t->log, t->columns);
+    const mocap::TendonMap map = mocap::IdentifyTendonMap(log, t->options);
+    std::printf("%s: %zu rows, %zu actuator columns; %zu tendons pulled one at a time\n%s",
+                t->log.c_str(), log.time_s.size(), log.actuator_columns.size(), map.tendons.size(),
+                map.Report().c_str());
+    if (!t->out.empty()) {
+      WriteTextFileAtomically(t->out, map.ToYaml(t->log));
+      std::printf("  output: %s\n", t->out.c_str());
+    }
+    if (!t->actuator_map.empty()) {
+      WriteTextFileAtomically(t->actuator_map,
+                              map.ActuatorMapYaml(t->log, t->columns.time, t->unit));
+      std::printf("  actuator map: %s\n", t->actuator_map.c_str());
+    }
+  });
+}
+
 // ccsrm dataset import-pose-log: parse -> mocap::ImportPoseLog -> check, write, print.
 void AddImportPoseLog(CLI::App* dataset) {
   CLI::App* import_log = dataset->add_subcommand(
@@ -179,76 +252,7 @@ void AddDatasetCommands(CLI::App& root) {
     }
   });
 
-  CLI::App* tendon_map = dataset->add_subcommand(
-      "tendon-map",
-      "Identify which actuator drives which tendon, with its sign and the reading at which it "
-      "engages, from a pose log that pulls one tendon at a time (CSV/TSV: time, pattern "
-      "label, actuator readings, tip position; docs/tdcr-recordings.md)");
-  struct TendonMapArgs {
-    std::string log, out, actuator_map, unit = "mm";
-    mocap::PoseLogColumns columns;
-    mocap::TendonMapOptions options;
-    std::string axis = "z";
-  };
-  auto t = std::make_shared<TendonMapArgs>();
-  tendon_map->add_option("--log", t->log, "The pose log (CSV or TSV)")->required();
-  tendon_map
-      ->add_option("--tendons-per-segment", t->options.tendons_per_segment,
-                   "Tendons per segment, evenly spread around the backbone")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 15));
-  tendon_map->add_option("--axis", t->axis, "The arm's axis in the capture frame: x, y or z")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"x", "y", "z"}));
-  tendon_map
-      ->add_option("--actuator-prefix", t->columns.actuator_prefix,
-                   "Columns whose names start with this are the actuators' readings")
-      ->capture_default_str();
-  tendon_map->add_option("--label-column", t->columns.label, "Column of the pattern labels")
-      ->capture_default_str();
-  tendon_map->add_option("--time-column", t->columns.time, "Column of the time [s]")
-      ->capture_default_str();
-  tendon_map
-      ->add_option("--min-rows", t->options.min_rows,
-                   "A pattern of fewer rows is not a pull (a hold, a label's tail)")
-      ->capture_default_str()
-      ->check(CLI::Range(3, 1000000));
-  tendon_map->add_option("--out", t->out, "Write the map (ccsrm-tendon-map/1 YAML)");
-  tendon_map->add_option(
-      "--actuator-map", t->actuator_map,
-      "Write the map as the actuators' (ccsrm-actuators/1 YAML: column, sign and "
-      "zero of every cable, tendon k as cable k)");
-  tendon_map->add_option("--unit", t->unit, "Unit of the actuators' readings (m or mm)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"m", "mm"}));
-  tendon_map->callback([t] {
-    if (!t->out.empty()) {
-      CheckOut(t->out, YamlFileOutput(mocap::kTendonMapSchema, "tendon map"), {t->log});
-    }
-    if (!t->actuator_map.empty()) {
-      // Neither the log nor the other output.
-      std::vector<std::string> not_these = {t->log};
-      if (!t->out.empty()) not_these.push_back(t->out);
-      CheckOutputPath(t->actuator_map, "--actuator-map",
-                      YamlFileOutput("ccsrm-actuators/1", "actuator map"), not_these);
-    }
-    t->options.axis = t->axis == "x" ? 0 : t->axis == "y" ? 1 : 2;
-    const mocap::PoseLog log = mocap::ReadPoseLog(t->log, t->columns);
-    const mocap::TendonMap map = mocap::IdentifyTendonMap(log, t->options);
-    std::printf("%s: %zu rows, %zu actuator columns; %zu tendons pulled one at a time\n%s",
-                t->log.c_str(), log.time_s.size(), log.actuator_columns.size(), map.tendons.size(),
-                map.Report().c_str());
-    if (!t->out.empty()) {
-      WriteTextFileAtomically(t->out, map.ToYaml(t->log));
-      std::printf("  output: %s\n", t->out.c_str());
-    }
-    if (!t->actuator_map.empty()) {
-      WriteTextFileAtomically(t->actuator_map,
-                              map.ActuatorMapYaml(t->log, t->columns.time, t->unit));
-      std::printf("  actuator map: %s\n", t->actuator_map.c_str());
-    }
-  });
-
+  AddTendonMap(dataset);
   AddImportPoseLog(dataset);
 
   CLI::App* assemble = dataset->add_subcommand(

@@ -14,15 +14,12 @@
 #include "ccsrm/sim/kinematics.h"
 #include "ccsrm/sim/recorded_inputs.h"
 #include "ccsrm/sim/simulator.h"
+#include "text_table.h"
 
 namespace ccsrm::mocap {
 namespace {
 
-std::string Format(const char* format, double value) {
-  char text[64];
-  std::snprintf(text, sizeof(text), format, value);
-  return text;
-}
+using internal::FormatNumber;
 
 // Linear interpolation of column `c` of `values` (rows at `time`, increasing)
 // at t; requires time[0] <= t <= time[n-1]. `hint` speeds up increasing t.
@@ -166,8 +163,8 @@ ClockFit AlignByTrigger(const std::vector<double>& mocap_edges_s,
     if (fits && drift_ok) {
       plausible.push_back({shift, fit});
     } else if (rejected.empty()) {
-      rejected = "best rejected pairing: residual " + Format("%.3g", fit.rms * 1e3) +
-                 " ms, drift " + Format("%.4g", fit.drift * 1e6) + " ppm";
+      rejected = "best rejected pairing: residual " + FormatNumber("%.3g", fit.rms * 1e3) +
+                 " ms, drift " + FormatNumber("%.4g", fit.drift * 1e6) + " ppm";
     }
   }
   if (plausible.empty()) {
@@ -175,15 +172,15 @@ ClockFit AlignByTrigger(const std::vector<double>& mocap_edges_s,
                     "no pairing of the " + std::to_string(m) + " C3D edge(s) with the " +
                         std::to_string(l) +
                         " log edge(s) fits within 5 × the edge timing and a drift below " +
-                        Format("%.4g", options.max_drift * 1e6) + " ppm (" + rejected + ")");
+                        FormatNumber("%.4g", options.max_drift * 1e6) + " ppm (" + rejected + ")");
   }
   if (plausible.size() > 1) {
     ThrowInputError(
         source, "trigger",
         "ambiguous alignment: " + std::to_string(plausible.size()) +
             " pairings of the edges fit equally well (offsets " +
-            Format("%.6g", plausible[0].fit.offset) + " s and " +
-            Format("%.6g", plausible[1].fit.offset) +
+            FormatNumber("%.6g", plausible[0].fit.offset) + " s and " +
+            FormatNumber("%.6g", plausible[1].fit.offset) +
             " s); use pulses at irregular intervals, --sync offset=S or --sync estimate");
   }
   const LineFit& fit = plausible.front().fit;
@@ -202,8 +199,9 @@ ClockFit AlignByTrigger(const std::vector<double>& mocap_edges_s,
   out.offset_sigma_s = sigma * std::sqrt(fit.inverse_normal(0, 0));
   out.drift_sigma = with_drift ? sigma * std::sqrt(fit.inverse_normal(1, 1)) : 0.0;
   out.note = std::to_string(pairs) + " edge pair(s) (" + std::to_string(m) + " in the C3D, " +
-             std::to_string(l) + " in the log), residual RMS " + Format("%.3g", fit.rms * 1e3) +
-             " ms" + (with_drift ? "" : ", drift not estimated");
+             std::to_string(l) + " in the log), residual RMS " +
+             FormatNumber("%.3g", fit.rms * 1e3) + " ms" +
+             (with_drift ? "" : ", drift not estimated");
   return out;
 }
 
@@ -375,17 +373,18 @@ ClockFit AlignToReference(const AlignmentData& d, const KinematicAlignmentOption
   double hi = log_time_s[log_time_s.size() - 1] - times.back();
   if (!(hi >= lo)) {
     ThrowInputError(source, "actuator log",
-                    "covers " + Format("%.6g", log_time_s[log_time_s.size() - 1] - log_time_s[0]) +
+                    "covers " +
+                        FormatNumber("%.6g", log_time_s[log_time_s.size() - 1] - log_time_s[0]) +
                         " s, shorter than the mocap recording (" +
-                        Format("%.6g", times.back() - times.front()) + " s)");
+                        FormatNumber("%.6g", times.back() - times.front()) + " s)");
   }
   if (std::isfinite(options.search_center_s) && std::isfinite(options.search_half_width_s)) {
     lo = std::max(lo, options.search_center_s - options.search_half_width_s);
     hi = std::min(hi, options.search_center_s + options.search_half_width_s);
     if (!(hi >= lo)) {
       ThrowInputError(source, "actuator log",
-                      "no offset within " + Format("%.6g", options.search_half_width_s) + " s of " +
-                          Format("%.6g", options.search_center_s) +
+                      "no offset within " + FormatNumber("%.6g", options.search_half_width_s) +
+                          " s of " + FormatNumber("%.6g", options.search_center_s) +
                           " s keeps the recording inside the log");
     }
   }
@@ -410,8 +409,8 @@ ClockFit AlignToReference(const AlignmentData& d, const KinematicAlignmentOption
     if (std::abs(minima[k].offset_s - best.offset_s) <= options.ambiguity_separation_s) continue;
     if ((minima[k].misfit - best.misfit) / (variance * inflation) < options.ambiguity_chi2) {
       ThrowInputError(source, "--sync estimate",
-                      "ambiguous alignment: log offsets " + Format("%.6g", best.offset_s) +
-                          " s and " + Format("%.6g", minima[k].offset_s) +
+                      "ambiguous alignment: log offsets " + FormatNumber("%.6g", best.offset_s) +
+                          " s and " + FormatNumber("%.6g", minima[k].offset_s) +
                           " s explain the measured angles equally well (a periodic motion?); "
                           "give a trigger or --sync offset=S");
     }
@@ -422,8 +421,9 @@ ClockFit AlignToReference(const AlignmentData& d, const KinematicAlignmentOption
   // Gauss-Newton: misfit ≈ misfit_min + ½ H δ², var(δ) = variance / (½ H).
   out.offset_sigma_s =
       best.curvature > 0.0 ? std::sqrt(2.0 * variance * inflation / best.curvature) : step;
-  const std::string stats = head + ", residual RMS " + Format("%.3g", std::sqrt(variance)) +
-                            " (N_eff " + Format("%.0f", n_eff) + " of " + Format("%.0f", n) + ")";
+  const std::string stats = head + ", residual RMS " + FormatNumber("%.3g", std::sqrt(variance)) +
+                            " (N_eff " + FormatNumber("%.0f", n_eff) + " of " +
+                            FormatNumber("%.0f", n) + ")";
   out.note = stats + "; drift not estimated";
   if (!options.estimate_drift) return out;
 
@@ -478,7 +478,8 @@ ClockFit AlignToReference(const AlignmentData& d, const KinematicAlignmentOption
   const double mid_sigma =
       at_best.curvature > 0.0 ? std::sqrt(2.0 * variance * inflation / at_best.curvature) : h;
   out.offset_sigma_s = std::hypot(mid_sigma, t_mid * out.drift_sigma);
-  out.note = stats + "; drift profiled over ±" + Format("%.4g", options.max_drift * 1e6) + " ppm";
+  out.note =
+      stats + "; drift profiled over ±" + FormatNumber("%.4g", options.max_drift * 1e6) + " ppm";
   return out;
 }
 
@@ -621,7 +622,7 @@ ClockFit AlignBySimulation(const sim::ArmModel& model, const sim::ArmParameters&
       AlignToReference(d, options,
                        std::to_string(frames) + " frames, " + std::to_string(joints) +
                            " joints; measured vs simulated angles (one run of the log, " +
-                           Format("%.3g", result.summary.wall_time_s) + " s) [rad]",
+                           FormatNumber("%.3g", result.summary.wall_time_s) + " s) [rad]",
                        source);
   out.method = "estimate";
   return out;
@@ -639,10 +640,11 @@ Eigen::MatrixXd ResampleOntoMocapTimes(const ClockFit& fit, const std::vector<do
   if (!mocap_time_s.empty() &&
       (mocap_time_s.front() < first - 1e-9 || mocap_time_s.back() > last + 1e-9)) {
     ThrowInputError(source, "actuator log",
-                    "covers mocap time " + Format("%.6g", first) + " to " + Format("%.6g", last) +
-                        " s after alignment (offset " + Format("%.6g", fit.offset_s) +
-                        " s), the markers " + Format("%.6g", mocap_time_s.front()) + " to " +
-                        Format("%.6g", mocap_time_s.back()) +
+                    "covers mocap time " + FormatNumber("%.6g", first) + " to " +
+                        FormatNumber("%.6g", last) + " s after alignment (offset " +
+                        FormatNumber("%.6g", fit.offset_s) + " s), the markers " +
+                        FormatNumber("%.6g", mocap_time_s.front()) + " to " +
+                        FormatNumber("%.6g", mocap_time_s.back()) +
                         " s: the log must cover the whole recording");
   }
   for (Eigen::Index c = 0; c < log_length_change_m.cols(); ++c) {

@@ -15,17 +15,14 @@
 #include "ccsrm/mocap/marker_io.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/recorded_inputs.h"
+#include "text_table.h"
 
 namespace ccsrm::mocap {
 namespace {
 
-namespace fs = std::filesystem;
+using internal::FormatNumber;
 
-std::string Format(const char* format, double value) {
-  char text[64];
-  std::snprintf(text, sizeof(text), format, value);
-  return text;
-}
+namespace fs = std::filesystem;
 
 std::string Lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -114,11 +111,12 @@ bool LabRecordingRequest::IsValid(std::string* error) const {
 
 std::string AssembledRecording::Report() const {
   std::string out = "actuator log: " + log_summary + "\n";
-  out += "clock alignment (" + clock.method + "): log time = " + Format("%.6f", clock.offset_s) +
-         " s + (1 + " + Format("%.2f", clock.drift * 1e6) + " ppm) × mocap time; offset ± " +
-         Format("%.3g", clock.offset_sigma_s * 1e3) + " ms";
+  out += "clock alignment (" + clock.method +
+         "): log time = " + FormatNumber("%.6f", clock.offset_s) + " s + (1 + " +
+         FormatNumber("%.2f", clock.drift * 1e6) + " ppm) × mocap time; offset ± " +
+         FormatNumber("%.3g", clock.offset_sigma_s * 1e3) + " ms";
   if (clock.drift_sigma > 0.0)
-    out += ", drift ± " + Format("%.3g", clock.drift_sigma * 1e6) + " ppm";
+    out += ", drift ± " + FormatNumber("%.3g", clock.drift_sigma * 1e6) + " ppm";
   out += "\n  " + clock.note + "\n";
   if (!kinematic_check.empty()) {
     out += std::string(misaligned ? "warning: " : "  ") + kinematic_check + "\n";
@@ -194,8 +192,9 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
   const double log_step = (log.time_s[n - 1] - log.time_s[0]) / static_cast<double>(n - 1);
   out.log_summary = request.actuators + ": " + std::to_string(n) + " samples, " +
                     std::to_string(log.length_change_m.cols()) + " cable(s), " +
-                    Format("%.6g", log.time_s[0]) + " to " + Format("%.6g", log.time_s[n - 1]) +
-                    " s on its clock (mean step " + Format("%.3g", log_step * 1e3) + " ms)";
+                    FormatNumber("%.6g", log.time_s[0]) + " to " +
+                    FormatNumber("%.6g", log.time_s[n - 1]) + " s on its clock (mean step " +
+                    FormatNumber("%.3g", log_step * 1e3) + " ms)";
 
   switch (request.sync) {
     case ClockSync::kOffset:
@@ -279,10 +278,11 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
       const double limit = std::max(4.0 * sigma, 2.0 * frame_s);
       out.misaligned = std::abs(difference) > limit;
       out.kinematic_check =
-          "kinematic check: the joint angles put the log " + Format("%+.1f", difference * 1e3) +
-          " ms from this alignment (± " + Format("%.2g", sigma * 1e3) + " ms)" +
+          "kinematic check: the joint angles put the log " +
+          FormatNumber("%+.1f", difference * 1e3) + " ms from this alignment (± " +
+          FormatNumber("%.2g", sigma * 1e3) + " ms)" +
           (out.misaligned
-               ? ", more than the " + Format("%.3g", limit * 1e3) +
+               ? ", more than the " + FormatNumber("%.3g", limit * 1e3) +
                      " ms a quasi-static arm allows: check the trigger or the offset (or the "
                      "arm lags its inputs: friction, elasticity; --sync estimate, which simulates "
                      "the "

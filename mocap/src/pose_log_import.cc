@@ -14,17 +14,14 @@
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/recorded_inputs.h"
+#include "text_table.h"
 
 namespace ccsrm::mocap {
 namespace {
 
-namespace fs = std::filesystem;
+using internal::FormatNumber;
 
-std::string Format(const char* format, double value) {
-  char text[64];
-  std::snprintf(text, sizeof(text), format, value);
-  return text;
-}
+namespace fs = std::filesystem;
 
 // The rows [begin, end) the request selects of a log of `rows` rows.
 std::pair<std::size_t, std::size_t> SelectedRows(const PoseLogImportRequest& request,
@@ -132,13 +129,13 @@ ImportedPoseLog ImportPoseLog(const PoseLogImportRequest& request) {
       std::minmax_element(e.input_length_change.values.begin(), e.input_length_change.values.end());
   out.report = request.log + ": rows " + std::to_string(begin + 1) + " to " + std::to_string(end) +
                " of " + std::to_string(poses.time_s.size()) + ": " + std::to_string(n) +
-               " settled poses over " + Format("%.1f", e.input_time.values.back()) + " s, " +
+               " settled poses over " + FormatNumber("%.1f", e.input_time.values.back()) + " s, " +
                std::to_string(patterns.size()) + " pattern label(s)\n  " + std::to_string(cables) +
                " cables through " + request.actuator_map + ": pulled in " +
-               Format("%.3f", *low * 1e3) + " to " + Format("%.3f", *high * 1e3) +
+               FormatNumber("%.3f", *low * 1e3) + " to " + FormatNumber("%.3f", *high * 1e3) +
                " mm\n  tracked point 'tip' on link" + std::to_string(tip_link) + " at (" +
-               Format("%.2f", local[0] * 1e3) + ", " + Format("%.2f", local[1] * 1e3) + ", " +
-               Format("%.2f", local[2] * 1e3) +
+               FormatNumber("%.2f", local[0] * 1e3) + ", " + FormatNumber("%.2f", local[1] * 1e3) +
+               ", " + FormatNumber("%.2f", local[2] * 1e3) +
                ") mm in its frame, in the capture frame (placement unknown)\n";
   return out;
 }

@@ -3,6 +3,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <system_error>
 
 #include "ccsrm/common/error.h"
@@ -144,6 +145,12 @@ void FailAtCell(const std::string& file, std::size_t line, std::size_t column,
 std::string Quoted(const std::string& cell) {
   if (cell.size() <= 40) return "'" + cell + "'";
   return "'" + cell.substr(0, 37) + "...'";
+}
+
+std::string FormatNumber(const char* format, double value) {
+  char text[64];
+  std::snprintf(text, sizeof(text), format, value);
+  return text;
 }
 
 double NumberCell(const std::string& file, const TextRow& row, std::size_t column,

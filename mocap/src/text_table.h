@@ -68,4 +68,8 @@ std::string PartialPointsWarning(std::size_t partial);
 // Quotes a cell for an error message, shortened to 40 characters.
 std::string Quoted(const std::string& cell);
 
+// `value` printed by a printf format of one double ("%.3f"), for messages and
+// reports.
+std::string FormatNumber(const char* format, double value);
+
 }  // namespace ccsrm::mocap::internal

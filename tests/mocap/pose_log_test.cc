@@ -243,15 +243,21 @@ PullFiles WritePullFiles(const std::string& name) {
   return f;
 }
 
-TEST(PoseLogImport, MakesSettledPosesOfATrackedTipFromTheLogThroughItsMap) {
-  const Robot robot;
-  const PullFiles f = WritePullFiles("pose_log_import");
+// The import of rows first..last of those files onto the robot's arm.
+PoseLogImportRequest ImportRequest(const PullFiles& f, std::size_t first, std::size_t last) {
   PoseLogImportRequest request;
   request.log = f.log;
   request.actuator_map = f.map;
   request.config = RobotConfigPath();
-  request.first_row = 3;
-  request.last_row = 40;
+  request.first_row = first;
+  request.last_row = last;
+  return request;
+}
+
+TEST(PoseLogImport, MakesSettledPosesOfATrackedTipFromTheLogThroughItsMap) {
+  const Robot robot;
+  const PullFiles f = WritePullFiles("pose_log_import");
+  PoseLogImportRequest request = ImportRequest(f, 3, 40);
   request.tip_from_link_end_m = Eigen::Vector3d(0.0, 0.0, 8e-3);
   const ImportedPoseLog imported = ImportPoseLog(request);
   std::printf("%s", imported.report.c_str());
@@ -300,12 +306,7 @@ TEST(PoseLogImport, MakesSettledPosesOfATrackedTipFromTheLogThroughItsMap) {
 
 TEST(PoseLogImport, BadRequestsAreNamedInOneLine) {
   const PullFiles f = WritePullFiles("pose_log_import_bad");
-  PoseLogImportRequest request;
-  request.log = f.log;
-  request.actuator_map = f.map;
-  request.config = RobotConfigPath();
-  request.first_row = 30;
-  request.last_row = 400;
+  PoseLogImportRequest request = ImportRequest(f, 30, 400);
   const std::size_t rows = f.poses.time_s.size();
   EXPECT_EQ(testing::InputErrorOf([&] { ImportPoseLog(request); }),
             f.log + ": rows: 30 to 400 selected, the log has " + std::to_string(rows) +
