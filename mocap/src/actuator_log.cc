@@ -14,6 +14,8 @@
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/yaml_document.h"
+#include "ccsrm/sim/model.h"
+#include "ccsrm/sim/recorded_inputs.h"
 #include "text_table.h"
 
 namespace ccsrm::mocap {
@@ -385,6 +387,26 @@ ActuatorLog ParseActuatorLog(const std::string& text, const std::string& source_
 ActuatorLog ReadActuatorLog(const std::string& path, const ActuatorMap& map,
                             const std::string& map_file) {
   return ParseActuatorLog(ReadTextFile(path), path, map, map_file);
+}
+
+void CheckActuatorLogOnArm(const ActuatorLog& log, const ActuatorMap& map,
+                           const std::string& map_file, const sim::ArmModel& model,
+                           const std::string& config_file, Eigen::Index first, Eigen::Index count) {
+  if (log.length_change_m.cols() != model.num_cables()) {
+    ThrowInputError(map_file, "cables",
+                    "maps " + std::to_string(log.length_change_m.cols()) + " cable(s), the arm (" +
+                        config_file + ") has " + std::to_string(model.num_cables()) +
+                        " driving cables");
+  }
+  if (count < 0) count = log.time_s.size() - first;
+  sim::RecordedInputs record;
+  record.source_name = log.source_name;
+  record.time_name = map.time_column;
+  record.cable_names = log.cable_columns;
+  record.time_s = log.time_s.segment(first, count);
+  record.length_change_m = log.length_change_m.middleRows(first, count);
+  record.lines.assign(log.lines.begin() + first, log.lines.begin() + first + count);
+  sim::CheckRecordedInputsOnArm(record, model);
 }
 
 }  // namespace ccsrm::mocap

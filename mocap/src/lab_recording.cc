@@ -14,7 +14,6 @@
 #include "ccsrm/mocap/c3d.h"
 #include "ccsrm/mocap/marker_io.h"
 #include "ccsrm/sim/config.h"
-#include "ccsrm/sim/recorded_inputs.h"
 #include "text_table.h"
 
 namespace ccsrm::mocap {
@@ -68,6 +67,81 @@ double StampJitter(const Eigen::VectorXd& time_s) {
   const double middle = median(steps);
   for (double& s : steps) s = std::abs(s - middle);
   return 1.4826 * median(steps) / std::sqrt(2.0);
+}
+
+// --sync trigger: the edges of the C3D analog channel `channel` matched to
+// those of the log's trigger column.
+ClockFit AlignByTriggerChannel(const C3dAnalog& analog, std::size_t channel,
+                               const std::vector<double>& mocap_time, const ActuatorLog& log,
+                               const ActuatorMap& map, const LabRecordingRequest& request) {
+  Eigen::VectorXd t(static_cast<Eigen::Index>(analog.sample_count));
+  Eigen::VectorXd v(static_cast<Eigen::Index>(analog.sample_count));
+  for (std::size_t s = 0; s < analog.sample_count; ++s) {
+    // Analog sample s of frame f = s / samples_per_frame lies s mod
+    // samples_per_frame sub-steps after the frame's time.
+    t[static_cast<Eigen::Index>(s)] = mocap_time.front() + analog.time_s(s);
+    v[static_cast<Eigen::Index>(s)] = analog.value(s, channel);
+  }
+  const std::vector<double> mocap_edges = FindEdges(t, v, request.mocap_edges);
+  EdgeOptions log_edges_options;
+  log_edges_options.threshold = map.trigger->threshold;
+  log_edges_options.rising = map.trigger->polarity == "rising";
+  log_edges_options.interpolate = false;  // the controller set its output at that tick
+  log_edges_options.min_separation_s = request.mocap_edges.min_separation_s;
+  const std::vector<double> log_edges = FindEdges(log.time_s, log.trigger, log_edges_options);
+  TriggerAlignmentOptions options = request.trigger;
+  // Quantisation of a crossing to one sample: period / √12.
+  if (options.mocap_edge_sigma_s <= 0.0) {
+    options.mocap_edge_sigma_s = 1.0 / (analog.rate_hz * std::sqrt(12.0));
+  }
+  // The log's edges are its ticks (the controller raised its output
+  // then): their error is the stamps' jitter, measured on the log
+  // itself from the scatter of its steps (a step is the difference of
+  // two stamps: √2 × one stamp's jitter).
+  if (options.log_edge_sigma_s <= 0.0) {
+    options.log_edge_sigma_s = StampJitter(log.time_s);
+  }
+  ClockFit clock =
+      AlignByTrigger(mocap_edges, log_edges, options, request.markers + " + " + request.actuators);
+  clock.note = "channel '" + analog.labels[channel] + "': " + clock.note;
+  return clock;
+}
+
+// The joint angles as a second witness of an alignment made without them:
+// where they put the log at the middle of the recording, against
+// out->clock. Sets out->misaligned and out->kinematic_check.
+void CheckAlignmentKinematically(const sim::ArmModel& model, const std::vector<double>& mocap_time,
+                                 const std::vector<double>& angles, const ActuatorLog& log,
+                                 const LabRecordingRequest& request, AssembledRecording* out) {
+  const double t_mid = 0.5 * (mocap_time.front() + mocap_time.back());
+  const double frame_s = (mocap_time.back() - mocap_time.front()) /
+                         static_cast<double>(std::max<std::size_t>(1, mocap_time.size() - 1));
+  // Within 1 s of the alignment used (ten times the largest lag seen on
+  // the generated arms): the check costs a fraction of a full search.
+  KinematicAlignmentOptions window = request.estimate;
+  window.estimate_drift = false;
+  window.search_center_s = out->clock.LogTime(t_mid) - t_mid;
+  window.search_half_width_s = 1.0;
+  try {
+    const ClockFit kinematic =
+        AlignByKinematics(model, mocap_time, angles, log.time_s, log.length_change_m, window,
+                          request.markers + " + " + request.actuators);
+    const double difference = kinematic.LogTime(t_mid) - out->clock.LogTime(t_mid);
+    const double sigma = std::hypot(kinematic.offset_sigma_s, out->clock.offset_sigma_s);
+    const double limit = std::max(4.0 * sigma, 2.0 * frame_s);
+    out->misaligned = std::abs(difference) > limit;
+    out->kinematic_check =
+        "kinematic check: the joint angles put the log " + FormatNumber("%+.1f", difference * 1e3) +
+        " ms from this alignment (± " + FormatNumber("%.2g", sigma * 1e3) + " ms)" +
+        (out->misaligned
+             ? ", more than the " + FormatNumber("%.3g", limit * 1e3) +
+                   " ms a quasi-static arm allows: check the trigger or the offset (or the "
+                   "arm lags its inputs: friction, elasticity; --sync estimate, which simulates "
+                   "the arm, tells them apart)"
+             : ": consistent");
+  } catch (const InputError& e) {
+    out->kinematic_check = std::string("kinematic check not possible: ") + e.what();
+  }
 }
 
 }  // namespace
@@ -139,25 +213,7 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
     sim::ApplyParameterYaml(ReadTextFile(request.params), request.params, &config.parameters);
   }
   const sim::ArmModel model(config.arm);
-  if (log.length_change_m.cols() != model.num_cables()) {
-    ThrowInputError(request.actuator_map, "cables",
-                    "maps " + std::to_string(log.length_change_m.cols()) + " cable(s), the arm (" +
-                        request.config + ") has " + std::to_string(model.num_cables()) +
-                        " driving cables");
-  }
-  {
-    // The log's lengths within the arm's bounds: a column in the wrong unit
-    // (mm declared m) pulls a cable metres, which the kinematic check
-    // cannot see (it compares shapes, not scale).
-    sim::RecordedInputs record;
-    record.source_name = request.actuators;
-    record.time_name = map.time_column;
-    record.cable_names = log.cable_columns;
-    record.time_s = log.time_s;
-    record.length_change_m = log.length_change_m;
-    record.lines.assign(log.lines.begin(), log.lines.end());
-    sim::CheckRecordedInputsOnArm(record, model);
-  }
+  CheckActuatorLogOnArm(log, map, request.actuator_map, model, request.config);
   if (request.sync == ClockSync::kTrigger && log.trigger.size() == 0) {
     ThrowInputError(request.actuator_map, "trigger",
                     "missing: --sync trigger needs the log's trigger column");
@@ -203,40 +259,9 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
       out.clock.drift = request.clock_drift_ppm * 1e-6;
       out.clock.note = "given (--sync offset=S)";
       break;
-    case ClockSync::kTrigger: {
-      const std::size_t channel = trigger_channel;
-      Eigen::VectorXd t(static_cast<Eigen::Index>(analog.sample_count));
-      Eigen::VectorXd v(static_cast<Eigen::Index>(analog.sample_count));
-      for (std::size_t s = 0; s < analog.sample_count; ++s) {
-        // Analog sample s of frame f = s / samples_per_frame lies s mod
-        // samples_per_frame sub-steps after the frame's time.
-        t[static_cast<Eigen::Index>(s)] = mocap_time.front() + analog.time_s(s);
-        v[static_cast<Eigen::Index>(s)] = analog.value(s, channel);
-      }
-      const std::vector<double> mocap_edges = FindEdges(t, v, request.mocap_edges);
-      EdgeOptions log_edges_options;
-      log_edges_options.threshold = map.trigger->threshold;
-      log_edges_options.rising = map.trigger->polarity == "rising";
-      log_edges_options.interpolate = false;  // the controller set its output at that tick
-      log_edges_options.min_separation_s = request.mocap_edges.min_separation_s;
-      const std::vector<double> log_edges = FindEdges(log.time_s, log.trigger, log_edges_options);
-      TriggerAlignmentOptions options = request.trigger;
-      // Quantisation of a crossing to one sample: period / √12.
-      if (options.mocap_edge_sigma_s <= 0.0) {
-        options.mocap_edge_sigma_s = 1.0 / (analog.rate_hz * std::sqrt(12.0));
-      }
-      // The log's edges are its ticks (the controller raised its output
-      // then): their error is the stamps' jitter, measured on the log
-      // itself from the scatter of its steps (a step is the difference of
-      // two stamps: √2 × one stamp's jitter).
-      if (options.log_edge_sigma_s <= 0.0) {
-        options.log_edge_sigma_s = StampJitter(log.time_s);
-      }
-      out.clock = AlignByTrigger(mocap_edges, log_edges, options,
-                                 request.markers + " + " + request.actuators);
-      out.clock.note = "channel '" + analog.labels[channel] + "': " + out.clock.note;
+    case ClockSync::kTrigger:
+      out.clock = AlignByTriggerChannel(analog, trigger_channel, mocap_time, log, map, request);
       break;
-    }
     case ClockSync::kEstimate:
     case ClockSync::kEstimateKinematic: {
       if (!experiment.measured_joint_angles) {
@@ -258,39 +283,8 @@ AssembledRecording AssembleLabRecording(const LabRecordingRequest& request) {
   const bool estimated =
       request.sync == ClockSync::kEstimate || request.sync == ClockSync::kEstimateKinematic;
   if (!estimated && experiment.measured_joint_angles) {
-    // The joint angles as a second witness: where they put the log, at the
-    // middle of the recording, against the alignment used.
-    const double t_mid = 0.5 * (mocap_time.front() + mocap_time.back());
-    const double frame_s = (mocap_time.back() - mocap_time.front()) /
-                           static_cast<double>(std::max<std::size_t>(1, mocap_time.size() - 1));
-    // Within 1 s of the alignment used (ten times the largest lag seen on
-    // the generated arms): the check costs a fraction of a full search.
-    KinematicAlignmentOptions window = request.estimate;
-    window.estimate_drift = false;
-    window.search_center_s = out.clock.LogTime(t_mid) - t_mid;
-    window.search_half_width_s = 1.0;
-    try {
-      const ClockFit kinematic = AlignByKinematics(
-          model, mocap_time, experiment.measured_joint_angles->values, log.time_s,
-          log.length_change_m, window, request.markers + " + " + request.actuators);
-      const double difference = kinematic.LogTime(t_mid) - out.clock.LogTime(t_mid);
-      const double sigma = std::hypot(kinematic.offset_sigma_s, out.clock.offset_sigma_s);
-      const double limit = std::max(4.0 * sigma, 2.0 * frame_s);
-      out.misaligned = std::abs(difference) > limit;
-      out.kinematic_check =
-          "kinematic check: the joint angles put the log " +
-          FormatNumber("%+.1f", difference * 1e3) + " ms from this alignment (± " +
-          FormatNumber("%.2g", sigma * 1e3) + " ms)" +
-          (out.misaligned
-               ? ", more than the " + FormatNumber("%.3g", limit * 1e3) +
-                     " ms a quasi-static arm allows: check the trigger or the offset (or the "
-                     "arm lags its inputs: friction, elasticity; --sync estimate, which simulates "
-                     "the "
-                     "arm, tells them apart)"
-               : ": consistent");
-    } catch (const InputError& e) {
-      out.kinematic_check = std::string("kinematic check not possible: ") + e.what();
-    }
+    CheckAlignmentKinematically(model, mocap_time, experiment.measured_joint_angles->values, log,
+                                request, &out);
   }
 
   const Eigen::MatrixXd lengths = ResampleOntoMocapTimes(out.clock, mocap_time, log.time_s,

@@ -7,13 +7,11 @@
 #include <set>
 #include <string>
 
-#include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
 #include "ccsrm/mocap/actuator_log.h"
 #include "ccsrm/mocap/pose_log.h"
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
-#include "ccsrm/sim/recorded_inputs.h"
 #include "text_table.h"
 
 namespace ccsrm::mocap {
@@ -60,27 +58,11 @@ ImportedPoseLog ImportPoseLog(const PoseLogImportRequest& request) {
 
   const sim::Config config = sim::LoadConfig(request.config);
   const sim::ArmModel model(config.arm);
-  if (lengths.length_change_m.cols() != model.num_cables()) {
-    ThrowInputError(request.actuator_map, "cables",
-                    "maps " + std::to_string(lengths.length_change_m.cols()) +
-                        " cable(s), the arm (" + request.config + ") has " +
-                        std::to_string(model.num_cables()) + " driving cables");
-  }
   const auto [begin, end] = SelectedRows(request, poses.time_s.size());
   const std::size_t n = end - begin;
   const Eigen::Index b = static_cast<Eigen::Index>(begin);
   const Eigen::Index rows = static_cast<Eigen::Index>(n);
-  {
-    // Within the arm's bounds: a column in the wrong unit pulls metres.
-    sim::RecordedInputs record;
-    record.source_name = request.log;
-    record.time_name = map.time_column;
-    record.cable_names = lengths.cable_columns;
-    record.time_s = lengths.time_s.segment(b, rows);
-    record.length_change_m = lengths.length_change_m.middleRows(b, rows);
-    record.lines.assign(lengths.lines.begin() + b, lengths.lines.begin() + b + rows);
-    sim::CheckRecordedInputsOnArm(record, model);
-  }
+  CheckActuatorLogOnArm(lengths, map, request.actuator_map, model, request.config, b, rows);
 
   ImportedPoseLog out;
   datasets::ExperimentFile& e = out.experiment;
@@ -88,7 +70,7 @@ ImportedPoseLog ImportPoseLog(const PoseLogImportRequest& request) {
   e.source = datasets::ExperimentSource::kRecorded;
   e.motion = datasets::RecordedMotion::kSettledPoses;
   e.marker_frame = datasets::MarkerFrame::kCapture;
-  e.config_yaml = ReadTextFile(request.config);
+  e.config_yaml = config.source_yaml;
   e.description = "pose log " + fs::path(request.log).filename().string() + ", rows " +
                   std::to_string(begin + 1) + " to " + std::to_string(end) + " of " +
                   std::to_string(poses.time_s.size()) + ", the actuators through " +

@@ -10,6 +10,10 @@
 #include <string>
 #include <vector>
 
+namespace ccsrm::sim {
+class ArmModel;
+}
+
 namespace ccsrm::mocap {
 
 inline constexpr const char* kActuatorMapSchema = "ccsrm-actuators/1";
@@ -94,5 +98,16 @@ ActuatorLog ParseActuatorLog(const std::string& text, const std::string& source_
                              const ActuatorMap& map, const std::string& map_file);
 ActuatorLog ReadActuatorLog(const std::string& path, const ActuatorMap& map,
                             const std::string& map_file);
+
+// The one check of a log's lengths against the arm they drive (`dataset
+// assemble`, `dataset import-pose-log`): one cable per driving cable of
+// `model` (else InputError naming `map_file`, key 'cables', and
+// `config_file`), and its samples [first, first + count) within the arm's
+// bounds (sim::CheckRecordedInputsOnArm: a column in the wrong unit pulls a
+// cable metres). count < 0: to the last sample.
+void CheckActuatorLogOnArm(const ActuatorLog& log, const ActuatorMap& map,
+                           const std::string& map_file, const sim::ArmModel& model,
+                           const std::string& config_file, Eigen::Index first = 0,
+                           Eigen::Index count = -1);
 
 }  // namespace ccsrm::mocap
