@@ -43,9 +43,14 @@ MarkerTable TableFromArrays(const py::object& positions, const std::vector<std::
   return table;
 }
 
-}  // namespace
+// The pipeline's outcome: the experiment it made and its quality summary.
+struct Processed {
+  std::shared_ptr<ExperimentFile> dataset;
+  mocap::ProcessingSummary summary;
+};
 
-void AddData(py::module_& m) {
+// The Dataset class: an experiment file's attributes and read-only arrays.
+void AddDatasetClass(py::module_& m) {
   py::class_<ExperimentFile, std::shared_ptr<ExperimentFile>>(
       m, "Dataset",
       "A ccsrm-dataset/1 experiment file (datasets/README.md): N input samples, F mocap "
@@ -115,12 +120,12 @@ void AddData(py::module_& m) {
         return "<ccsrm.Dataset '" + e.name + "': " + std::to_string(e.input_time.rows()) +
                " input samples, " + std::to_string(e.mocap_time.rows()) + " mocap frames>";
       });
+}
 
-  // The pipeline's outcome: the experiment it made and its quality summary.
-  struct Processed {
-    std::shared_ptr<ExperimentFile> dataset;
-    mocap::ProcessingSummary summary;
-  };
+}  // namespace
+
+void AddData(py::module_& m) {
+  AddDatasetClass(m);
   py::class_<Processed>(m, "ProcessedRecording",
                         "What the mocap pipeline made of a recording (ccsrm.process_markers).")
       .def_readonly("dataset", &Processed::dataset,
