@@ -187,6 +187,9 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
     const HoleNodeRef& hole = layout_.holes()[h];
     stuck_s_[h] = y0[model_.node_offset(hole.cable, hole.node) + 3];
   }
+  zero_rates_.assign(n_, 0.0);
+  rest_memory_.assign(y0.data() + memory_offset(), y0.data() + state_size());
+  settled_now_ = InitialSettledFriction();
 }
 
 const char* ArmDynamics::StateEntryKind(int k) const {
@@ -417,7 +420,11 @@ void ArmDynamics::AddHoleFriction(const double* q, const double* qd, const doubl
     memory_rate_[h] = 0.0;
     const double v = qd[o + 3];
     if (presliding_ >= 0) {
-      AddPreslidingFriction(static_cast<int>(h), o + 3, t_before, v, memory);
+      const double xi =
+          settled_from_ != nullptr
+              ? SettledHoleDisplacement(static_cast<int>(h), q[o + 3], report.wrap_angle)
+              : memory[presliding_ + h];
+      AddPreslidingFriction(static_cast<int>(h), o + 3, t_before, v, memory, xi);
       continue;
     }
     if (solver_.hole_friction == HoleFrictionModel::kSmoothed) {
@@ -475,7 +482,7 @@ void ArmDynamics::AddHoleFriction(const double* q, const double* qd, const doubl
 // and that damper would feed energy in. The spring's energy joins the
 // elastic energy; the plastic and the smoothing power are dissipated.
 void ArmDynamics::AddPreslidingFriction(int h, int s_col, double t_before, double v,
-                                        const double* memory) {
+                                        const double* memory, double xi) {
   const PreslidingLaw law{
       {parameters_.mu, parameters_.mu_s, parameters_.v_s, solver_.stick_velocity_tolerance_mps},
       parameters_.xi_f,
@@ -485,7 +492,6 @@ void ArmDynamics::AddPreslidingFriction(int h, int s_col, double t_before, doubl
   const double target = HoleMemoryTarget(law.friction, v, nullptr);
   const double z = remembers ? memory[h] : target;
   if (remembers) memory_rate_[h] = (target - z) / parameters_.tau_f;
-  const double xi = memory[presliding_ + h];
   const PreslidingFriction f = PreslidingHoleFriction(law, t_before, report.wrap_angle, v, z, xi);
   memory_rate_[presliding_ + h] = f.rate;
   report.required_friction = f.force;
@@ -594,7 +600,10 @@ void ArmDynamics::AddConnectingMoments(double t, const double* memory) {
                                                     solver_.stick_velocity_tolerance_mps,
                                                     PreslidingRelaxationResolution()};
           const int eta_index = pair.presliding + axis;
-          const double eta = memory[eta_index];
+          const double eta = settled_from_ != nullptr
+                                 ? SettledConduitDisplacement(static_cast<int>(p), axis,
+                                                              theta_[i][axis], theta_[j][axis])
+                                 : memory[eta_index];
           const ConduitPresliding f = PreslidingConduitFriction(presliding_law, v_tau1, z, eta);
           memory_rate_[eta_index] = f.rate;
           large = LargeSMomentsWithCoefficient(*large_params, th_i, th_j, rt_i, rt_j, f.coefficient,
@@ -1005,6 +1014,112 @@ void ArmDynamics::FillConstraints(double t, const double* q, const double* qd, b
     finish(row, a_vec.dot(c_vec), a_dot.dot(c_vec) + a_vec.dot(c_dot), bias_o);
   }
   CCSRM_CHECK(r == m_);
+}
+
+SettledFriction ArmDynamics::InitialSettledFriction() const {
+  SettledFriction friction;
+  const std::vector<HoleNodeRef>& holes = layout_.holes();
+  const Eigen::VectorXd y0 = InitialState();
+  for (const HoleNodeRef& hole : holes)
+    friction.hole_s.push_back(y0[model_.node_offset(hole.cable, hole.node) + 3]);
+  friction.hole_xi.assign(holes.size(), 0.0);
+  friction.conduit_slip.assign(2 * pair_kernels_.size(), 0.0);
+  friction.conduit_eta.assign(2 * pair_kernels_.size(), 0.0);
+  return friction;
+}
+
+Eigen::VectorXd ArmDynamics::RestState(const double* q, const SettledFriction& friction) const {
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(state_size());
+  y.head(n_) = Eigen::Map<const Eigen::VectorXd>(q, n_);
+  y.tail(num_memory_) = Eigen::Map<const Eigen::VectorXd>(rest_memory_.data(), num_memory_);
+  if (presliding_ >= 0) {
+    for (std::size_t h = 0; h < layout_.holes().size(); ++h)
+      y[memory_offset() + presliding_ + h] = friction.hole_xi[h];
+  }
+  for (std::size_t p = 0; p < pair_kernels_.size(); ++p) {
+    if (pair_kernels_[p].presliding < 0) continue;
+    for (int axis = 0; axis < 2; ++axis)
+      y[memory_offset() + pair_kernels_[p].presliding + axis] = friction.conduit_eta[2 * p + axis];
+  }
+  return y;
+}
+
+// The presliding laws at rest (memory z = 1), without their relaxation's
+// smoothing: slow slip is the limit it leaves unchanged.
+double ArmDynamics::SettledHoleDisplacement(int h, double s, double wrap_angle) {
+  const PreslidingLaw law{
+      {parameters_.mu, parameters_.mu_s, parameters_.v_s, solver_.stick_velocity_tolerance_mps},
+      parameters_.xi_f,
+      0.0};
+  const double up = PreslidingSteadyDisplacement(law, wrap_angle, 1.0, 1.0);
+  const double down = PreslidingSteadyDisplacement(law, wrap_angle, 1.0, -1.0);
+  const double xi = ElastoplasticDisplacementAfterSlip(settled_from_->hole_xi[h],
+                                                       s - settled_from_->hole_s[h], up, down);
+  settled_now_.hole_s[h] = s;
+  settled_now_.hole_xi[h] = xi;
+  return xi;
+}
+
+// At rest eta_ss is xi_c in both directions (PreslidingConduitFriction at z
+// = 1); the slip coordinate is v_tau1's integral, linear in the angles.
+double ArmDynamics::SettledConduitDisplacement(int p, int axis, double theta_i, double theta_j) {
+  const int k = 2 * p + axis;
+  const double slip = ConduitSlipVelocity(pair_kernels_[p].large, theta_i, theta_j);
+  const double eta = ElastoplasticDisplacementAfterSlip(settled_from_->conduit_eta[k],
+                                                        slip - settled_from_->conduit_slip[k],
+                                                        parameters_.xi_c, parameters_.xi_c);
+  settled_now_.conduit_slip[k] = slip;
+  settled_now_.conduit_eta[k] = eta;
+  return eta;
+}
+
+bool ArmDynamics::SettledResidual(double t, const double* x, const SettledFriction& from,
+                                  double* residual) {
+  ++evaluations_;
+  failure_.clear();
+  const double* q = x;
+  const double* qd = zero_rates_.data();
+  const double* memory = rest_memory_.data();
+  system_.Clear();
+  force_.setZero();
+  dissipation_ = kinetic_ = elastic_ = 0.0;
+  // The stages of Evaluate up to the constraints, at rest; the presliding
+  // displacements from `from` (settled_from_ is read by the friction stages).
+  settled_from_ = &from;
+  ComputeLinkKinematics(q, qd);
+  const bool elements = AddCableElements(q, qd);
+  if (elements) {
+    AddHoleFriction(q, qd, memory);
+    ComputeJointAngles();
+    AddConnectingMoments(t, memory);
+    AddBackboneMoments();
+    AddEffectLoads(t, qd);
+    ApplyJointMoments(q);
+    AddLinkInertia(q, qd);
+    FillConstraints(t, q, qd, true);
+  }
+  settled_from_ = nullptr;
+  if (!elements) return false;
+  const double* lambda = x + n_;
+  std::copy(force_.data(), force_.data() + n_, residual);
+  const std::vector<ConstraintRowLayout>& layout_rows = layout_.rows();
+  for (int r = 0; r < m_; ++r) {
+    const RowValues& row = rows_[r];
+    if (!row.active) {
+      residual[n_ + r] = lambda[r];
+      continue;
+    }
+    residual[n_ + r] = row.phi;
+    const ConstraintRowLayout& cols = layout_rows[r];
+    for (int a = 0; a < cols.count; ++a) residual[cols.cols[a]] -= row.vals[a] * lambda[r];
+  }
+  for (int k = 0; k < n_ + m_; ++k) {
+    if (!std::isfinite(residual[k])) {
+      failure_ = "non-finite force at rest";
+      return false;
+    }
+  }
+  return true;
 }
 
 double ArmDynamics::ConstraintViolation(double t, const double* y) {

@@ -47,6 +47,16 @@ struct HoleReport {
   double sliding_speed = 0.0;
 };
 
+// The frictional state that a settled pose leaves for the next (the
+// quasi-static replay, quasi_static.h): per hole node its material
+// coordinate s [m] and presliding displacement xi [m]; per connecting pair
+// and axis (index 2 p + axis; small-S pairs unused) its conduit's slip
+// coordinate -r (theta_i + theta_j) / 2 [m] and presliding displacement eta [m].
+struct SettledFriction {
+  std::vector<double> hole_s, hole_xi;
+  std::vector<double> conduit_slip, conduit_eta;
+};
+
 class ArmDynamics {
  public:
   // `model` and `inputs` must outlive this object. Preconditions (checked):
@@ -101,12 +111,39 @@ class ArmDynamics {
 
   std::int64_t evaluations() const { return evaluations_; }
 
+  // Quasi-static replay (quasi_static.h). The unknowns x = [q (n), lambda
+  // (num_constraints())] of the static equilibrium at rest at time t, and
+  // its residual [F(q) - Phi_q^T lambda; Phi(q, t)] with every velocity zero,
+  // every frictional memory at rest (z = 1) and every presliding
+  // displacement carried from `from` over its contact's slip since then
+  // (ElastoplasticDisplacementAfterSlip); a constraint row that is off has
+  // the residual lambda. Returns false as Evaluate does.
+  int num_constraints() const { return m_; }
+  bool SettledResidual(double t, const double* x, const SettledFriction& from, double* residual);
+  // Row r of Phi_q over SparseLayout::rows()[r].cols at the last
+  // SettledResidual (or Evaluate), and whether the row is on.
+  const double* constraint_gradient(int r) const { return rows_[r].vals; }
+  bool constraint_active(int r) const { return rows_[r].active; }
+  // The friction state at the x of the last SettledResidual.
+  const SettledFriction& settled_friction() const { return settled_now_; }
+  // That of InitialState(): no presliding displacement anywhere.
+  SettledFriction InitialSettledFriction() const;
+  // The state at rest at coordinates q with the friction state `friction`
+  // (for Observe).
+  Eigen::VectorXd RestState(const double* q, const SettledFriction& friction) const;
+
  private:
   // The stages of Evaluate, in order.
   void ComputeLinkKinematics(const double* q, const double* qd);
   bool AddCableElements(const double* q, const double* qd);
   void AddHoleFriction(const double* q, const double* qd, const double* memory);
-  void AddPreslidingFriction(int h, int s_col, double t_before, double v, const double* memory);
+  void AddPreslidingFriction(int h, int s_col, double t_before, double v, const double* memory,
+                             double xi);
+  // Settled residual: hole h's and conduit (pair p, axis)'s presliding
+  // displacement after their slips since settled_from_, recorded in
+  // settled_now_.
+  double SettledHoleDisplacement(int h, double s, double wrap_angle);
+  double SettledConduitDisplacement(int p, int axis, double theta_i, double theta_j);
   void ComputeJointAngles();
   void AddConnectingMoments(double t, const double* memory);
   void AddBackboneMoments();
@@ -167,6 +204,12 @@ class ArmDynamics {
   std::vector<std::unique_ptr<Effect>> effects_;
   std::vector<const Effect*> pretension_effects_, deflection_effects_, load_effects_;
   std::unique_ptr<EffectLoadsView> effect_loads_;
+
+  // Set during SettledResidual only.
+  const SettledFriction* settled_from_ = nullptr;
+  SettledFriction settled_now_;
+  std::vector<double> zero_rates_;   // n zeros: q_dot at rest
+  std::vector<double> rest_memory_;  // the memory states at rest
 
   std::vector<HoleMode> modes_;
   std::vector<double> stuck_s_;

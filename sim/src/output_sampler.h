@@ -3,6 +3,7 @@
 // step exactly on next_time() and hands the frame over; the sampler keeps
 // the trajectory and the largest constraint violation seen.
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "ccsrm/sim/simulator.h"
@@ -13,6 +14,15 @@ namespace ccsrm::sim::internal {
 // 1 / solver.output_rate_hz from 0 to duration_s (the last one at
 // duration_s). Precondition: options.IsValid().
 std::vector<double> SampleTimes(const SimulationOptions& options);
+
+// What is wrong with a frame whose joint is past its range
+// (ArmModel::joint_range_rad), or "" when every joint is within it. A joint
+// past its range would need contact between its disks, which the model
+// does not have.
+std::string JointPastRange(const ArmModel& model, const TrajectoryFrame& frame);
+
+// Where a driving cable went slack over the frames (FindSlackIntervals).
+std::vector<SlackInterval> SlackIntervalsOf(const ArmModel& model, const Trajectory& trajectory);
 
 class OutputSampler {
  public:

@@ -17,6 +17,7 @@
 #include "effects/effect.h"
 #include "integrator.h"
 #include "output_sampler.h"
+#include "quasi_static.h"
 #include "stick_slip.h"
 
 namespace ccsrm::sim {
@@ -193,24 +194,10 @@ class StepLoop {
       Diverge(text);
       return;
     }
-    CheckJointRange();
-  }
-
-  // A joint past its range (ArmModel::joint_range_rad) would need contact
-  // between its disks, which the model does not have, and soon folds a
-  // cable's path through the gap: the run stops there, like a divergence.
-  void CheckJointRange() {
-    for (int j = 1; j <= model_.num_joints(); ++j) {
-      const double tilt = JointTiltRad(frame_.joint_angles[j - 1]);
-      if (tilt <= model_.joint_range_rad(j)) continue;
-      char text[224];
-      std::snprintf(text, sizeof(text),
-                    "joint %d tilted to %.2f deg, past its range of %.2f deg where its disks "
-                    "meet (ccsrm has no contact between disks)",
-                    j, tilt * 180.0 / M_PI, model_.joint_range_rad(j) * 180.0 / M_PI);
-      Diverge(text);
-      return;
-    }
+    // A joint past its range soon folds a cable's path through the gap
+    // between its disks: the run stops there, like a divergence.
+    const std::string past = internal::JointPastRange(model_, frame_);
+    if (!past.empty()) Diverge(past);
   }
 
   SimulationResult Finish() {
@@ -229,13 +216,7 @@ class StepLoop {
     s.largest_threshold_raise_n = stick_slip_->largest_threshold_raise_n();
     s.max_constraint_violation = sampler_.max_constraint_violation();
     result.trajectory = sampler_.Take();
-    const Trajectory& trajectory = result.trajectory;
-    Eigen::MatrixXi slack(static_cast<Eigen::Index>(trajectory.size()), model_.num_cables());
-    for (std::size_t f = 0; f < trajectory.size(); ++f) {
-      for (int c = 0; c < model_.num_cables(); ++c)
-        slack(f, c) = CountSlackElements(trajectory.frames[f].element_tension[c]);
-    }
-    s.slack = FindSlackIntervals(trajectory.time, slack);
+    s.slack = internal::SlackIntervalsOf(model_, result.trajectory);
     return result;
   }
 
@@ -291,6 +272,10 @@ bool SimulationOptions::IsValid(std::string* error) const {
   }
   if (!(wall_time_budget_s >= 0.0)) {
     *error = "wall-time budget must be >= 0 s (0: none)";
+    return false;
+  }
+  if (!(quasi_static_increment_m > 0.0) || !std::isfinite(quasi_static_increment_m)) {
+    *error = "quasi-static increment must be > 0 m";
     return false;
   }
   for (std::size_t k = 0; k < sample_times.size(); ++k) {
@@ -423,7 +408,10 @@ SimulationResult Simulate(const ArmModel& model, const ArmParameters& parameters
   // realise from the commanded inputs; with none on, the inputs as given.
   const std::unique_ptr<CableInputs> realised =
       internal::RealisedInputs(model, parameters, inputs, options.duration_s);
-  return StepLoop(model, parameters, realised ? *realised : inputs, options).Run();
+  const CableInputs& driven = realised ? *realised : inputs;
+  if (options.quasi_static)
+    return internal::SimulateSettledPoses(model, parameters, driven, options);
+  return StepLoop(model, parameters, driven, options).Run();
 }
 
 }  // namespace ccsrm::sim

@@ -203,6 +203,65 @@ TEST(PreslidingFriction, UnloadingIsElasticAndALimitThatFallsIsSlidDownTo) {
               HoleSlipFriction(kTension, 0.21, kWrap, v), 1e-6 * UpLimit());
 }
 
+// The quasi-static replay's displacement after a finite slip is the law's
+// slow limit: ElastoplasticSlide integrated over the slip at a speed far
+// beyond its band (the yield's ramp is then the speed itself), without the
+// relaxation's smoothing, by RK4 in fine steps; the steady displacements
+// differ with the direction, as the capstan's do.
+double IntegratedDisplacementAfterSlip(double xi, double slip, double ss_up, double ss_down) {
+  const double v = slip > 0.0 ? 1.0 : -1.0;  // m/s: slip as time
+  const double band = 1e-12;                 // m/s, far below v
+  auto rate = [&](double x) {
+    const double sigma = x < 0.0 ? -1.0 : 1.0;
+    const double rho = std::abs(x) / (sigma > 0.0 ? ss_up : ss_down);
+    return v - ElastoplasticSlide(rho, sigma, v, band).sliding;
+  };
+  const int steps = 200000;
+  const double dt = std::abs(slip) / steps;
+  for (int k = 0; k < steps; ++k) {
+    const double k1 = rate(xi), k2 = rate(xi + 0.5 * dt * k1), k3 = rate(xi + 0.5 * dt * k2),
+                 k4 = rate(xi + dt * k3);
+    xi += dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+  }
+  return xi;
+}
+
+TEST(PreslidingFriction, DisplacementAfterASlipAtRestIsTheLawsSlowLimit) {
+  const double up = 1.0e-5, down = 1.3e-5;  // xi_ss by direction [m]
+  struct Case {
+    const char* what;
+    double xi, slip;
+  };
+  const Case cases[] = {
+      {"elastic from rest", 0.0, 0.3 * up},
+      {"loading past the breakaway", 0.0, 0.8 * up},
+      {"loading to the limit", 0.0, 6.0 * up},
+      {"on from part way", 0.7 * up, 0.2 * up},
+      {"unloading", 0.9 * up, -0.4 * up},
+      {"reversal through zero", 0.9 * up, -3.0 * down},
+      {"reversal from the other side", -0.95 * down, 2.5 * up},
+      {"beyond a limit that fell", 1.6 * up, 0.7 * up},
+  };
+  for (const Case& c : cases) {
+    const double reference = IntegratedDisplacementAfterSlip(c.xi, c.slip, up, down);
+    // RK4 over 2e5 steps of the C1 law resolves it to ~1e-12 of xi_ss; the
+    // closed form's quadrature is good to ~1e-10 of its range.
+    EXPECT_NEAR(ElastoplasticDisplacementAfterSlip(c.xi, c.slip, up, down), reference, 1e-9 * up)
+        << c.what;
+  }
+  // Far beyond the limit the displacement is the limit, in the slip's direction.
+  EXPECT_NEAR(ElastoplasticDisplacementAfterSlip(0.2 * up, -1e3 * down, up, down), -down,
+              1e-15 * down);
+  // Loading, d xi_new / d slip is the law's 1 - alpha rho at the end point:
+  // the map is smooth in the slip, as a Newton solve over it needs.
+  const double xi0 = 0.4 * up, slip = 0.5 * up, h = 1e-6 * up;
+  const double plus = ElastoplasticDisplacementAfterSlip(xi0, slip + h, up, down);
+  const double minus = ElastoplasticDisplacementAfterSlip(xi0, slip - h, up, down);
+  const double end = ElastoplasticDisplacementAfterSlip(xi0, slip, up, down);
+  const double slope = 1.0 - ElastoplasticSlide(end / up, 1.0, 1.0, 1e-12).sliding;
+  EXPECT_NEAR((plus - minus) / (2.0 * h), slope, 1e-5);
+}
+
 TEST(PreslidingFriction, FrictionNeverReturnsMoreThanTheElasticEnergyItStored) {
   // Pointwise: F s_dot = -d/dt (k xi^2 / 2) - plastic power, plastic power
   // >= 0. Over a random slip history (loading, breakaway, reversals): the

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <gsl/gsl_integration.h>
+
 namespace ccsrm::sim::internal {
 
 double WrapAngle(const Eigen::Vector3d& r_prev, const Eigen::Vector3d& r_i,
@@ -115,14 +117,10 @@ ElastoplasticYield ElastoplasticSlide(double load_ratio, double sigma, double v,
   return out;
 }
 
-PreslidingFriction PreslidingHoleFriction(const PreslidingLaw& law, double tension_before,
-                                          double wrap_angle, double s_dot, double memory,
-                                          double displacement) {
-  PreslidingFriction out;
+double PreslidingSteadyDisplacement(const PreslidingLaw& law, double wrap_angle, double memory,
+                                    double sigma) {
   const HoleFrictionLaw& f = law.friction;
   const double xi_max = law.presliding_displacement_m;
-  const double t_b = std::max(0.0, tension_before);
-  const double sigma = displacement < 0.0 ? -1.0 : 1.0;
   const double mu_z = f.mu_kinetic + (f.mu_static - f.mu_kinetic) * memory;
   const double b = f.mu_static * wrap_angle;
   // q = k xi_ss / (T_b sinh(mu' theta)) = xi_ss / xi_max. At b = 0 (a
@@ -136,7 +134,19 @@ PreslidingFriction PreslidingHoleFriction(const PreslidingLaw& law, double tensi
   }
   // A limit of nothing (mu_z = 0 under mu' > 0) would make rho infinite.
   q = std::max(q, 1e-3);
-  const double xi_ss = xi_max * q;
+  return xi_max * q;
+}
+
+PreslidingFriction PreslidingHoleFriction(const PreslidingLaw& law, double tension_before,
+                                          double wrap_angle, double s_dot, double memory,
+                                          double displacement) {
+  PreslidingFriction out;
+  const HoleFrictionLaw& f = law.friction;
+  const double xi_max = law.presliding_displacement_m;
+  const double t_b = std::max(0.0, tension_before);
+  const double sigma = displacement < 0.0 ? -1.0 : 1.0;
+  const double b = f.mu_static * wrap_angle;
+  const double xi_ss = PreslidingSteadyDisplacement(law, wrap_angle, memory, sigma);
   out.stiffness = t_b * std::sinh(b) / xi_max;
   out.force = -out.stiffness * displacement;
   out.load_ratio = std::abs(displacement) / xi_ss;
@@ -147,6 +157,82 @@ PreslidingFriction PreslidingHoleFriction(const PreslidingLaw& law, double tensi
   out.sliding_speed = yield.sliding;
   out.plastic_power = out.stiffness * displacement * yield.sliding;
   return out;
+}
+
+namespace {
+
+// Beyond the breakaway the loading law d rho / d delta = g(rho) = 1 - alpha
+// rho (delta = slip / xi_ss, alpha the C1 step from rho = 1/2 to 1) factors
+// as g = (1 - rho) p(rho) with the cubic p = -16 rho^3 + 20 rho^2 - 4 rho +
+// 1, which lies in [1, 2.52] there (p(1/2) = 2, p(1) = 1). So 1 / g =
+// 1 / (1 - rho) - 4 rho (4 rho - 1) / p(rho): the log of the exponential
+// approach to the limit plus a smooth remainder, integrated below.
+static_assert(kPreslidingBreakaway == 0.5, "the cubic p belongs to a breakaway at rho = 1/2");
+
+double YieldCubic(double rho) { return ((-16.0 * rho + 20.0) * rho - 4.0) * rho + 1.0; }
+
+double YieldRemainder(double rho, void* /*unused*/) {
+  return 4.0 * rho * (4.0 * rho - 1.0) / YieldCubic(rho);
+}
+
+// The remainder's integral over [from, to] in [1/2, 1]: 16-point
+// Gauss-Legendre (the nearest pole, p's real root at 1.07, keeps the error
+// near 1e-10 of the integral over the whole range).
+double YieldRemainderIntegral(double from, double to) {
+  static const gsl_integration_glfixed_table* const table = gsl_integration_glfixed_table_alloc(16);
+  gsl_function f;
+  f.function = &YieldRemainder;
+  f.params = nullptr;
+  return gsl_integration_glfixed(&f, from, to, table);
+}
+
+// rho after loading over delta = slip / xi_ss from rho0 >= 0.
+double LoadRatioAfterLoading(double rho0, double delta) {
+  // A displacement beyond a limit that fell: alpha = 1, g = 1 - rho.
+  if (rho0 >= 1.0) return 1.0 + (rho0 - 1.0) * std::exp(-delta);
+  const double elastic = std::max(0.0, kPreslidingBreakaway - rho0);
+  if (delta <= elastic) return rho0 + delta;
+  delta -= elastic;
+  rho0 = std::max(rho0, kPreslidingBreakaway);
+  // rho = 1 - e^u: G(u) = u - u0 + delta + I(rho0, rho) = 0 with
+  // G' = 1 / p(rho) in [1/2.52, 1], so u lies in [u0 - 2.52 delta,
+  // u0 - delta]; safeguarded Newton inside that bracket.
+  const double u0 = std::log1p(-rho0);
+  double lo = u0 - 2.52 * delta, hi = u0 - delta;
+  double u = hi;
+  for (int iteration = 0; iteration < 100; ++iteration) {
+    const double rho = -std::expm1(u);
+    const double g = u - u0 + delta + YieldRemainderIntegral(rho0, rho);
+    if (g > 0.0) {
+      hi = u;
+    } else {
+      lo = u;
+    }
+    double next = u - g * YieldCubic(rho);
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    const bool converged = std::abs(next - u) <= 1e-14 * std::max(1.0, std::abs(u));
+    u = next;
+    if (converged || hi - lo <= 1e-14 * std::max(1.0, std::abs(u))) break;
+  }
+  return -std::expm1(u);
+}
+
+}  // namespace
+
+double ElastoplasticDisplacementAfterSlip(double displacement, double slip, double steady_positive,
+                                          double steady_negative) {
+  if (slip == 0.0) return displacement;
+  const double direction = slip > 0.0 ? 1.0 : -1.0;
+  double loading = std::abs(slip);
+  if (displacement * direction < 0.0) {
+    // Unloading is elastic until the displacement passes zero.
+    if (loading <= std::abs(displacement)) return displacement + slip;
+    loading -= std::abs(displacement);
+    displacement = 0.0;
+  }
+  const double steady = direction > 0.0 ? steady_positive : steady_negative;
+  return direction * steady *
+         LoadRatioAfterLoading(std::abs(displacement) / steady, loading / steady);
 }
 
 }  // namespace ccsrm::sim::internal

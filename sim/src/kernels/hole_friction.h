@@ -165,4 +165,29 @@ PreslidingFriction PreslidingHoleFriction(const PreslidingLaw& law, double tensi
                                           double wrap_angle, double s_dot, double memory,
                                           double displacement);
 
+// The presliding displacement at which PreslidingHoleFriction's spring
+// holds eq. 9's force of the memory's coefficient in the direction `sigma`
+// (+-1) of the displacement, xi_ss [m] (its load ratio's unit).
+double PreslidingSteadyDisplacement(const PreslidingLaw& law, double wrap_angle, double memory,
+                                    double sigma);
+
+// The elastoplastic law's displacement after a finite slip at rest, for the
+// quasi-static replay (sim/src/quasi_static.h): ElastoplasticSlide's
+// displacement rate integrated over the contact's slip `slip` [m] in the
+// limit of slow slip, where the yield's ramp is the slip speed itself and
+// the relaxation is not smoothed (rate independence):
+//   d xi / d s = 1 - alpha(rho) rho  loading (slip along xi),
+//   d xi / d s = 1                   unloading,
+// rho = |xi| / xi_ss, xi_ss being `steady_positive` for xi > 0 and
+// `steady_negative` for xi < 0 [m, > 0]. Unloading is elastic until xi
+// passes zero; loading is elastic below the breakaway, and beyond it
+// rho = 1 - e^u solves du/ds = -p(rho)/xi_ss exactly, p = g / (1 - rho) the
+// cubic that the law's g = 1 - alpha rho leaves (model notes, "quasi-static
+// replay"), by Newton's method on u with the quadrature of the cubic's
+// smooth remainder; a displacement beyond its limit (one that fell) relaxes
+// as 1 + (rho - 1) e^(-slip / xi_ss). Smooth in the slip on each side of
+// zero, as the time integration of the law is.
+double ElastoplasticDisplacementAfterSlip(double displacement, double slip, double steady_positive,
+                                          double steady_negative);
+
 }  // namespace ccsrm::sim::internal

@@ -51,6 +51,19 @@ struct SimulationOptions {
   std::function<void(const SimulationProgress&)> progress;
   double progress_interval_s = 1.0;  // wall seconds between progress calls
 
+  // Quasi-static replay, for recordings of settled poses: instead of
+  // integrating the dynamics, the frame at each sample time is the arm's
+  // static equilibrium at rest under the inputs then, reached from the
+  // previous frame's through equilibria at most quasi_static_increment_m of
+  // any input apart, with every presliding displacement carried over its
+  // contact's slip, so friction's hysteresis is kept (docs/model-notes.md,
+  // "Quasi-static replay"). It needs friction laws that hold at rest:
+  // solver.hole_friction presliding or off, and conduit friction presliding
+  // or none (mu_c = mu_c_s = 0); the frames' rates and dissipated energy
+  // are zero.
+  bool quasi_static = false;
+  double quasi_static_increment_m = 5e-4;
+
   // Checks every field except `solver` (Simulate checks that with
   // ValidateSolver).
   bool IsValid(std::string* error) const;

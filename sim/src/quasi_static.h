@@ -1,0 +1,86 @@
+#pragma once
+// Quasi-static replay (SimulationOptions::quasi_static): the arm's static
+// equilibria at rest, one per sample time, each reached from the one before
+// through equilibria at most options.quasi_static_increment_m of any input
+// apart, every presliding displacement carried over its contact's slip
+// (ArmDynamics::SettledResidual). It is the limit of slow motion, in which
+// the presliding laws are rate independent and keep friction's hysteresis:
+// the model for a recording of settled poses, whose transients between
+// poses nobody measured (docs/model-notes.md, "Quasi-static replay").
+//
+// Each equilibrium is a Newton solve of SettledResidual over x = [q,
+// lambda]. Its Jacobian is sparse with the arm's topology (elements, hole
+// nodes, joints, connecting pairs, constraint rows): forward differences of
+// groups of columns that share no row (a greedy distance-2 colouring of the
+// pattern) give it in a few dozen residuals, and a sparse LU solves it; a
+// Jacobian is kept while the iterations contract fast (chord steps) and
+// every step must pass Deuflhard's natural monotonicity test.
+#include <Eigen/Core>
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ccsrm/sim/simulator.h"
+#include "dynamics.h"
+
+namespace ccsrm::sim::internal {
+
+class SettledPoseSolver {
+ public:
+  // `dynamics` must outlive the solver.
+  SettledPoseSolver(const ArmModel& model, ArmDynamics* dynamics);
+
+  int size() const { return size_; }
+  int num_colours() const { return static_cast<int>(colours_.size()); }
+
+  // Newton from *x (the guess) to the equilibrium at t with the friction
+  // carried from `from`; on success *x is the equilibrium and
+  // dynamics->settled_friction() its friction state. Returns false (with
+  // failure()) when the iterations stop contracting.
+  bool Solve(double t, const SettledFriction& from, Eigen::VectorXd* x);
+  const std::string& failure() const { return failure_; }
+
+  // The forward-difference Jacobian of the residual at x, factorised for
+  // the next Solve (which keeps it while it serves).
+  bool ComputeJacobian(double t, const SettledFriction& from, const Eigen::VectorXd& x);
+  const Eigen::SparseMatrix<double>& jacobian() const { return jacobian_; }
+
+  std::int64_t jacobians() const { return jacobians_; }
+  std::int64_t iterations() const { return iterations_; }
+
+ private:
+  bool Residual(double t, const SettledFriction& from, const Eigen::VectorXd& x,
+                Eigen::VectorXd* r);
+  // The Newton correction -J^-1 r; false if not finite.
+  bool Correction(const Eigen::VectorXd& r, Eigen::VectorXd* dx);
+  // Weighted RMS of a correction's coordinates (the multipliers follow
+  // them): 1 is the convergence tolerance.
+  double Norm(const Eigen::VectorXd& dx, const Eigen::VectorXd& x) const;
+
+  ArmDynamics* dynamics_;
+  const SparseLayout& layout_;
+  int n_ = 0;                             // coordinates
+  int size_ = 0;                          // coordinates and multipliers
+  Eigen::SparseMatrix<double> jacobian_;  // column-major, pattern fixed
+  // The coordinates' columns by colour: forward differences of the force
+  // rows. The constraint rows and the multipliers' columns are exact:
+  // their entries' positions in jacobian_ per constraint row r, over its
+  // columns from row_start_[r] (Phi_q, then -Phi_q^T), and its diagonal.
+  std::vector<std::vector<int>> colours_;
+  std::vector<int> row_start_, gradient_entry_, reaction_entry_, diagonal_entry_;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu_;
+  bool factorised_ = false;
+  std::string failure_;
+  std::int64_t jacobians_ = 0, iterations_ = 0;
+  Eigen::VectorXd r_, r_try_, x_try_, perturbed_;
+};
+
+// Simulate() under options.quasi_static (after its checks and the
+// realisation of the inputs).
+SimulationResult SimulateSettledPoses(const ArmModel& model, const ArmParameters& parameters,
+                                      const CableInputs& inputs, const SimulationOptions& options);
+
+}  // namespace ccsrm::sim::internal
