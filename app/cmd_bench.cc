@@ -96,6 +96,10 @@ void AddBenchCommand(CLI::App& root) {
       ->check(AtLeast(1));
   AddParameterOptions(cmd, &a->run);
   AddMotionOptions(cmd, &a->run, &a->motion);
+  cmd->add_option("--output-rate", a->run.output_rate_hz,
+                  "Output frames per second (default: solver.output_rate_hz); a quasi-static "
+                  "replay solves a pose at each")
+      ->check(InRange(1e-3, 1e5, "Hz"));  // solver.output_rate_hz
   cmd->callback([a] {
     a->run.config_path = sim::ConfigPathOrBundled(a->run.config_path);
     RunBench(*a);

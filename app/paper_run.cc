@@ -95,6 +95,10 @@ void AddMotionOptions(CLI::App* command, sim::PaperRunOptions* args, MotionArgs*
                    "Longest interval between two recorded samples [s]; a longer gap is refused")
       ->capture_default_str()
       ->check(Above(0.0, "s"));
+  command->add_flag("--quasi-static", args->quasi_static,
+                    "Replay settled poses: the static equilibrium at each frame, friction's "
+                    "hysteresis carried from one to the next (needs solver.hole_friction: "
+                    "presliding or off, and conduit_friction: presliding)");
 }
 
 sim::PaperRunOptions WithMotion(sim::PaperRunOptions options, const MotionArgs& motion) {

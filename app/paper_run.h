@@ -19,9 +19,9 @@ void AddConfigOption(CLI::App* command, std::string* config_path);
 // table of sim/parameters.h) applied after the case.
 void AddParameterOptions(CLI::App* command, sim::PaperRunOptions* options);
 
-// What drives the arm, for `simulate` and `generate`: --protocol FILE or
-// --inputs FILE (exclusive), with the units and gap limit of a table of
-// inputs.
+// What drives the arm, for `simulate`, `generate`, `bench` and
+// `derivatives`: --protocol FILE or --inputs FILE (exclusive), with the
+// units and gap limit of a table of inputs, and --quasi-static.
 struct MotionArgs {
   std::string inputs_path;  // --inputs
   std::string time_unit;    // --inputs-time-unit

@@ -9,6 +9,7 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/mocap/recording.h"
 #include "ccsrm/mocap/signal.h"
+#include "ccsrm/sim/simulator.h"
 #include "ccsrm/sim_io/experiment_check.h"
 
 namespace ccsrm::identify {
@@ -274,6 +275,12 @@ Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::s
   e.config = std::move(arm->config);
   e.model = std::move(arm->model);
   e.joints = e.model->num_joints();
+  e.settled_poses = file.motion == datasets::RecordedMotion::kSettledPoses;
+  if (e.settled_poses) {
+    const std::string why = sim::WhyNotQuasiStatic(*e.model, e.config.parameters, e.config.solver);
+    if (!why.empty())
+      ThrowInputError(path, "attribute 'motion'", "settled_poses: the replay " + why);
+  }
   SetInputs(file, path, &e);
   const std::size_t first = SetMeasuredFrames(file, path, &e);
   if (processed) {

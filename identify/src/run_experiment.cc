@@ -13,6 +13,7 @@ RunResult RunExperiment(const Experiment& e, const identify::RunRequest& request
   options.duration_s = e.duration_s();
   options.sample_times = e.sample_time_s;
   options.solver = e.config.solver;
+  options.quasi_static = e.settled_poses;
   sim::SimulationResult result = sim::Simulate(*e.model, request.parameters, *e.inputs, options);
 
   RunResult out;

@@ -239,7 +239,11 @@ GeneratedExperiment GenerateExperiment(const GenerateOptions& o) {
                 o.recording.noise_sigma_m * 1e3, o.recording.occlusions.enabled ? "on" : "off",
                 static_cast<unsigned long long>(o.recording.seed));
   options.description = description;
-  const VirtualExperiment generated = Record(g, result, truth_run, options);
+  VirtualExperiment generated = Record(g, result, truth_run, options);
+  // A quasi-static replay's frames are settled poses: what identification
+  // replays the recording as (identify::Experiment::settled_poses).
+  if (simulation.quasi_static)
+    generated.experiment.motion = datasets::RecordedMotion::kSettledPoses;
   g.recording = generated.recording;
   g.frames = generated.experiment.mocap_time.rows();
   g.markers = generated.experiment.marker_names.size();

@@ -104,7 +104,8 @@ std::shared_ptr<Run> SimulateRun(const Model& model, const py::object& params,
                                  const py::object& inputs, const py::object& sample_times,
                                  std::optional<double> duration,
                                  std::optional<double> amplitude_deg,
-                                 std::optional<double> output_rate, double max_input_gap) {
+                                 std::optional<double> output_rate, double max_input_gap,
+                                 bool quasi_static) {
   sim::Config config = model.config;
   std::map<std::string, double> overrides;
   if (py::isinstance<sim::ArmParameters>(params)) {
@@ -134,6 +135,7 @@ std::shared_ptr<Run> SimulateRun(const Model& model, const py::object& params,
   if (amplitude_deg) options.amplitude_deg = Finite(*amplitude_deg, "amplitude_deg");
   if (output_rate) options.output_rate_hz = Finite(*output_rate, "output_rate");
   options.recorded_input_options.max_gap_s = max_input_gap;
+  options.quasi_static = quasi_static;
   if (!inputs.is_none()) {
     // Columns as a table of inputs has them: time [s], then the pulled-in
     // length of each cable [m]; the library checks them as it checks a file.
@@ -172,7 +174,9 @@ std::shared_ptr<Run> SimulateRun(const Model& model, const py::object& params,
     // The case was applied above; the run names it as the command does.
     prepared.case_number = case_number.value_or(0);
     sim::SimulationOptions simulation = prepared.simulation;
-    simulation.sample_times = std::move(samples);
+    // Given frame times replace the run's own (the output grid, or the
+    // poses of a quasi-static replay of recorded inputs).
+    if (!samples.empty()) simulation.sample_times = std::move(samples);
     watch.Attach(&simulation);
     std::string error;
     if (!simulation.IsValid(&error)) ThrowInputError("sample_times", "", error);
@@ -192,7 +196,7 @@ py::dict Generate(const py::object& out, const py::object& config, std::optional
                   const py::object& protocol, const std::map<std::string, double>& params,
                   const std::vector<std::string>& effects, std::optional<double> duration,
                   std::optional<double> amplitude_deg, double noise_mm, double resolution_mm,
-                  std::uint64_t seed, bool occlusions) {
+                  std::uint64_t seed, bool occlusions, bool quasi_static) {
   mocap::GenerateOptions options;
   options.out = PathString(out);
   options.run.config_path = sim::ConfigPathOrBundled(config.is_none() ? "" : PathString(config));
@@ -206,6 +210,7 @@ py::dict Generate(const py::object& out, const py::object& config, std::optional
     options.run.sets.push_back(name + text);
   }
   options.effects = effects;
+  options.run.quasi_static = quasi_static;
   options.recording.noise_sigma_m = noise_mm * 1e-3;
   options.recording.resolution_m = resolution_mm * 1e-3;
   options.recording.seed = seed;
@@ -434,13 +439,15 @@ void AddSimulation(py::module_& m) {
         py::arg("duration") = py::none(), py::arg("amplitude_deg") = py::none(),
         py::arg("output_rate") = py::none(),
         py::arg("max_input_gap") = sim::RecordedInputOptions().max_gap_s,
+        py::arg("quasi_static") = false,
         "Simulates the arm as `ccsrm simulate` does and returns a Run.\n\n"
         "params: a Parameters object (it replaces the configured parameters; a case then "
         "switches friction off where the case says), or a dict of values by name, set after "
         "the case (like --set). case: 1..4, the paper's friction switches. "
         "The motion: protocol (a ccsrm-protocol/1 file), or inputs (N x (1 + C) array: time "
         "[s], then each cable's pulled-in length [m]), or neither (the configuration's paper "
-        "protocol). sample_times: frame times [s] (default every 1 / output_rate). The GIL is "
+        "protocol). sample_times: frame times [s] (default every 1 / output_rate). quasi_static: "
+        "replay settled poses, as --quasi-static (needs presliding or no friction). The GIL is "
         "released while the arm is simulated; Ctrl-C cancels the run and raises "
         "KeyboardInterrupt. A diverged run is returned with its status, not raised.");
 
@@ -450,12 +457,15 @@ void AddSimulation(py::module_& m) {
         py::arg("effects") = std::vector<std::string>(), py::arg("duration") = py::none(),
         py::arg("amplitude_deg") = py::none(), py::arg("noise_mm") = 0.2,
         py::arg("resolution_mm") = 0.0, py::arg("seed") = 1, py::arg("occlusions") = true,
+        py::arg("quasi_static") = false,
         "Generates a virtual experiment as `ccsrm generate --out OUT` does: the arm of `config` "
         "(default: the bundled paper.yaml) simulated with the truth (case, params by name, "
         "effects as 'NAME' or 'NAME:param=value,...'), recorded by virtual motion capture, "
         "written as OUT (a ccsrm-dataset/1 experiment stating the nominal configuration) with "
         "OUT's stem .truth.yaml and .truth.h5 beside it. protocol: a ccsrm-protocol/1 file, "
-        "optionally 'file.yaml@name=value,...'. The output policy is the command's: an "
+        "optionally 'file.yaml@name=value,...'. quasi_static: the arm replayed as settled poses "
+        "(--quasi-static); the experiment says so (motion: settled_poses). The output policy is "
+        "the command's: an "
         "existing file that is not an earlier output of its kind is refused. Returns a dict "
         "of the paths written and the recording's figures. The GIL is released while the arm "
         "is simulated; Ctrl-C cancels the run (nothing written) and raises KeyboardInterrupt; "

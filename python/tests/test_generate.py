@@ -59,6 +59,20 @@ def test_generate_writes_the_files_the_command_writes(exe, paper_config, tmp_pat
     assert ccsrm.read_dataset(tmp_path / "py.h5").source == "generated"
 
 
+def test_generate_of_settled_poses_says_so_and_is_the_commands(exe, paper_config, tmp_path):
+    # A quasi-static replay's frames are settled poses: the experiment says
+    # so (identify, predict and loop replay it the same way).
+    run_ccsrm(exe, "generate", "--config", paper_config, "--case", 2, "--duration", 0.3,
+              "--quasi-static", "--seed", 4, "--quiet", "--out", tmp_path / "cli.h5")
+    out = ccsrm.generate(tmp_path / "py.h5", paper_config, case=2, duration=0.3, seed=4,
+                         quasi_static=True)
+    assert out["frames"] == 31
+    assert_same_files(tmp_path / "cli.h5", tmp_path / "py.h5")
+    assert ccsrm.read_dataset(tmp_path / "py.h5").motion == "settled_poses"
+    ccsrm.generate(tmp_path / "dynamic.h5", paper_config, case=2, duration=0.3, seed=4)
+    assert ccsrm.read_dataset(tmp_path / "dynamic.h5").motion == "continuous"
+
+
 def test_generate_refuses_a_file_that_is_not_an_earlier_experiment(paper_config, tmp_path):
     notes = tmp_path / "notes.h5"
     notes.write_text("my notes")

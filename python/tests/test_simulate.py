@@ -96,6 +96,32 @@ def test_recorded_inputs_equal_command_line_table(exe, paper_config, paper_model
     assert_same_as_file(run, out)
 
 
+def test_settled_poses_replay_as_the_command_line_does(exe, paper_config, paper_model, tmp_path):
+    # Five settled poses a second apart: cable 1 pulled 3 mm in steps and let
+    # back to zero, as a pose log records them.
+    pull = np.array([0.0, 1e-3, 3e-3, 1.5e-3, 0.0])
+    table = np.zeros((pull.size, 1 + paper_model.num_cables))
+    table[:, 0] = np.arange(pull.size, dtype=float)
+    table[:, 1] = pull
+    csv = tmp_path / "poses.csv"
+    header = "time_s," + ",".join(f"cable{k}_m" for k in range(1, paper_model.num_cables + 1))
+    csv.write_text(header + "\n" + "\n".join(",".join(repr(float(v)) for v in row)
+                                             for row in table) + "\n")
+    out = tmp_path / "cli.h5"
+    run_ccsrm(exe, "simulate", "--config", paper_config, "--case", 2, "--inputs", csv,
+              "--quasi-static", "--quiet", "--out", out)
+    run = ccsrm.simulate(paper_model, case=2, inputs=table, quasi_static=True)
+    assert_same_as_file(run, out)
+    # A frame at each pose (no gap limit for poses a second apart).
+    assert run.time.tolist() == table[:, 0].tolist()
+    # Friction keeps part of the bend after the pull is let back to zero;
+    # the frictionless arm (case 1) is straight again.
+    back = np.abs(run.joint_angles[-1]).max()
+    frictionless = ccsrm.simulate(paper_model, case=1, inputs=table, quasi_static=True)
+    assert np.abs(frictionless.joint_angles[-1]).max() < 1e-7
+    assert back > 1e-3 * np.abs(run.joint_angles[2]).max()
+
+
 def test_sample_times_are_the_frames(paper_model):
     times = [0.0, 0.013, 0.2, 0.25]
     run = ccsrm.simulate(paper_model, case=1, duration=0.25, sample_times=times)

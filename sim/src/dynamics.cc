@@ -190,6 +190,8 @@ ArmDynamics::ArmDynamics(const ArmModel& model, const ArmParameters& parameters,
   zero_rates_.assign(n_, 0.0);
   rest_memory_.assign(y0.data() + memory_offset(), y0.data() + state_size());
   settled_now_ = InitialSettledFriction();
+  branches_.hole.assign(holes, 0);
+  branches_.conduit.assign(2 * pair_kernels_.size(), 0);
 }
 
 const char* ArmDynamics::StateEntryKind(int k) const {
@@ -1044,6 +1046,18 @@ Eigen::VectorXd ArmDynamics::RestState(const double* q, const SettledFriction& f
   return y;
 }
 
+namespace {
+
+// The presliding displacement after a slip at rest, on the branch the
+// settled residual was told (0: the law itself).
+double DisplacementOnBranch(double displacement, double slip, double up, double down,
+                            signed char branch) {
+  if (branch == 0) return ElastoplasticDisplacementAfterSlip(displacement, slip, up, down);
+  return ElastoplasticDisplacementOnBranch(displacement, slip, up, down, branch > 0);
+}
+
+}  // namespace
+
 // The presliding laws at rest (memory z = 1), without their relaxation's
 // smoothing: slow slip is the limit it leaves unchanged.
 double ArmDynamics::SettledHoleDisplacement(int h, double s, double wrap_angle) {
@@ -1053,8 +1067,8 @@ double ArmDynamics::SettledHoleDisplacement(int h, double s, double wrap_angle) 
       0.0};
   const double up = PreslidingSteadyDisplacement(law, wrap_angle, 1.0, 1.0);
   const double down = PreslidingSteadyDisplacement(law, wrap_angle, 1.0, -1.0);
-  const double xi = ElastoplasticDisplacementAfterSlip(settled_from_->hole_xi[h],
-                                                       s - settled_from_->hole_s[h], up, down);
+  const double xi = DisplacementOnBranch(settled_from_->hole_xi[h], s - settled_from_->hole_s[h],
+                                         up, down, branches_.hole[h]);
   settled_now_.hole_s[h] = s;
   settled_now_.hole_xi[h] = xi;
   return xi;
@@ -1065,9 +1079,9 @@ double ArmDynamics::SettledHoleDisplacement(int h, double s, double wrap_angle) 
 double ArmDynamics::SettledConduitDisplacement(int p, int axis, double theta_i, double theta_j) {
   const int k = 2 * p + axis;
   const double slip = ConduitSlipVelocity(pair_kernels_[p].large, theta_i, theta_j);
-  const double eta = ElastoplasticDisplacementAfterSlip(settled_from_->conduit_eta[k],
-                                                        slip - settled_from_->conduit_slip[k],
-                                                        parameters_.xi_c, parameters_.xi_c);
+  const double eta =
+      DisplacementOnBranch(settled_from_->conduit_eta[k], slip - settled_from_->conduit_slip[k],
+                           parameters_.xi_c, parameters_.xi_c, branches_.conduit[k]);
   settled_now_.conduit_slip[k] = slip;
   settled_now_.conduit_eta[k] = eta;
   return eta;

@@ -124,6 +124,14 @@ class ArmDynamics {
   // SettledResidual (or Evaluate), and whether the row is on.
   const double* constraint_gradient(int r) const { return rows_[r].vals; }
   bool constraint_active(int r) const { return rows_[r].active; }
+  // The branch of each contact's presliding law that SettledResidual
+  // evaluates (ElastoplasticDisplacementOnBranch): per hole node, and per
+  // connecting pair and axis (2 p + axis), +1 slipping along its last
+  // settled displacement, -1 against it, 0 the law itself (the default).
+  struct SettledBranches {
+    std::vector<signed char> hole, conduit;
+  };
+  SettledBranches& settled_branches() { return branches_; }
   // The friction state at the x of the last SettledResidual.
   const SettledFriction& settled_friction() const { return settled_now_; }
   // That of InitialState(): no presliding displacement anywhere.
@@ -208,6 +216,7 @@ class ArmDynamics {
   // Set during SettledResidual only.
   const SettledFriction* settled_from_ = nullptr;
   SettledFriction settled_now_;
+  SettledBranches branches_;
   std::vector<double> zero_rates_;   // n zeros: q_dot at rest
   std::vector<double> rest_memory_;  // the memory states at rest
 

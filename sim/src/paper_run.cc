@@ -114,9 +114,12 @@ PaperRun PreparePaperRun(const PaperRunOptions& o, Config config, const ArmModel
   std::string inputs_note;
   std::optional<CableInputs> recorded;
   if (o.recorded_inputs) {
-    recorded = MakeRecordedCableInputs(*o.recorded_inputs, model.num_cables(),
-                                       o.recorded_input_options, &inputs_note);
-    CheckRecordedInputsOnArm(*o.recorded_inputs, model, o.recorded_input_options);
+    // A quasi-static replay takes the recorded samples as settled poses.
+    RecordedInputOptions recorded_options = o.recorded_input_options;
+    recorded_options.settled_poses = recorded_options.settled_poses || o.quasi_static;
+    recorded = MakeRecordedCableInputs(*o.recorded_inputs, model.num_cables(), recorded_options,
+                                       &inputs_note);
+    CheckRecordedInputsOnArm(*o.recorded_inputs, model, recorded_options);
   } else if (default_protocol) {
     // The configuration's protocol section sets the paper protocol's
     // parameters (SI values, as the configuration holds them).
@@ -144,6 +147,15 @@ PaperRun PreparePaperRun(const PaperRunOptions& o, Config config, const ArmModel
   SimulationOptions simulation;
   simulation.duration_s = duration;
   simulation.solver = config.solver;
+  simulation.quasi_static = o.quasi_static;
+  // Replaying recorded poses: a frame at each (the output rate would
+  // solve poses nobody recorded).
+  if (o.quasi_static && !protocol) {
+    for (Eigen::Index i = 0; i < inputs.time().size(); ++i) {
+      const double t = inputs.time()[i];
+      if (t >= 0.0 && t <= duration) simulation.sample_times.push_back(t);
+    }
+  }
   PaperRun run{path,
                std::move(text),
                std::move(config),

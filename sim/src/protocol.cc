@@ -42,8 +42,12 @@ struct CableInputs::Splines {
   }
 };
 
-CableInputs::CableInputs(Eigen::VectorXd time, Eigen::MatrixXd length_change)
-    : time_(std::move(time)), length_change_(std::move(length_change)), splines_(new Splines) {
+CableInputs::CableInputs(Eigen::VectorXd time, Eigen::MatrixXd length_change,
+                         Interpolation interpolation)
+    : time_(std::move(time)),
+      length_change_(std::move(length_change)),
+      interpolation_(interpolation),
+      splines_(new Splines) {
   const Eigen::Index n = time_.size();
   if (n < 2) ThrowInputError("cable inputs", "time", "needs at least 2 samples");
   if (length_change_.rows() != n) {
@@ -60,7 +64,9 @@ CableInputs::CableInputs(Eigen::VectorXd time, Eigen::MatrixXd length_change)
   if (!length_change_.allFinite())
     ThrowInputError("cable inputs", "length_change", "has a non-finite value");
   UseGslErrorCodes();
-  const gsl_interp_type* type = n >= 3 ? gsl_interp_cspline : gsl_interp_linear;
+  const gsl_interp_type* type = n >= 3 && interpolation == Interpolation::kCubicSpline
+                                    ? gsl_interp_cspline
+                                    : gsl_interp_linear;
   for (Eigen::Index c = 0; c < length_change_.cols(); ++c) {
     Eigen::VectorXd column = length_change_.col(c);
     gsl_spline* spline = gsl_spline_alloc(type, static_cast<std::size_t>(n));

@@ -16,17 +16,25 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // Convergence: a correction's weighted RMS below 1 with these weights,
-// about 1e-9 m on the arm's coordinates (~0.1 m) and 1e-8 on the
+// about 2e-9 m on the arm's coordinates (~0.1 m) and 1e-8 on the
 // quaternions: far below what any frame is compared with (0.03 deg of a
 // joint is 5e-4 rad).
-constexpr double kAbsoluteTolerance = 1e-10;
+constexpr double kAbsoluteTolerance = 1e-9;
 constexpr double kRelativeTolerance = 1e-8;
 constexpr int kMaxIterations = 40;
 // A Jacobian is kept while the corrections shrink at least this fast.
-constexpr double kKeepJacobianContraction = 0.25;
+constexpr double kKeepJacobianContraction = 0.5;
+// A correction within this many tolerances that no step improves on is
+// taken as converged (about 2e-8 m).
+constexpr double kStallTolerance = 10.0;
 // Forward-difference steps: sqrt(machine epsilon) of the coordinate's
 // size, at least of 1 cm.
 constexpr double kDifferenceStep = 1.5e-8;
+// The active set of the contacts' branches: at most this many passes, and
+// a slip against a contact's branch by less than this [m] (the solves'
+// accuracy) is none.
+constexpr int kMaxActiveSetPasses = 20;
+constexpr double kBranchTolerance = 1e-9;
 // An increment that fails is halved at most this often.
 constexpr int kMaxHalvings = 8;
 
@@ -268,9 +276,46 @@ double SettledPoseSolver::Norm(const Eigen::VectorXd& dx, const Eigen::VectorXd&
   return std::sqrt(sum / n_);
 }
 
-bool SettledPoseSolver::Solve(double t, const SettledFriction& from, Eigen::VectorXd* x_io) {
-  Eigen::VectorXd& x = *x_io;
+bool SettledPoseSolver::Solve(double t, const SettledFriction& from, Eigen::VectorXd* x) {
   failure_.clear();
+  if (!Residual(t, from, *x, &r_)) return false;
+  ChooseBranches(from, true);
+  for (int pass = 0; pass < kMaxActiveSetPasses; ++pass) {
+    if (!Newton(t, from, x)) return false;
+    if (ChooseBranches(from, false) == 0) return true;
+  }
+  failure_ = "the contacts' loading and unloading did not settle in " +
+             std::to_string(kMaxActiveSetPasses) + " passes";
+  return false;
+}
+
+int SettledPoseSolver::ChooseBranches(const SettledFriction& from, bool initial) {
+  const SettledFriction& now = dynamics_->settled_friction();
+  ArmDynamics::SettledBranches& branches = dynamics_->settled_branches();
+  int flips = 0;
+  auto choose = [&](double slip, double displacement, signed char* branch) {
+    const double along = displacement < 0.0 ? -slip : slip;
+    signed char wanted = *branch;
+    if (initial) {
+      wanted = along > 0.0 ? 1 : -1;
+    } else if (*branch > 0 && along < -kBranchTolerance) {
+      wanted = -1;
+    } else if (*branch < 0 && along > kBranchTolerance) {
+      wanted = 1;
+    }
+    if (wanted != *branch) ++flips;
+    *branch = wanted;
+  };
+  for (std::size_t h = 0; h < branches.hole.size(); ++h)
+    choose(now.hole_s[h] - from.hole_s[h], from.hole_xi[h], &branches.hole[h]);
+  for (std::size_t k = 0; k < branches.conduit.size(); ++k) {
+    choose(now.conduit_slip[k] - from.conduit_slip[k], from.conduit_eta[k], &branches.conduit[k]);
+  }
+  return flips;
+}
+
+bool SettledPoseSolver::Newton(double t, const SettledFriction& from, Eigen::VectorXd* x_io) {
+  Eigen::VectorXd& x = *x_io;
   // `fresh`: the Jacobian is that of the current x.
   bool fresh = false;
   if (!factorised_) {
@@ -282,9 +327,12 @@ bool SettledPoseSolver::Solve(double t, const SettledFriction& from, Eigen::Vect
   if (!Correction(r_, &dx)) return false;
   double norm = Norm(dx, x);
   double damping = 1.0;
+  double rate = 1.0;  // the last accepted step's contraction
   for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
     ++iterations_;
-    if (norm <= 1.0) {
+    // Converged: the correction, or the error it leaves at the contraction
+    // seen, rate / (1 - rate) |dx|, is within the tolerance.
+    if (norm <= 1.0 || (rate < 1.0 && rate / (1.0 - rate) * norm <= 1.0)) {
       x += dx;
       // The friction state of the final x.
       return Residual(t, from, x, &r_);
@@ -297,20 +345,24 @@ bool SettledPoseSolver::Solve(double t, const SettledFriction& from, Eigen::Vect
     const bool monotone = Residual(t, from, x_try_, &r_try_) && Correction(r_try_, &dx_bar) &&
                           (norm_bar = Norm(dx_bar, x_try_)) < (1.0 - 0.25 * damping) * norm;
     if (monotone) {
-      const double contraction = norm_bar / norm;
+      rate = norm_bar / norm;
       std::swap(x, x_try_);
       std::swap(r_, r_try_);
       dx = dx_bar;
       norm = norm_bar;
       damping = std::min(1.0, 2.0 * damping);
       fresh = false;
-      if (contraction > kKeepJacobianContraction && norm > 1.0) {
+      if (rate > kKeepJacobianContraction && norm > 1.0) {
         if (!ComputeJacobian(t, from, x) || !Correction(r_, &dx)) return false;
         norm = Norm(dx, x);
         fresh = true;
       }
       continue;
     }
+    // No step improves on an x within a few tolerances of the equilibrium:
+    // the floor of the forward differences where a presliding
+    // displacement turns from loading to unloading (a kink in the force).
+    if (norm <= kStallTolerance) return Residual(t, from, x, &r_);
     if (!fresh) {
       // An old Jacobian: a new one at x before damping.
       if (!ComputeJacobian(t, from, x) || !Correction(r_, &dx)) return false;
@@ -510,17 +562,36 @@ class SettledPoseLoop {
   double next_progress_ = 0.0;
 };
 
+}  // namespace
+
+SimulationResult SimulateSettledPoses(const ArmModel& model, const ArmParameters& parameters,
+                                      const CableInputs& inputs, const SimulationOptions& options) {
+  const std::string why = WhyNotQuasiStatic(model, parameters, options.solver);
+  if (!why.empty()) ThrowInputError("simulation options", "quasi_static", why);
+  // Between settled poses the actuators go from one set point to the next:
+  // straight lines, not the spline of a continuous motion, whose swings
+  // past the samples friction would remember as loops.
+  if (inputs.interpolation() == CableInputs::Interpolation::kLinear)
+    return SettledPoseLoop(model, parameters, inputs, options).Run();
+  const CableInputs lines(inputs.time(), inputs.length_change(),
+                          CableInputs::Interpolation::kLinear);
+  return SettledPoseLoop(model, parameters, lines, options).Run();
+}
+
+}  // namespace ccsrm::sim::internal
+
+namespace ccsrm::sim {
+
 // The laws that hold nothing at rest cannot be replayed quasi-statically:
 // an arm held only by them would fall through every pose.
-void CheckFrictionHoldsAtRest(const ArmModel& model, const ArmParameters& parameters,
+std::string WhyNotQuasiStatic(const ArmModel& model, const ArmParameters& parameters,
                               const SolverConfig& solver) {
   const bool holes = solver.hole_friction == HoleFrictionModel::kPresliding ||
                      solver.hole_friction == HoleFrictionModel::kOff ||
                      (parameters.mu == 0.0 && parameters.mu_s == 0.0);
   if (!holes) {
-    ThrowInputError("simulation options", "quasi_static",
-                    "needs solver.hole_friction: presliding or off (events and smoothed "
-                    "friction hold nothing at rest)");
+    return "needs solver.hole_friction: presliding or off (events and smoothed friction hold "
+           "nothing at rest)";
   }
   bool large_s = false;
   for (const ConnectingPairModel& pair : model.connecting_pairs())
@@ -528,18 +599,10 @@ void CheckFrictionHoldsAtRest(const ArmModel& model, const ArmParameters& parame
   const bool conduits = !large_s || solver.conduit_friction == ConduitFrictionModel::kPresliding ||
                         (parameters.mu_c == 0.0 && parameters.mu_c_s == 0.0);
   if (!conduits) {
-    ThrowInputError("simulation options", "quasi_static",
-                    "needs solver.conduit_friction: presliding, or no conduit friction "
-                    "(modified Coulomb friction holds nothing at rest)");
+    return "needs solver.conduit_friction: presliding, or no conduit friction (modified Coulomb "
+           "friction holds nothing at rest)";
   }
+  return "";
 }
 
-}  // namespace
-
-SimulationResult SimulateSettledPoses(const ArmModel& model, const ArmParameters& parameters,
-                                      const CableInputs& inputs, const SimulationOptions& options) {
-  CheckFrictionHoldsAtRest(model, parameters, options.solver);
-  return SettledPoseLoop(model, parameters, inputs, options).Run();
-}
-
-}  // namespace ccsrm::sim::internal
+}  // namespace ccsrm::sim

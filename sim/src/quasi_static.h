@@ -36,10 +36,18 @@ class SettledPoseSolver {
   int size() const { return size_; }
   int num_colours() const { return static_cast<int>(colours_.size()); }
 
-  // Newton from *x (the guess) to the equilibrium at t with the friction
-  // carried from `from`; on success *x is the equilibrium and
-  // dynamics->settled_friction() its friction state. Returns false (with
-  // failure()) when the iterations stop contracting.
+  // The equilibrium at t with the friction carried from `from`, from the
+  // guess *x; on success *x is the equilibrium and
+  // dynamics->settled_friction() its friction state. Each contact's
+  // presliding law has a kink where its slip turns from along its
+  // displacement to against it (loading to unloading), which Newton's
+  // method cannot cross: an active set fixes every contact's branch
+  // (ArmDynamics::SettledBranches; at first from the guess's slips, the
+  // elastic side where it has none), solves, and flips the contacts whose
+  // slip contradicts their branch, until none does. The force is monotone
+  // in each slip, so one consistent set exists. Returns false (with
+  // failure()) when a Newton solve stops contracting or the set does not
+  // settle.
   bool Solve(double t, const SettledFriction& from, Eigen::VectorXd* x);
   const std::string& failure() const { return failure_; }
 
@@ -54,6 +62,12 @@ class SettledPoseSolver {
  private:
   bool Residual(double t, const SettledFriction& from, const Eigen::VectorXd& x,
                 Eigen::VectorXd* r);
+  // Newton on the residual with the branches as they are.
+  bool Newton(double t, const SettledFriction& from, Eigen::VectorXd* x);
+  // Each contact's branch from its slip at the last residual: `initial`,
+  // along where it slips along its displacement, else against; otherwise
+  // flips those whose slip contradicts their branch. Returns the flips.
+  int ChooseBranches(const SettledFriction& from, bool initial);
   // The Newton correction -J^-1 r; false if not finite.
   bool Correction(const Eigen::VectorXd& r, Eigen::VectorXd* dx);
   // Weighted RMS of a correction's coordinates (the multipliers follow
@@ -71,6 +85,9 @@ class SettledPoseSolver {
   // columns from row_start_[r] (Phi_q, then -Phi_q^T), and its diagonal.
   std::vector<std::vector<int>> colours_;
   std::vector<int> row_start_, gradient_entry_, reaction_entry_, diagonal_entry_;
+  // The Jacobian is unsymmetric and indefinite (a saddle point in the
+  // multipliers). Eigen's supernodal LU with COLAMD: on the robot's arm
+  // (3 400 unknowns) 3.5x faster than SuiteSparse's KLU through Eigen.
   Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu_;
   bool factorised_ = false;
   std::string failure_;

@@ -212,12 +212,20 @@ CableInputs MakeRecordedCableInputs(const RecordedInputs& r, int num_cables,
                       "time " + Number(r.time_s[i]) + " s does not increase (previous " +
                           Number(r.time_s[i - 1]) + " s)");
     }
-    if (step > options.max_gap_s * (1.0 + 1e-9)) {  // a gap at the limit in ms rounds above it
+    if (!options.settled_poses &&
+        step > options.max_gap_s * (1.0 + 1e-9)) {  // a gap at the limit in ms rounds above it
       ThrowInputError(r.source_name, SampleWhere(r, i, r.time_name),
                       "a gap of " + Number(step) + " s after " + Number(r.time_s[i - 1]) +
                           " s, longer than the " + Number(options.max_gap_s) +
                           " s allowed (max gap option)");
     }
+  }
+  if (options.settled_poses) {
+    if (note != nullptr) {
+      *note = std::to_string(n) + " settled poses from " + Number(r.time_s[0]) + " to " +
+              Number(r.time_s[n - 1]) + " s, used as recorded, straight lines between them";
+    }
+    return CableInputs(r.time_s, r.length_change_m, CableInputs::Interpolation::kLinear);
   }
   std::vector<double> steps(n - 1);
   for (Eigen::Index i = 1; i < n; ++i) steps[i - 1] = r.time_s[i] - r.time_s[i - 1];

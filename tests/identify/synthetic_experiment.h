@@ -41,26 +41,31 @@ inline sim::Config Nominal(const std::string& config = "paper.yaml") {
 // the same noise (from which the loader estimates it). With low_pass_hz > 0
 // the true angles pass through the mocap pipeline's low-pass (order 2,
 // recorded in the file's quality figures, so identification filters its
-// simulated angles alike) before the noise is added.
+// simulated angles alike) before the noise is added. With pose_step_s > 0
+// the rows are settled poses that far apart (motion: settled_poses), the
+// truth replayed quasi-statically, as identification replays them.
 inline datasets::ExperimentFile Record(const sim::ArmParameters& truth, double noise_deg,
                                        unsigned seed, const sim::Config& config = Nominal(),
-                                       double low_pass_hz = 0.0) {
+                                       double low_pass_hz = 0.0, double pose_step_s = 0.0) {
   const sim::ArmModel model(config.arm);
   const double duration = config.protocol.ramp_s + config.protocol.hold_s;
   const sim::CableInputs planned =
       sim::PlanCableInputs(model, sim::PaperTrajectory(model, config.protocol), duration);
-  const std::size_t frames = static_cast<std::size_t>(std::lround(duration * 100.0)) + 1;
+  const bool settled = pose_step_s > 0.0;
+  const double step = settled ? pose_step_s : 0.01;
+  const std::size_t frames = static_cast<std::size_t>(std::lround(duration / step)) + 1;
   const int cables = model.num_cables();
   datasets::ExperimentFile file;
   file.name = "synthetic";
   file.source = datasets::ExperimentSource::kGenerated;
+  if (settled) file.motion = datasets::RecordedMotion::kSettledPoses;
   file.config_yaml = sim::ToYaml(config);
   file.input_time = datasets::Array({frames});
   file.input_length_change = datasets::Array({frames, static_cast<std::size_t>(cables)});
   Eigen::VectorXd time(static_cast<Eigen::Index>(frames));
   Eigen::MatrixXd length(static_cast<Eigen::Index>(frames), cables);
   for (std::size_t f = 0; f < frames; ++f) {
-    const double t = static_cast<double>(f) / 100.0;
+    const double t = static_cast<double>(f) * step;
     file.input_time.at(f) = t;
     time[static_cast<Eigen::Index>(f)] = t;
     for (int c = 0; c < cables; ++c) {
@@ -74,7 +79,9 @@ inline datasets::ExperimentFile Record(const sim::ArmParameters& truth, double n
   const sim::CableInputs inputs(time, length);
   sim::SimulationOptions options;
   options.duration_s = duration;
+  options.sample_times.assign(time.data(), time.data() + time.size());
   options.solver = config.solver;
+  options.quasi_static = settled;
   const sim::SimulationResult run = sim::Simulate(model, truth, inputs, options);
   EXPECT_TRUE(run.summary.completed()) << run.summary.message;
   EXPECT_EQ(run.trajectory.size(), frames);

@@ -235,4 +235,19 @@ double ElastoplasticDisplacementAfterSlip(double displacement, double slip, doub
          LoadRatioAfterLoading(std::abs(displacement) / steady, loading / steady);
 }
 
+double ElastoplasticDisplacementOnBranch(double displacement, double slip, double steady_positive,
+                                         double steady_negative, bool along) {
+  const double sigma = displacement < 0.0 ? -1.0 : 1.0;
+  const bool slips_along = slip * sigma > 0.0;
+  if (slip == 0.0 || slips_along == along) {
+    return ElastoplasticDisplacementAfterSlip(displacement, slip, steady_positive, steady_negative);
+  }
+  if (!along) return displacement + slip;
+  // d xi / d s at zero slip, loading: 1 - alpha(rho) rho (1 - rho beyond a
+  // limit that fell).
+  const double rho = std::abs(displacement) / (sigma > 0.0 ? steady_positive : steady_negative);
+  const double alpha = SmoothStep((rho - kPreslidingBreakaway) / (1.0 - kPreslidingBreakaway));
+  return displacement + slip * (1.0 - alpha * rho);
+}
+
 }  // namespace ccsrm::sim::internal

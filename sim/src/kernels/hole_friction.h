@@ -190,4 +190,15 @@ double PreslidingSteadyDisplacement(const PreslidingLaw& law, double wrap_angle,
 double ElastoplasticDisplacementAfterSlip(double displacement, double slip, double steady_positive,
                                           double steady_negative);
 
+// The same on one branch of the law, for a Newton solve that must not see
+// its kink at zero slip (the quasi-static replay's active set): `along`
+// true is the contact slipping along its displacement (loading, sgn(slip)
+// = sgn(displacement), +1 at zero), false against it (unloading, on
+// through zero). Where the slip has the branch's sign this is
+// ElastoplasticDisplacementAfterSlip; past zero slip each branch goes on
+// smoothly: unloading elastically, loading along its tangent at zero slip
+// (1 - alpha(rho) rho).
+double ElastoplasticDisplacementOnBranch(double displacement, double slip, double steady_positive,
+                                         double steady_negative, bool along);
+
 }  // namespace ccsrm::sim::internal

@@ -79,6 +79,9 @@ struct Experiment {
   // the noise itself is known. Infinite for a given noise or the floor, and
   // when empty (an experiment built in code).
   std::vector<double> noise_effective_samples;
+  // The file's `motion` is settled_poses: every run replays it
+  // quasi-statically (sim::SimulationOptions::quasi_static).
+  bool settled_poses = false;
   // True when the file had no /measured/joint_angles and the mocap pipeline
   // computed them at load, with default settings.
   bool angles_from_pipeline = false;

@@ -62,6 +62,9 @@ struct PaperRunOptions {
   // (--params), then name=value assignments (--set).
   std::string params_path;
   std::vector<std::string> sets;
+  // --quasi-static: the run replays settled poses
+  // (SimulationOptions::quasi_static).
+  bool quasi_static = false;
 };
 
 struct PaperRun {

@@ -32,9 +32,16 @@ JointTrajectory PaperTrajectory(const ArmModel& model, const ProtocolConfig& pro
 // samples; before the first and after the last sample the end value holds.
 class CableInputs {
  public:
+  // Between the samples: a C2 cubic spline (a continuous motion: its rate
+  // and acceleration enter the constraints, eq. 63), or straight lines (an
+  // actuator moving from one set point to the next between settled poses:
+  // a spline would swing past them).
+  enum class Interpolation { kCubicSpline, kLinear };
+
   // time: N >= 2 strictly increasing samples [s]; length_change: N × C [m].
   // Throws InputError on a bad shape, non-increasing time or a non-finite value.
-  CableInputs(Eigen::VectorXd time, Eigen::MatrixXd length_change);
+  CableInputs(Eigen::VectorXd time, Eigen::MatrixXd length_change,
+              Interpolation interpolation = Interpolation::kCubicSpline);
   ~CableInputs();
   CableInputs(CableInputs&&) noexcept;
   CableInputs& operator=(CableInputs&&) noexcept;
@@ -44,6 +51,7 @@ class CableInputs {
   double end_time() const { return time_[time_.size() - 1]; }
   const Eigen::VectorXd& time() const { return time_; }
   const Eigen::MatrixXd& length_change() const { return length_change_; }
+  Interpolation interpolation() const { return interpolation_; }
 
   // Value [m], rate [m/s] and acceleration [m/s²] of cable `cable` at t.
   // Thread-safe.
@@ -53,6 +61,7 @@ class CableInputs {
   struct Splines;
   Eigen::VectorXd time_;
   Eigen::MatrixXd length_change_;
+  Interpolation interpolation_;
   std::unique_ptr<Splines> splines_;
 };
 

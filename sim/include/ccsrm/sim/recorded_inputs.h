@@ -47,6 +47,11 @@ struct RecordedInputOptions {
   // (ProtocolLimits::cable_speed_mps). No actuator of such an arm reaches
   // it; a length in the wrong unit (mm read as m) or a corrupt sample does.
   double max_cable_speed_mps = 1.0;
+  // The samples are settled poses (a quasi-static replay,
+  // SimulationOptions::quasi_static): used as recorded whatever their
+  // spacing (no gap limit, no resampling), followed along straight lines
+  // between them (CableInputs::Interpolation::kLinear).
+  bool settled_poses = false;
 
   bool IsValid(std::string* error) const;
 };

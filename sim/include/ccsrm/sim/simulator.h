@@ -161,4 +161,10 @@ struct SimulationResult {
 SimulationResult Simulate(const ArmModel& model, const ArmParameters& parameters,
                           const CableInputs& inputs, const SimulationOptions& options);
 
+// Why the arm cannot be replayed quasi-statically under `solver`, or "" when
+// it can: its friction laws must hold at rest (SimulationOptions::quasi_static).
+// Simulate refuses such a replay with this text (InputError).
+std::string WhyNotQuasiStatic(const ArmModel& model, const ArmParameters& parameters,
+                              const SolverConfig& solver);
+
 }  // namespace ccsrm::sim
