@@ -23,7 +23,7 @@ constexpr double kAbsoluteTolerance = 1e-9;
 constexpr double kRelativeTolerance = 1e-8;
 constexpr int kMaxIterations = 40;
 // A Jacobian is kept while the corrections shrink at least this fast.
-constexpr double kKeepJacobianContraction = 0.5;
+constexpr double kKeepJacobianContraction = 0.7;
 // A correction within this many tolerances that no step improves on is
 // taken as converged (about 2e-8 m).
 constexpr double kStallTolerance = 10.0;
