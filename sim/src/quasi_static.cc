@@ -1,7 +1,6 @@
 #include "quasi_static.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -9,11 +8,10 @@
 
 #include "ccsrm/common/error.h"
 #include "output_sampler.h"
+#include "run_control.h"
 
 namespace ccsrm::sim::internal {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 // Convergence: a correction's weighted RMS below 1 with these weights,
 // about 2e-9 m on the arm's coordinates (~0.1 m) and 1e-8 on the
@@ -37,12 +35,6 @@ constexpr int kMaxActiveSetPasses = 20;
 constexpr double kBranchTolerance = 1e-9;
 // An increment that fails is halved at most this often.
 constexpr int kMaxHalvings = 8;
-
-std::string FormatTime(double t) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.6g s", t);
-  return text;
-}
 
 // The residual's sparsity from the arm's topology: which unknowns each
 // residual row may depend on (sim/src/dynamics.cc's stages at rest).
@@ -391,6 +383,7 @@ class SettledPoseLoop {
       : model_(model),
         inputs_(inputs),
         options_(options),
+        control_(options),
         dynamics_(model, parameters, inputs, options.solver),
         solver_(model, &dynamics_),
         sampler_(SampleTimes(options)),
@@ -418,10 +411,6 @@ class SettledPoseLoop {
     if (!running_) return;
     running_ = false;
     message_ = cause;
-  }
-
-  double WallSeconds() const {
-    return std::chrono::duration<double>(Clock::now() - wall_start_).count();
   }
 
   // The largest path length of any input over (t_, t_out), from 32 points:
@@ -491,26 +480,11 @@ class SettledPoseLoop {
   }
 
   void CheckCancellationAndReport() {
-    if (options_.cancel != nullptr && options_.cancel->load(std::memory_order_relaxed)) {
-      running_ = false;
-      cancelled_ = true;
-      message_ = "cancelled at t = " + FormatTime(t_);
-      return;
-    }
-    const double wall = WallSeconds();
-    if (options_.wall_time_budget_s > 0.0 && wall > options_.wall_time_budget_s) {
-      char text[128];
-      std::snprintf(text, sizeof(text), "wall-time budget of %.3g s used up at t = %s",
-                    options_.wall_time_budget_s, FormatTime(t_).c_str());
-      running_ = false;
-      cancelled_ = true;
-      message_ = text;
-      return;
-    }
-    if (options_.progress && wall >= next_progress_) {
-      next_progress_ = wall + options_.progress_interval_s;
-      options_.progress({t_, options_.duration_s, wall, t_ / std::max(1e-9, wall), steps_, 0});
-    }
+    const std::string stop = control_.Check(t_, steps_, 0);
+    if (stop.empty() || !running_) return;
+    running_ = false;
+    cancelled_ = true;
+    message_ = stop;
   }
 
   void Sample() {
@@ -529,7 +503,7 @@ class SettledPoseLoop {
                           : SimulationStatus::kDiverged;
     s.message = running_ ? "completed" : message_;
     s.simulated_s = t_;
-    s.wall_time_s = WallSeconds();
+    s.wall_time_s = control_.WallSeconds();
     s.real_time_factor = s.wall_time_s > 0 ? t_ / s.wall_time_s : 0.0;
     s.steps = steps_;
     s.rejected_steps = rejected_;
@@ -543,7 +517,7 @@ class SettledPoseLoop {
   const ArmModel& model_;
   const CableInputs& inputs_;
   const SimulationOptions& options_;
-  const Clock::time_point wall_start_ = Clock::now();
+  RunControl control_;
   ArmDynamics dynamics_;
   SettledPoseSolver solver_;
   OutputSampler sampler_;
@@ -559,7 +533,6 @@ class SettledPoseLoop {
   bool running_ = true, cancelled_ = false;
   std::string message_;
   std::int64_t steps_ = 0, rejected_ = 0;
-  double next_progress_ = 0.0;
 };
 
 }  // namespace

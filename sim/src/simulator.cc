@@ -3,7 +3,6 @@
 #include "ccsrm/sim/declared_values.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -18,19 +17,14 @@
 #include "integrator.h"
 #include "output_sampler.h"
 #include "quasi_static.h"
+#include "run_control.h"
 #include "stick_slip.h"
 
 namespace ccsrm::sim {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using internal::FormatTime;
 using internal::StickSlipTreatment;
-
-std::string FormatTime(double t) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.6g s", t);
-  return text;
-}
 
 // One run's step loop: explicit steps with error control that land exactly
 // on every sample time, the stick-slip treatment after each accepted step,
@@ -42,6 +36,7 @@ class StepLoop {
       : model_(model),
         options_(options),
         solver_(options.solver),
+        control_(options),
         dynamics_(model, parameters, inputs, options.solver),
         integrator_(internal::MakeIntegrator(&dynamics_, solver_)),
         stick_slip_(
@@ -83,10 +78,6 @@ class StepLoop {
 
   void Diverge(const std::string& cause) {
     Stop(SimulationStatus::kDiverged, cause + " at t = " + FormatTime(t_));
-  }
-
-  double WallSeconds() const {
-    return std::chrono::duration<double>(Clock::now() - wall_start_).count();
   }
 
   // One accepted step towards t_out (rejected trials retried shorter), then
@@ -157,25 +148,10 @@ class StepLoop {
   }
 
   void CheckCancellationAndReport() {
-    if (options_.cancel != nullptr && options_.cancel->load(std::memory_order_relaxed)) {
-      Stop(SimulationStatus::kCancelled, "cancelled at t = " + FormatTime(t_));
-      return;
-    }
     // The clock is read every 64 steps: cheap against ~60 evaluations.
-    if ((steps_ & 63) != 0) return;
-    const double wall = WallSeconds();
-    if (options_.wall_time_budget_s > 0.0 && wall > options_.wall_time_budget_s) {
-      char text[128];
-      std::snprintf(text, sizeof(text), "wall-time budget of %.3g s used up at t = %s",
-                    options_.wall_time_budget_s, FormatTime(t_).c_str());
-      Stop(SimulationStatus::kCancelled, text);
-      return;
-    }
-    if (options_.progress && wall >= next_progress_) {
-      next_progress_ = wall + options_.progress_interval_s;
-      options_.progress({t_, options_.duration_s, wall, t_ / std::max(1e-9, wall), steps_,
-                         stick_slip_->switches()});
-    }
+    const std::string stop =
+        control_.Check(t_, steps_, stick_slip_->switches(), (steps_ & 63) == 0);
+    if (!stop.empty()) Stop(SimulationStatus::kCancelled, stop);
   }
 
   // The frame at t = next sample time; a constraint violation above the
@@ -206,7 +182,7 @@ class StepLoop {
     s.status = status_;
     s.message = running() ? "completed" : message_;
     s.simulated_s = t_;
-    s.wall_time_s = WallSeconds();
+    s.wall_time_s = control_.WallSeconds();
     s.real_time_factor = s.wall_time_s > 0 ? t_ / s.wall_time_s : 0.0;
     s.steps = steps_;
     s.rejected_steps = rejected_;
@@ -223,7 +199,7 @@ class StepLoop {
   const ArmModel& model_;
   const SimulationOptions& options_;
   const SolverConfig& solver_;
-  const Clock::time_point wall_start_ = Clock::now();
+  internal::RunControl control_;
   internal::ArmDynamics dynamics_;
   std::unique_ptr<internal::Integrator> integrator_;
   std::unique_ptr<StickSlipTreatment> stick_slip_;
@@ -244,7 +220,6 @@ class StepLoop {
   SimulationStatus status_ = SimulationStatus::kCompleted;
   std::string message_;
   std::int64_t steps_ = 0, rejected_ = 0;
-  double next_progress_ = 0.0;
 };
 
 }  // namespace
