@@ -74,6 +74,28 @@ TEST(SettledPoseSolver, ColouredJacobianIsTheDenseFiniteDifferenceOne) {
   std::printf("%d unknowns in %d colours\n", size, solver.num_colours());
 }
 
+TEST(SettledPoseSolver, EquilibriumOfSlackCablesIsRegular) {
+  // Every element 1 % longer in material than its chord: all cables slack.
+  // Slack elements have no stiffness of their own, and without the settled
+  // residual's weak stiffness every material coordinate of a hole node
+  // would be a column of zeros (a singular Jacobian: no unique
+  // equilibrium).
+  Config config = test_support::SmallArm(5);
+  UsePreslidingFriction(&config.solver);
+  const ArmModel model(config.arm);
+  const CableInputs inputs = test_support::PullAndHold(model, 0, 1e-3, 1.0, 2.0);
+  internal::ArmDynamics dynamics(model, config.parameters, inputs, config.solver);
+  internal::SettledPoseSolver solver(model, &dynamics);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(solver.size());
+  x.head(dynamics.num_coordinates()) = dynamics.InitialState().head(dynamics.num_coordinates());
+  for (int c = 0; c < model.num_cables(); ++c) {
+    for (std::size_t k = 0; k < model.cables()[c].nodes.size(); ++k)
+      x[model.node_offset(c, static_cast<int>(k)) + 3] *= 1.01;
+  }
+  EXPECT_TRUE(solver.ComputeJacobian(0.0, dynamics.InitialSettledFriction(), x))
+      << solver.failure();
+}
+
 SimulationResult Replay(const ArmModel& model, const ArmParameters& parameters,
                         const CableInputs& inputs, SolverConfig solver,
                         const std::vector<double>& times) {
@@ -129,6 +151,27 @@ TEST(QuasiStaticReplay, FrictionKeepsTheBendThatTheFrictionlessArmGivesBack) {
   EXPECT_GT(back_with, 1e-3 * last_joint);
   std::printf("largest bend %.4f deg; after the return %.3g deg with friction, %.3g without\n",
               last_joint / kDeg, back_with / kDeg, back_without / kDeg);
+}
+
+TEST(QuasiStaticReplay, SettlesWithACableSlack) {
+  // Cables paid out by more than their stretch lie slack: at rest their
+  // material coordinates have no stiffness of their own, and the replay
+  // must still find the one equilibrium (the settled residual's weak
+  // stiffness spreads the slack material evenly), with the cables
+  // reported slack and the arm held straight by its connecting cables.
+  Config config = test_support::SmallArm(5);
+  UsePreslidingFriction(&config.solver);
+  const ArmModel model(config.arm);
+  Eigen::VectorXd time(3);
+  time << 0.0, 1.0, 2.0;
+  Eigen::MatrixXd change = Eigen::MatrixXd::Zero(3, model.num_cables());
+  change.bottomRows(2).setConstant(-3e-3);  // paid out 3 mm, about 7x the stretch
+  const SimulationResult run =
+      Replay(model, config.parameters, CableInputs(time, change), config.solver, {0.0, 1.0, 2.0});
+  ASSERT_TRUE(run.summary.completed()) << run.summary.message;
+  ASSERT_EQ(run.summary.slack.size(), static_cast<std::size_t>(model.num_cables()));
+  for (const Eigen::Vector2d& angles : run.trajectory.frames.back().joint_angles)
+    EXPECT_LT(angles.cwiseAbs().maxCoeff(), 1e-6);
 }
 
 TEST(QuasiStaticReplay, LawsThatHoldNothingAtRestAreRefused) {
