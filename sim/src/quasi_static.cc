@@ -496,22 +496,11 @@ class SettledPoseLoop {
   }
 
   SimulationResult Finish() {
-    SimulationResult result;
-    SimulationSummary& s = result.summary;
-    s.status = cancelled_ ? SimulationStatus::kCancelled
-               : running_ ? SimulationStatus::kCompleted
-                          : SimulationStatus::kDiverged;
-    s.message = running_ ? "completed" : message_;
-    s.simulated_s = t_;
-    s.wall_time_s = control_.WallSeconds();
-    s.real_time_factor = s.wall_time_s > 0 ? t_ / s.wall_time_s : 0.0;
-    s.steps = steps_;
-    s.rejected_steps = rejected_;
-    s.rhs_evaluations = dynamics_.evaluations();
-    s.max_constraint_violation = sampler_.max_constraint_violation();
-    result.trajectory = sampler_.Take();
-    s.slack = SlackIntervalsOf(model_, result.trajectory);
-    return result;
+    const SimulationStatus status = cancelled_ ? SimulationStatus::kCancelled
+                                    : running_ ? SimulationStatus::kCompleted
+                                               : SimulationStatus::kDiverged;
+    return FinishRun(model_, control_,
+                     {status, message_, t_, steps_, rejected_, dynamics_.evaluations()}, &sampler_);
   }
 
   const ArmModel& model_;

@@ -37,4 +37,22 @@ std::string RunControl::Check(double t, std::int64_t steps, std::int64_t switche
   return "";
 }
 
+SimulationResult FinishRun(const ArmModel& model, const RunControl& control, const RunTally& tally,
+                           OutputSampler* sampler) {
+  SimulationResult result;
+  SimulationSummary& s = result.summary;
+  s.status = tally.status;
+  s.message = tally.status == SimulationStatus::kCompleted ? "completed" : tally.message;
+  s.simulated_s = tally.simulated_s;
+  s.wall_time_s = control.WallSeconds();
+  s.real_time_factor = s.wall_time_s > 0 ? tally.simulated_s / s.wall_time_s : 0.0;
+  s.steps = tally.steps;
+  s.rejected_steps = tally.rejected_steps;
+  s.rhs_evaluations = tally.evaluations;
+  s.max_constraint_violation = sampler->max_constraint_violation();
+  result.trajectory = sampler->Take();
+  s.slack = SlackIntervalsOf(model, result.trajectory);
+  return result;
+}
+
 }  // namespace ccsrm::sim::internal

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "ccsrm/sim/simulator.h"
+#include "output_sampler.h"
 
 namespace ccsrm::sim::internal {
 
@@ -33,5 +34,19 @@ class RunControl {
   const Clock::time_point start_ = Clock::now();
   double next_progress_ = 0.0;
 };
+
+// How a run ended and what it did.
+struct RunTally {
+  SimulationStatus status = SimulationStatus::kCompleted;
+  std::string message;  // the cause, when it did not complete
+  double simulated_s = 0.0;
+  std::int64_t steps = 0, rejected_steps = 0, evaluations = 0;
+};
+
+// A run's result: its frames (taken from `sampler`) and the summary of
+// `tally` with the wall time, the largest constraint violation and where a
+// cable went slack.
+SimulationResult FinishRun(const ArmModel& model, const RunControl& control, const RunTally& tally,
+                           OutputSampler* sampler);
 
 }  // namespace ccsrm::sim::internal

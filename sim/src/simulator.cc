@@ -177,22 +177,13 @@ class StepLoop {
   }
 
   SimulationResult Finish() {
-    SimulationResult result;
+    SimulationResult result = internal::FinishRun(
+        model_, control_, {status_, message_, t_, steps_, rejected_, dynamics_.evaluations()},
+        &sampler_);
     SimulationSummary& s = result.summary;
-    s.status = status_;
-    s.message = running() ? "completed" : message_;
-    s.simulated_s = t_;
-    s.wall_time_s = control_.WallSeconds();
-    s.real_time_factor = s.wall_time_s > 0 ? t_ / s.wall_time_s : 0.0;
-    s.steps = steps_;
-    s.rejected_steps = rejected_;
-    s.rhs_evaluations = dynamics_.evaluations();
     s.stick_slip_switches = stick_slip_->switches();
     s.failed_releases = stick_slip_->failed_releases();
     s.largest_threshold_raise_n = stick_slip_->largest_threshold_raise_n();
-    s.max_constraint_violation = sampler_.max_constraint_violation();
-    result.trajectory = sampler_.Take();
-    s.slack = internal::SlackIntervalsOf(model_, result.trajectory);
     return result;
   }
 
