@@ -51,6 +51,15 @@ def assert_same_as_file(run, path):
         assert run.status == "completed"
 
 
+def write_input_table(table, path):
+    """A table of inputs as `--inputs` reads it: time_s, then cable<k>_m."""
+    header = "time_s," + ",".join(f"cable{k}_m" for k in range(1, table.shape[1]))
+    # repr: the shortest text that reads back to the same double.
+    path.write_text(header + "\n" + "\n".join(",".join(repr(float(v)) for v in row)
+                                              for row in table) + "\n")
+    return path
+
+
 def test_protocol_run_equals_command_line_run_file(exe, paper_config, paper_model, tmp_path):
     out = tmp_path / "cli.h5"
     run_ccsrm(exe, "simulate", "--config", paper_config, "--case", 2, "--protocol", TWO_AXIS,
@@ -84,11 +93,7 @@ def test_recorded_inputs_equal_command_line_table(exe, paper_config, paper_model
     table[:, 0] = t
     table[:, 1] = pull
     table[:, 4] = -pull
-    csv = tmp_path / "inputs.csv"
-    header = "time_s," + ",".join(f"cable{k}_m" for k in range(1, paper_model.num_cables + 1))
-    # repr: the shortest text that reads back to the same double.
-    csv.write_text(header + "\n" + "\n".join(",".join(repr(float(v)) for v in row)
-                                             for row in table) + "\n")
+    csv = write_input_table(table, tmp_path / "inputs.csv")
     out = tmp_path / "cli.h5"
     run_ccsrm(exe, "simulate", "--config", paper_config, "--case", 1, "--inputs", csv,
               "--quiet", "--out", out)
@@ -103,10 +108,7 @@ def test_settled_poses_replay_as_the_command_line_does(exe, paper_config, paper_
     table = np.zeros((pull.size, 1 + paper_model.num_cables))
     table[:, 0] = np.arange(pull.size, dtype=float)
     table[:, 1] = pull
-    csv = tmp_path / "poses.csv"
-    header = "time_s," + ",".join(f"cable{k}_m" for k in range(1, paper_model.num_cables + 1))
-    csv.write_text(header + "\n" + "\n".join(",".join(repr(float(v)) for v in row)
-                                             for row in table) + "\n")
+    csv = write_input_table(table, tmp_path / "poses.csv")
     out = tmp_path / "cli.h5"
     run_ccsrm(exe, "simulate", "--config", paper_config, "--case", 2, "--inputs", csv,
               "--quasi-static", "--quiet", "--out", out)
