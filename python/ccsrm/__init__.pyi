@@ -149,8 +149,13 @@ class Dataset:
     protocol_yaml: str
     inputs_file: str
     marker_names: list[str]
+    input_labels: list[str]
     @property
     def source(self) -> str: ...
+    @property
+    def motion(self) -> str: ...
+    @property
+    def marker_frame(self) -> str: ...
     @property
     def input_time(self) -> npt.NDArray[np.float64]: ...
     @property
@@ -269,6 +274,7 @@ def simulate(
     amplitude_deg: float | None = None,
     output_rate: float | None = None,
     max_input_gap: float = 0.1,
+    quasi_static: bool = False,
 ) -> Run: ...
 def generate(
     out: _Path,
@@ -284,6 +290,7 @@ def generate(
     resolution_mm: float = 0.0,
     seed: int = 1,
     occlusions: bool = True,
+    quasi_static: bool = False,
 ) -> dict[str, Any]: ...
 def read_run_file(path: _Path) -> Run: ...
 def read_dataset(path: _Path) -> Dataset: ...
