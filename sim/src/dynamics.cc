@@ -29,15 +29,6 @@ Vector3 Position(const double* q, int offset) {
 // kRegularization * lambda, far below the Baumgarte-stabilised drift.
 constexpr double kRegularization = 1e-10;
 
-// At rest a slack element (row 27) has no stiffness, and a slack cable's
-// material coordinates none: its equilibrium would not be unique, and the
-// toe's stiffness rising from nothing throws Newton's corrections far. In
-// the settled residual every element carries this fraction of EA on its
-// strain as well: a slack cable's material then spreads evenly, pushing
-// with at most 1e-5 EA at a strain of -0.1, and a taut one's tension moves
-// by 1e-4 of itself.
-constexpr double kSettledResidualStiffness = 1e-4;
-
 }  // namespace
 
 // The state an effect may read and the loads it may add during one
@@ -376,7 +367,7 @@ bool ArmDynamics::AddCableElements(const double* q, const double* qd) {
       AddSymmetricBlock(terms.mass + terms.elastic_mass, index, values);
       Vector8d f = terms.ale_inertia_force + terms.elastic_force;
       if (settled_from_ != nullptr) {
-        f -= (ds * ale_.axial_stiffness_n * kSettledResidualStiffness * terms.strain) *
+        f -= (ds * ale_.axial_stiffness_n * settled_element_stiffness_ * terms.strain) *
              terms.strain_jacobian.transpose();
       }
       for (int a = 0; a < 8; ++a) force_[cols[a]] += f[a];

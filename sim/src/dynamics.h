@@ -132,6 +132,15 @@ class ArmDynamics {
     std::vector<signed char> hole, conduit;
   };
   SettledBranches& settled_branches() { return branches_; }
+  // At rest a slack element (row 27) has no stiffness, and a slack cable's
+  // material coordinates none: its equilibrium would not be unique. In the
+  // settled residual every element also carries this fraction of EA on its
+  // strain: a slack cable's material then spreads evenly (pushing with at
+  // most 1e-5 EA at a strain of -0.1), a taut one's tension moves by that
+  // fraction of itself. The solver raises it for a continuation where the
+  // toe's stiffness, rising from nothing, defeats Newton's method.
+  static constexpr double kSettledElementStiffness = 1e-4;
+  void set_settled_element_stiffness(double fraction) { settled_element_stiffness_ = fraction; }
   // The friction state at the x of the last SettledResidual.
   const SettledFriction& settled_friction() const { return settled_now_; }
   // That of InitialState(): no presliding displacement anywhere.
@@ -217,6 +226,7 @@ class ArmDynamics {
   const SettledFriction* settled_from_ = nullptr;
   SettledFriction settled_now_;
   SettledBranches branches_;
+  double settled_element_stiffness_ = kSettledElementStiffness;
   std::vector<double> zero_rates_;   // n zeros: q_dot at rest
   std::vector<double> rest_memory_;  // the memory states at rest
 

@@ -269,6 +269,26 @@ double SettledPoseSolver::Norm(const Eigen::VectorXd& dx, const Eigen::VectorXd&
 }
 
 bool SettledPoseSolver::Solve(double t, const SettledFriction& from, Eigen::VectorXd* x) {
+  const Eigen::VectorXd guess = *x;
+  if (SolveWithBranches(t, from, x)) return true;
+  // A cable going slack or taut: the toe's stiffness rises from nothing,
+  // and Newton's corrections from a slack side fly off. Continuation in
+  // the elements' residual stiffness: solved where the slack side is
+  // stiffer, then brought back to the model's in two steps.
+  *x = guess;
+  bool solved = true;
+  for (double fraction : {1e-2, 1e-3, ArmDynamics::kSettledElementStiffness}) {
+    dynamics_->set_settled_element_stiffness(fraction);
+    factorised_ = false;
+    solved = solved && SolveWithBranches(t, from, x);
+  }
+  dynamics_->set_settled_element_stiffness(ArmDynamics::kSettledElementStiffness);
+  if (!solved) *x = guess;
+  return solved;
+}
+
+bool SettledPoseSolver::SolveWithBranches(double t, const SettledFriction& from,
+                                          Eigen::VectorXd* x) {
   failure_.clear();
   if (!Residual(t, from, *x, &r_)) return false;
   ChooseBranches(from, true);

@@ -62,6 +62,8 @@ class SettledPoseSolver {
  private:
   bool Residual(double t, const SettledFriction& from, const Eigen::VectorXd& x,
                 Eigen::VectorXd* r);
+  // Solve without the continuation.
+  bool SolveWithBranches(double t, const SettledFriction& from, Eigen::VectorXd* x);
   // Newton on the residual with the branches as they are.
   bool Newton(double t, const SettledFriction& from, Eigen::VectorXd* x);
   // Each contact's branch from its slip at the last residual: `initial`,
