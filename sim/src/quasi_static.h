@@ -45,9 +45,11 @@ class SettledPoseSolver {
   // (ArmDynamics::SettledBranches; at first from the guess's slips, the
   // elastic side where it has none), solves, and flips the contacts whose
   // slip contradicts their branch, until none does. The force is monotone
-  // in each slip, so one consistent set exists. Returns false (with
-  // failure()) when a Newton solve stops contracting or the set does not
-  // settle.
+  // in each slip, so one consistent set exists. Where that fails (a cable
+  // going slack or taut), it is solved again by continuation in the
+  // elements' residual stiffness (ArmDynamics::kSettledElementStiffness,
+  // from 1e-2 down). Returns false (with failure()) when a Newton solve
+  // stops contracting or the set does not settle.
   bool Solve(double t, const SettledFriction& from, Eigen::VectorXd* x);
   const std::string& failure() const { return failure_; }
 
