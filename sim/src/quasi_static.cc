@@ -203,6 +203,10 @@ SettledPoseSolver::SettledPoseSolver(const ArmModel& model, ArmDynamics* dynamic
     }
     diagonal_entry_.push_back(EntryIndex(jacobian_, n_ + r, n_ + r));
   }
+  for (int c = 0; c < model.num_cables(); ++c) {
+    for (int e = 0; e < model.cables()[c].num_elements(); ++e)
+      element_material_.emplace_back(model.node_offset(c, e) + 3, model.node_offset(c, e + 1) + 3);
+  }
   lu_.analyzePattern(jacobian_);
 }
 
@@ -257,6 +261,16 @@ bool SettledPoseSolver::Correction(const Eigen::VectorXd& r, Eigen::VectorXd* dx
   if (dx->allFinite()) return true;
   failure_ = "non-finite Newton correction";
   return false;
+}
+
+double SettledPoseSolver::MaterialStepLimit(const Eigen::VectorXd& x,
+                                            const Eigen::VectorXd& dx) const {
+  double limit = 1.0;
+  for (const auto& [before, after] : element_material_) {
+    const double shrink = dx[before] - dx[after];  // > 0 shortens the element
+    if (shrink > 0.0) limit = std::min(limit, 0.5 * (x[after] - x[before]) / shrink);
+  }
+  return limit;
 }
 
 double SettledPoseSolver::Norm(const Eigen::VectorXd& dx, const Eigen::VectorXd& x) const {
@@ -349,6 +363,7 @@ bool SettledPoseSolver::Newton(double t, const SettledFriction& from, Eigen::Vec
       // The friction state of the final x.
       return Residual(t, from, x, &r_);
     }
+    damping = std::min(damping, MaterialStepLimit(x, dx));
     x_try_ = x + damping * dx;
     // Deuflhard's restricted natural monotonicity test: the simplified
     // correction at the trial point, with the same Jacobian, must be

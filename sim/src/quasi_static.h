@@ -21,6 +21,7 @@
 #include <Eigen/SparseLU>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ccsrm/sim/simulator.h"
@@ -74,6 +75,10 @@ class SettledPoseSolver {
   int ChooseBranches(const SettledFriction& from, bool initial);
   // The Newton correction -J^-1 r; false if not finite.
   bool Correction(const Eigen::VectorXd& r, Eigen::VectorXd* dx);
+  // The largest fraction of dx that leaves every element at least half its
+  // material length (at most 1): a slack cable's material, weakly held,
+  // would otherwise be stepped through itself.
+  double MaterialStepLimit(const Eigen::VectorXd& x, const Eigen::VectorXd& dx) const;
   // Weighted RMS of a correction's coordinates (the multipliers follow
   // them): 1 is the convergence tolerance.
   double Norm(const Eigen::VectorXd& dx, const Eigen::VectorXd& x) const;
@@ -89,6 +94,9 @@ class SettledPoseSolver {
   // columns from row_start_[r] (Phi_q, then -Phi_q^T), and its diagonal.
   std::vector<std::vector<int>> colours_;
   std::vector<int> row_start_, gradient_entry_, reaction_entry_, diagonal_entry_;
+  // Per cable element, the material coordinates' columns of its two nodes
+  // (a step may shorten an element's material by at most half).
+  std::vector<std::pair<int, int>> element_material_;
   // The Jacobian is unsymmetric and indefinite (a saddle point in the
   // multipliers). Eigen's supernodal LU with COLAMD: on the robot's arm
   // (3 400 unknowns) 3.5x faster than SuiteSparse's KLU through Eigen.
