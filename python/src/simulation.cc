@@ -252,9 +252,8 @@ py::list PerCable(const py::object& self, const Run& run,
   return out;
 }
 
-}  // namespace
-
-void AddSimulation(py::module_& m) {
+// ccsrm.Model and ccsrm.load_config.
+void AddModelClass(py::module_& m) {
   py::class_<Model, std::shared_ptr<Model>>(
       m, "Model",
       "An arm's configuration and its model, read-only (ccsrm.load_config). Shared by any "
@@ -310,7 +309,10 @@ void AddSimulation(py::module_& m) {
       py::arg("name") = "paper.yaml",
       "The path of a configuration that ships with ccsrm (paper.yaml, three-segment.yaml, "
       "protocols/<name>.yaml).");
+}
 
+// A run and what it reports: ccsrm.SlackInterval, SimulationSummary, Run.
+void AddRunClasses(py::module_& m) {
   py::class_<sim::SlackInterval>(m, "SlackInterval", "A stretch of time a driving cable was slack.")
       .def_readonly("cable", &sim::SlackInterval::cable, "1-based.")
       .def_readonly("start_s", &sim::SlackInterval::start_s)
@@ -432,7 +434,13 @@ void AddSimulation(py::module_& m) {
         return "<ccsrm.Run " + std::to_string(r.file.frames()) + " frames, " +
                datasets::RunStatusName(r.file.status) + ">";
       });
+}
 
+}  // namespace
+
+void AddSimulation(py::module_& m) {
+  AddModelClass(m);
+  AddRunClasses(m);
   m.def("simulate", &SimulateRun, py::arg("model"), py::arg("params") = py::none(), py::kw_only(),
         py::arg("case") = py::none(), py::arg("protocol") = py::none(),
         py::arg("inputs") = py::none(), py::arg("sample_times") = py::none(),

@@ -489,10 +489,7 @@ void ArmDynamics::AddHoleFriction(const double* q, const double* qd, const doubl
 // elastic energy; the plastic and the smoothing power are dissipated.
 void ArmDynamics::AddPreslidingFriction(int h, int s_col, double t_before, double v,
                                         const double* memory, double xi) {
-  const PreslidingLaw law{
-      {parameters_.mu, parameters_.mu_s, parameters_.v_s, solver_.stick_velocity_tolerance_mps},
-      parameters_.xi_f,
-      PreslidingRelaxationResolution()};
+  const PreslidingLaw law = HolePreslidingLaw(PreslidingRelaxationResolution());
   HoleReport& report = reports_[h];
   const bool remembers = parameters_.tau_f > 0.0;
   const double target = HoleMemoryTarget(law.friction, v, nullptr);
@@ -1065,10 +1062,7 @@ double DisplacementOnBranch(double displacement, double slip, double up, double 
 // The presliding laws at rest (memory z = 1), without their relaxation's
 // smoothing: slow slip is the limit it leaves unchanged.
 double ArmDynamics::SettledHoleDisplacement(int h, double s, double wrap_angle) {
-  const PreslidingLaw law{
-      {parameters_.mu, parameters_.mu_s, parameters_.v_s, solver_.stick_velocity_tolerance_mps},
-      parameters_.xi_f,
-      0.0};
+  const PreslidingLaw law = HolePreslidingLaw(0.0);
   const double up = PreslidingSteadyDisplacement(law, wrap_angle, 1.0, 1.0);
   const double down = PreslidingSteadyDisplacement(law, wrap_angle, 1.0, -1.0);
   const double xi = DisplacementOnBranch(settled_from_->hole_xi[h], s - settled_from_->hole_s[h],

@@ -177,6 +177,15 @@ class ArmDynamics {
     return solver_.smooth_presliding_relaxation ? solver_.smoothing_step_s : 0.0;
   }
 
+  // The holes' presliding law of this run, its relaxation smoothed over
+  // `relaxation_resolution_s` (0: not).
+  PreslidingLaw HolePreslidingLaw(double relaxation_resolution_s) const {
+    return {
+        {parameters_.mu, parameters_.mu_s, parameters_.v_s, solver_.stick_velocity_tolerance_mps},
+        parameters_.xi_f,
+        relaxation_resolution_s};
+  }
+
   // Row `axis` of d(theta_dot of joint k)/d(e_dot of link), 1-based k and
   // link (zero unless link is k or k - 1).
   Eigen::Matrix<double, 1, 4> JointRateRow(int k, int link, int axis) const;
