@@ -1,5 +1,6 @@
 #include "job_options.h"
 
+#include <cmath>
 #include <cstdio>
 
 #include "ccsrm/common/name_list.h"
@@ -73,10 +74,14 @@ identify::JobReporting TerminalReporting(bool quiet, const std::string& indent) 
       values += text;
     }
     std::fprintf(stderr, "\r%-100s\r", "");
-    std::printf("%siteration %2d: cost %.6g, RMS %.4f deg%s, %lld simulations, %.0f s;%s\n",
-                indent.c_str(), p.iteration, p.cost, p.rms_deg,
-                p.step_accepted ? "" : " (step rejected)", static_cast<long long>(p.simulations),
-                p.wall_time_s, values.c_str());
+    char rms[96] = "";
+    if (std::isfinite(p.rms_deg)) std::snprintf(rms, sizeof(rms), ", RMS %.4f deg", p.rms_deg);
+    if (std::isfinite(p.rms_mm)) {
+      std::snprintf(rms, sizeof(rms), ", points RMS %.3f mm", p.rms_mm);
+    }
+    std::printf("%siteration %2d: cost %.6g%s%s, %lld simulations, %.0f s;%s\n", indent.c_str(),
+                p.iteration, p.cost, rms, p.step_accepted ? "" : " (step rejected)",
+                static_cast<long long>(p.simulations), p.wall_time_s, values.c_str());
     std::fflush(stdout);
   };
   reporting.on_run = RunProgress();

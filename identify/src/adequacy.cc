@@ -15,6 +15,35 @@ constexpr double kDeg = 180.0 / 3.14159265358979323846;
 
 double Ratio(const ChannelAboveNoise& c) { return c.rms_deg / c.noise_deg; }
 
+// "joint 3 θx, 0.0412 deg RMS against 0.0300 deg of noise" or the same of a
+// tracked point's coordinate in mm.
+std::string ChannelText(const ChannelAboveNoise& c) {
+  if (!c.point.empty()) {
+    return Format("point %s %c, %.3f mm RMS against %.3f mm of noise", c.point.c_str(),
+                  "xyz"[c.axis], c.rms_deg, c.noise_deg);
+  }
+  return Format("joint %d %s, %.4f deg RMS against %.4f deg of noise", c.joint,
+                c.axis == 0 ? "θx" : "θy", c.rms_deg, c.noise_deg);
+}
+
+// The channel's test as noise: its weighted residuals' mean square against
+// the noise's F (or chi-square without a noise estimate's own samples).
+void TestAsNoise(const std::vector<double>& weighted, double above_noise_ratio,
+                 ChannelAboveNoise* c, ModelAdequacy* out, std::vector<bool>* large) {
+  double sum = 0.0;
+  for (const double w : weighted) sum += w * w;
+  const double n = static_cast<double>(weighted.size());
+  c->rms_deg = std::sqrt(sum / n) * c->noise_deg;
+  c->effective_samples = internal::EffectiveSampleSize({weighted});
+  // A run that ended early leaves NaN: never noise.
+  c->p_value = !std::isfinite(sum) ? 0.0
+               : std::isfinite(c->noise_effective_samples)
+                   ? gsl_cdf_fdist_Q(sum / n, c->effective_samples, c->noise_effective_samples)
+                   : gsl_cdf_chisq_Q(sum * c->effective_samples / n, c->effective_samples);
+  out->worst_ratio = std::isfinite(sum) ? std::max(out->worst_ratio, Ratio(*c)) : INFINITY;
+  large->push_back(!(c->rms_deg <= above_noise_ratio * c->noise_deg));
+}
+
 }  // namespace
 
 const ChannelAboveNoise* ModelAdequacy::Worst() const {
@@ -34,16 +63,17 @@ std::string ModelAdequacy::Verdict() const {
   if (!assessed) return "the model was not judged: no complete run to compare with the data";
   if (above_noise.empty()) {
     return Format(
-        "the model explains the data: no joint axis stands above its noise (%zu tested, the "
+        "the model explains the data: no %s stands above its noise (%zu tested, the "
         "largest RMS residual %.2fx its noise; above means beyond %gx and beyond chance)",
-        channels, worst_ratio, above_noise_ratio);
+        point_channels > 0 ? "measured axis" : "joint axis", channels, worst_ratio,
+        above_noise_ratio);
   }
   const ChannelAboveNoise& w = *Worst();
   return Format(
-      "the model does NOT explain the data: %zu of %zu joint axes stand above their noise "
-      "(worst: %s joint %d %s, %.4f deg RMS against %.4f deg of noise, %.2fx)",
-      above_noise.size(), channels, w.recording.c_str(), w.joint, w.axis == 0 ? "θx" : "θy",
-      w.rms_deg, w.noise_deg, Ratio(w));
+      "the model does NOT explain the data: %zu of %zu %s stand above their noise "
+      "(worst: %s %s, %.2fx)",
+      above_noise.size(), channels, point_channels > 0 ? "measured axes" : "joint axes",
+      w.recording.c_str(), ChannelText(w).c_str(), Ratio(w));
 }
 
 ModelAdequacy AssessModelAdequacy(const std::vector<const Experiment*>& recordings,
@@ -57,43 +87,52 @@ ModelAdequacy AssessModelAdequacy(const std::vector<const Experiment*>& recordin
   for (std::size_t e = 0; e < recordings.size() && e < simulated.size(); ++e) {
     const Experiment& x = *recordings[e];
     const Eigen::MatrixXd& sim = *simulated[e];
-    if (sim.rows() != x.measured_rad.rows() || sim.cols() != x.measured_rad.cols()) continue;
+    if (sim.rows() != x.measured.rows() || sim.cols() != x.measured.cols()) continue;
+    const auto weighted_column = [&](Eigen::Index column) {
+      std::vector<double> weighted;
+      for (Eigen::Index f = 0; f < x.measured.rows(); ++f) {
+        if (std::isfinite(x.measured(f, column))) {
+          weighted.push_back(x.WeightedResidual(f, column, sim(f, column)));
+        }
+      }
+      return weighted;
+    };
     for (int j = 0; j < x.joints; ++j) {
       const std::size_t jj = static_cast<std::size_t>(j);
       for (int a = 0; a < 2; ++a) {
-        std::vector<double> weighted;
-        double sum = 0.0;
-        for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
-          const double m = x.measured_rad(f, 2 * j + a);
-          if (!std::isfinite(m)) continue;
-          const double w = (sim(f, 2 * j + a) - m) * kDeg / x.NoiseDeg(f, 2 * j + a);
-          weighted.push_back(w);
-          sum += w * w;
-        }
+        const std::vector<double> weighted = weighted_column(2 * j + a);
         if (weighted.empty()) continue;
         ChannelAboveNoise c;
         c.recording = x.name;
         c.joint = j + 1;
         c.axis = a;
-        const double n = static_cast<double>(weighted.size());
         c.noise_deg = x.noise_deg[jj];
-        c.rms_deg = std::sqrt(sum / n) * c.noise_deg;
-        c.effective_samples = internal::EffectiveSampleSize({weighted});
         c.noise_effective_samples =
             jj < x.noise_effective_samples.size() ? x.noise_effective_samples[jj] : INFINITY;
-        // A run that ended early leaves NaN: never noise.
-        c.p_value = !std::isfinite(sum) ? 0.0
-                    : std::isfinite(c.noise_effective_samples)
-                        ? gsl_cdf_fdist_Q(sum / n, c.effective_samples, c.noise_effective_samples)
-                        : gsl_cdf_chisq_Q(sum * c.effective_samples / n, c.effective_samples);
-        out.worst_ratio = std::isfinite(sum) ? std::max(out.worst_ratio, Ratio(c)) : INFINITY;
-        large.push_back(!(c.rms_deg <= above_noise_ratio * c.noise_deg));
+        TestAsNoise(weighted, above_noise_ratio, &c, &out, &large);
+        tested.push_back(c);
+      }
+    }
+    for (std::size_t p = 0; p < x.tracked_points.size(); ++p) {
+      for (int a = 0; a < 3; ++a) {
+        const std::vector<double> weighted =
+            weighted_column(2 * x.joints + 3 * static_cast<Eigen::Index>(p) + a);
+        if (weighted.empty()) continue;
+        ChannelAboveNoise c;
+        c.recording = x.name;
+        c.point = x.tracked_points[p].name;
+        c.axis = a;
+        c.noise_deg = x.point_noise_mm;
+        c.noise_effective_samples = INFINITY;  // a stated noise
+        TestAsNoise(weighted, above_noise_ratio, &c, &out, &large);
         tested.push_back(c);
       }
     }
   }
   out.assessed = !tested.empty();
   out.channels = tested.size();
+  out.point_channels = static_cast<std::size_t>(std::count_if(
+      tested.begin(), tested.end(), [](const ChannelAboveNoise& c) { return !c.point.empty(); }));
   for (std::size_t k = 0; k < tested.size(); ++k) {
     if (large[k] && tested[k].p_value < significance / static_cast<double>(tested.size())) {
       out.above_noise.push_back(tested[k]);
@@ -107,6 +146,7 @@ nlohmann::json ToJson(const ModelAdequacy& a) {
   for (const ChannelAboveNoise& c : a.above_noise) {
     above.push_back({{"recording", c.recording},
                      {"joint", c.joint},
+                     {"point", c.point},
                      {"axis", c.axis == 0 ? "x" : "y"},
                      {"rms_deg", c.rms_deg},
                      {"noise_deg", c.noise_deg},

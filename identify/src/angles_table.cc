@@ -87,9 +87,7 @@ void WriteRecordingOutputs(const Experiment& x, const std::string& name,
   } else {
     (*entry)["run_file"] = nullptr;
   }
-  const auto measured = [&x](Eigen::Index f, Eigen::Index c) {
-    return x.measured_rad(f, c) * kDeg;
-  };
+  const auto measured = [&x](Eigen::Index f, Eigen::Index c) { return x.measured(f, c) * kDeg; };
   const auto simulated = [&simulated_rad](Eigen::Index f, Eigen::Index c) {
     return simulated_rad.rows() > f ? simulated_rad(f, c) * kDeg : NAN;
   };

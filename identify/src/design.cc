@@ -41,8 +41,8 @@ Experiment AsExperiment(const PlannedExperiment& planned, const DesignOptions& o
     e.frame_time_s.push_back(t);
     e.sample_time_s.push_back(t);
   }
-  e.measured_rad = Eigen::MatrixXd::Zero(frames, 2 * e.joints);
-  e.measured_samples = static_cast<std::size_t>(e.measured_rad.size());
+  e.measured = Eigen::MatrixXd::Zero(frames, 2 * e.joints);
+  e.measured_samples = static_cast<std::size_t>(e.measured.size());
   e.noise_deg.assign(static_cast<std::size_t>(e.joints), options.noise_deg);
   e.noise_source = "given (design)";
   // The recordings' low-pass, which a fit applies to its simulated angles:
@@ -203,7 +203,7 @@ CandidateInformation EvaluateCandidate(const DesignCandidate& candidate,
                        ": the run at the prior did not complete: " + runs[e].summary.message;
         break;
       }
-      experiments[e].measured_rad = runs[e].angles_rad;
+      experiments[e].measured = runs[e].simulated;
     }
   }
   if (info.message.empty()) {

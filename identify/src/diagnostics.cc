@@ -202,7 +202,7 @@ void DiagnoseLag(const Experiment& x, const Eigen::MatrixXd& sim, ExperimentDiag
          f + static_cast<std::size_t>(max_shift) < frames; ++f) {
       const std::size_t g = static_cast<std::size_t>(static_cast<long>(f) - s);
       for (Eigen::Index c = 0; c < sim.cols(); ++c) {
-        const double m = x.measured_rad(static_cast<Eigen::Index>(f), c);
+        const double m = x.measured(static_cast<Eigen::Index>(f), c);
         const double v = sim(static_cast<Eigen::Index>(g), c);
         if (!std::isfinite(m) || !std::isfinite(v)) continue;
         sq += (m - v) * (m - v);
@@ -226,7 +226,7 @@ Series ChannelSeries(const Experiment& x, const Eigen::MatrixXd& sim, int j, int
   const Eigen::Index col = 2 * j + a;
   Series s;
   for (std::size_t f = 0; f < x.sample_time_s.size(); ++f) {
-    const double m = x.measured_rad(static_cast<Eigen::Index>(f), col);
+    const double m = x.measured(static_cast<Eigen::Index>(f), col);
     const double v = sim(static_cast<Eigen::Index>(f), col);
     if (!std::isfinite(m) || !std::isfinite(v)) continue;
     double heading = 0.0;

@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
+
+#include <Eigen/Geometry>
 
 #include "ccsrm/common/autocorrelation.h"
 #include "ccsrm/common/error.h"
@@ -36,7 +39,7 @@ std::optional<mocap::ZeroLagNoiseGain> LowPassNoiseGain(const Experiment& e) {
 
 // e->relative_noise from `gain` (null: no low-pass, 1 everywhere).
 void FillRelativeNoise(mocap::ZeroLagNoiseGain* gain, Experiment* e) {
-  const Eigen::MatrixXd& measured = e->measured_rad;
+  const Eigen::MatrixXd& measured = e->measured;
   e->relative_noise = Eigen::MatrixXd::Ones(measured.rows(), measured.cols());
   if (gain == nullptr) return;
   for (Eigen::Index c = 0; c < measured.cols(); ++c) {
@@ -91,6 +94,10 @@ bool ExperimentLoadOptions::IsValid(std::string* error) const {
     *error = "min_noise_deg must be > 0";
     return false;
   }
+  if (!(point_noise_mm > 0.0 && std::isfinite(point_noise_mm))) {
+    *error = "point_noise_mm must be > 0";
+    return false;
+  }
   return true;
 }
 
@@ -143,12 +150,10 @@ void SetInputs(const datasets::ExperimentFile& file, const std::string& path, Ex
   e->inputs = std::make_shared<sim::CableInputs>(std::move(time), std::move(length));
 }
 
-// The measured frames the simulation can reach (from the first input sample
-// on). Returns the index of the first.
-std::size_t SetMeasuredFrames(const datasets::ExperimentFile& file, const std::string& path,
-                              Experiment* e) {
-  CCSRM_CHECK(file.measured_joint_angles.has_value());
-  const datasets::Array& measured = *file.measured_joint_angles;  // F × J × 2 (checked)
+// The mocap frames the simulation can reach (from the first input sample
+// on), into e's frame and sample times. Returns the index of the first.
+std::size_t SetFrames(const datasets::ExperimentFile& file, const std::string& path,
+                      Experiment* e) {
   std::size_t first = 0;
   while (first < file.mocap_time.rows() && file.mocap_time.at(first) < e->start_time_s) ++first;
   const std::size_t frames = file.mocap_time.rows() - first;
@@ -157,16 +162,27 @@ std::size_t SetMeasuredFrames(const datasets::ExperimentFile& file, const std::s
                     "has fewer than 2 frames at or after the first input sample (t = " +
                         std::to_string(e->start_time_s) + " s): nothing to simulate");
   }
-  const std::size_t joints = static_cast<std::size_t>(e->joints);
-  e->measured_rad.resize(static_cast<Eigen::Index>(frames), 2 * e->joints);
   for (std::size_t f = 0; f < frames; ++f) {
     const double t = file.mocap_time.at(first + f);
     e->frame_time_s.push_back(t);
     e->sample_time_s.push_back(t - e->start_time_s);
+  }
+  return first;
+}
+
+// The measured joint angles from frame `first` on.
+void SetMeasuredAngles(const datasets::ExperimentFile& file, const std::string& path,
+                       std::size_t first, Experiment* e) {
+  CCSRM_CHECK(file.measured_joint_angles.has_value());
+  const datasets::Array& measured = *file.measured_joint_angles;  // F × J × 2 (checked)
+  const std::size_t joints = static_cast<std::size_t>(e->joints);
+  const std::size_t frames = e->frame_time_s.size();
+  e->measured.resize(static_cast<Eigen::Index>(frames), 2 * e->joints);
+  for (std::size_t f = 0; f < frames; ++f) {
     for (std::size_t j = 0; j < joints; ++j) {
       for (std::size_t a = 0; a < 2; ++a) {
         const double v = measured.values[((first + f) * joints + j) * 2 + a];
-        e->measured_rad(static_cast<Eigen::Index>(f), static_cast<Eigen::Index>(2 * j + a)) = v;
+        e->measured(static_cast<Eigen::Index>(f), static_cast<Eigen::Index>(2 * j + a)) = v;
         if (std::isfinite(v)) ++e->measured_samples;
       }
     }
@@ -175,7 +191,74 @@ std::size_t SetMeasuredFrames(const datasets::ExperimentFile& file, const std::s
     ThrowInputError(path, "/measured/joint_angles",
                     "has no finite angle after t = " + std::to_string(e->start_time_s) + " s");
   }
-  return first;
+}
+
+// A file whose markers cannot give link poses (a body with fewer than the
+// three markers a pose needs, as a pose log's one tip marker) and that
+// holds no measured angles is compared in its markers' positions.
+bool TracksPoints(const datasets::ExperimentFile& file) {
+  if (file.measured_joint_angles || file.rigid_bodies.empty()) return false;
+  return std::any_of(file.rigid_bodies.begin(), file.rigid_bodies.end(),
+                     [](const datasets::RigidBody& b) { return b.marker_names.size() < 3; });
+}
+
+// Every marker of every rigid body as a tracked point, its positions from
+// frame `first` on.
+void SetTrackedPoints(const datasets::ExperimentFile& file, const std::string& path,
+                      std::size_t first, Experiment* e) {
+  const int links = e->model->num_links();
+  std::vector<std::size_t> marker_column;
+  for (const datasets::RigidBody& body : file.rigid_bodies) {
+    const std::string field = "/mocap/rigid_bodies/" + body.name;
+    int link = -1;
+    if (body.name == "base") {
+      link = 0;
+    } else if (body.name.rfind("link", 0) == 0 && body.name.size() > 4 &&
+               body.name.find_first_not_of("0123456789", 4) == std::string::npos) {
+      link = std::stoi(body.name.substr(4));
+    }
+    if (link < 0 || link > links) {
+      ThrowInputError(
+          path, field,
+          "names no body of the arm ('base' or 'link1' to 'link" + std::to_string(links) + "')");
+    }
+    for (std::size_t m = 0; m < body.marker_names.size(); ++m) {
+      const auto it =
+          std::find(file.marker_names.begin(), file.marker_names.end(), body.marker_names[m]);
+      CCSRM_CHECK(it != file.marker_names.end());  // the file's own check
+      marker_column.push_back(static_cast<std::size_t>(it - file.marker_names.begin()));
+      e->tracked_points.push_back(
+          {body.marker_names[m], link,
+           Eigen::Vector3d(body.local_position.at(m, 0), body.local_position.at(m, 1),
+                           body.local_position.at(m, 2))});
+    }
+  }
+  const std::size_t frames = e->frame_time_s.size();
+  const std::size_t markers = file.marker_names.size();
+  const Eigen::Index angles = 2 * e->joints;
+  e->measured = Eigen::MatrixXd::Constant(
+      static_cast<Eigen::Index>(frames),
+      angles + 3 * static_cast<Eigen::Index>(e->tracked_points.size()), kNaN);
+  for (std::size_t f = 0; f < frames; ++f) {
+    for (std::size_t p = 0; p < marker_column.size(); ++p) {
+      const double* xyz =
+          &file.mocap_markers.values[((first + f) * markers + marker_column[p]) * 3];
+      if (!(std::isfinite(xyz[0]) && std::isfinite(xyz[1]) && std::isfinite(xyz[2]))) continue;
+      for (Eigen::Index c = 0; c < 3; ++c) {
+        e->measured(static_cast<Eigen::Index>(f), angles + 3 * static_cast<Eigen::Index>(p) + c) =
+            xyz[c];
+      }
+      e->measured_samples += 3;
+    }
+  }
+  if (e->measured_samples == 0) {
+    ThrowInputError(
+        path, "/mocap/markers",
+        "has no finite tracked point after t = " + std::to_string(e->start_time_s) + " s");
+  }
+  e->point_placement = file.marker_frame == datasets::MarkerFrame::kCapture
+                           ? PointPlacement::kFittedRigidMotion
+                           : PointPlacement::kWorld;
 }
 
 // The low-pass the pipeline applied, when the file records it.
@@ -259,7 +342,8 @@ Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::s
   std::optional<sim_io::ExperimentArm> arm =
       sim_io::CheckExperimentAgainstConfig(*input, path, given ? &*given : nullptr);
   std::optional<mocap::ProcessedRecording> processed;
-  if (!input->measured_joint_angles) {
+  const bool tracks_points = TracksPoints(*input);
+  if (!input->measured_joint_angles && !tracks_points) {
     processed = mocap::AddMeasuredJointAngles(*input, path, {}, arm ? arm->model : nullptr);
     arm = sim_io::CheckExperimentAgainstConfig(processed->experiment, path, arm ? &*arm : nullptr);
   }
@@ -282,7 +366,12 @@ Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::s
       ThrowInputError(path, "attribute 'motion'", "settled_poses: the replay " + why);
   }
   SetInputs(file, path, &e);
-  const std::size_t first = SetMeasuredFrames(file, path, &e);
+  const std::size_t first = SetFrames(file, path, &e);
+  if (tracks_points) {
+    SetTrackedPoints(file, path, first, &e);
+  } else {
+    SetMeasuredAngles(file, path, first, &e);
+  }
   if (processed) {
     e.angles_from_pipeline = true;
     e.pipeline_report = processed->result.summary.BriefReport();
@@ -291,25 +380,110 @@ Experiment MakeExperiment(const datasets::ExperimentFile& recorded, const std::s
   std::optional<mocap::ZeroLagNoiseGain> gain = LowPassNoiseGain(e);
   FillRelativeNoise(gain ? &*gain : nullptr, &e);
   SetNoise(file, first, options, gain ? &*gain : nullptr, &e);
+  e.point_noise_mm = options.point_noise_mm;
+  if (tracks_points) {
+    char noise[96];
+    std::snprintf(noise, sizeof noise, "tracked points, %.3g mm per coordinate", e.point_noise_mm);
+    e.noise_source = noise;
+  }
   return e;
 }
 
 void Experiment::AsMeasured(Eigen::MatrixXd* angles_rad) const {
-  CCSRM_CHECK(angles_rad->rows() == measured_rad.rows() &&
-              angles_rad->cols() == measured_rad.cols());
-  for (Eigen::Index c = 0; c < measured_rad.cols(); ++c) {
-    for (Eigen::Index f = 0; f < measured_rad.rows(); ++f) {
-      if (!std::isfinite(measured_rad(f, c))) (*angles_rad)(f, c) = kNaN;
+  CCSRM_CHECK(angles_rad->rows() == measured.rows() && angles_rad->cols() == measured.cols());
+  for (Eigen::Index c = 0; c < measured.cols(); ++c) {
+    for (Eigen::Index f = 0; f < measured.rows(); ++f) {
+      if (!std::isfinite(measured(f, c))) (*angles_rad)(f, c) = kNaN;
     }
   }
   if (!low_pass) return;
   const std::vector<mocap::BiquadSection> sections =
       mocap::DesignButterworthLowPass(low_pass->order, low_pass->cutoff_hz, low_pass->rate_hz);
-  for (Eigen::Index c = 0; c < angles_rad->cols(); ++c) {
+  for (Eigen::Index c = 0; c < 2 * joints; ++c) {
     mocap::ZeroLagLowPass(sections, low_pass->cutoff_hz, low_pass->rate_hz,
                           angles_rad->col(c).data(), static_cast<std::size_t>(angles_rad->rows()),
                           1, static_cast<std::size_t>(low_pass->min_run_frames));
   }
+}
+
+RigidPlacement RecordTrackedPoints(const Experiment& e, const sim::Trajectory& trajectory,
+                                   Eigen::MatrixXd* simulated) {
+  const Eigen::Index angles = 2 * e.joints;
+  const Eigen::Index points = static_cast<Eigen::Index>(e.tracked_points.size());
+  CCSRM_CHECK(simulated->cols() == angles + 3 * points);
+  const std::size_t frames =
+      std::min(trajectory.size(), static_cast<std::size_t>(simulated->rows()));
+  for (std::size_t f = 0; f < frames; ++f) {
+    const sim::TrajectoryFrame& frame = trajectory.frames[f];
+    for (Eigen::Index p = 0; p < points; ++p) {
+      const TrackedPoint& point = e.tracked_points[static_cast<std::size_t>(p)];
+      Eigen::Vector3d p_WP = point.position_B_m;  // the base's frame is W
+      if (point.link > 0) {
+        const Eigen::Matrix<double, 7, 1>& pose =
+            frame.link_pose[static_cast<std::size_t>(point.link - 1)];
+        const Eigen::Quaterniond q_WB(pose[3], pose[4], pose[5], pose[6]);
+        p_WP = pose.head<3>() + q_WB.normalized() * point.position_B_m;
+      }
+      simulated->block<1, 3>(static_cast<Eigen::Index>(f), angles + 3 * p) = p_WP.transpose();
+    }
+  }
+  RigidPlacement placement;
+  if (e.point_placement != PointPlacement::kFittedRigidMotion) return placement;
+  // Umeyama's closed form over every (frame, point) both have.
+  std::vector<Eigen::Vector3d> from, to;
+  for (std::size_t f = 0; f < frames; ++f) {
+    const Eigen::Index row = static_cast<Eigen::Index>(f);
+    for (Eigen::Index p = 0; p < points; ++p) {
+      const Eigen::Vector3d s = simulated->block<1, 3>(row, angles + 3 * p).transpose();
+      const Eigen::Vector3d m = e.measured.block<1, 3>(row, angles + 3 * p).transpose();
+      if (s.allFinite() && m.allFinite()) from.push_back(s), to.push_back(m);
+    }
+  }
+  if (from.size() < 3) return placement;
+  Eigen::Matrix3Xd src(3, static_cast<Eigen::Index>(from.size())), dst(3, src.cols());
+  for (std::size_t k = 0; k < from.size(); ++k) {
+    src.col(static_cast<Eigen::Index>(k)) = from[k];
+    dst.col(static_cast<Eigen::Index>(k)) = to[k];
+  }
+  const Eigen::Matrix4d X_CW = Eigen::umeyama(src, dst, /*with_scaling=*/false);
+  placement.R_CW = X_CW.topLeftCorner<3, 3>();
+  placement.p_CW_m = X_CW.topRightCorner<3, 1>();
+  for (std::size_t f = 0; f < frames; ++f) {
+    for (Eigen::Index p = 0; p < points; ++p) {
+      auto xyz = simulated->block<1, 3>(static_cast<Eigen::Index>(f), angles + 3 * p);
+      xyz = (placement.R_CW * xyz.transpose() + placement.p_CW_m).transpose();
+    }
+  }
+  return placement;
+}
+
+TrackedPointErrors PointErrors(const Experiment& e, const Eigen::MatrixXd& simulated) {
+  CCSRM_CHECK(simulated.rows() == e.measured.rows() && simulated.cols() == e.measured.cols());
+  TrackedPointErrors out;
+  const Eigen::Index angles = 2 * e.joints;
+  for (std::size_t p = 0; p < e.tracked_points.size(); ++p) {
+    const Eigen::Index c = angles + 3 * static_cast<Eigen::Index>(p);
+    std::vector<Eigen::Vector3d> d;
+    for (Eigen::Index f = 0; f < e.measured.rows(); ++f) {
+      const Eigen::Vector3d diff =
+          (simulated.block<1, 3>(f, c) - e.measured.block<1, 3>(f, c)).transpose() * 1e3;
+      if (diff.allFinite()) d.push_back(diff);
+    }
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& v : d) mean += v;
+    if (!d.empty()) mean /= static_cast<double>(d.size());
+    double sum = 0.0, sum_removed = 0.0;
+    for (const Eigen::Vector3d& v : d) {
+      sum += v.squaredNorm();
+      sum_removed += (v - mean).squaredNorm();
+    }
+    const double n = static_cast<double>(d.size());
+    out.rms_mm.push_back(d.empty() ? kNaN : std::sqrt(sum / n));
+    out.rms_mean_removed_mm.push_back(d.empty() ? kNaN : std::sqrt(sum_removed / n));
+    out.mean_offset_mm.push_back(mean);
+    out.frames.push_back(d.size());
+  }
+  return out;
 }
 
 void SetRelativeNoise(Experiment* e) {

@@ -1,4 +1,5 @@
 // The identification summary as text, JSON and a fit directory.
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -37,6 +38,69 @@ nlohmann::json ChannelJson(const ChannelErrors& e) {
           {"axes", {"theta_x", "theta_y"}}};
 }
 
+nlohmann::json PointsJson(const TrackedPointErrors& e, const std::vector<TrackedPoint>& points) {
+  nlohmann::json out = nlohmann::json::array();
+  for (std::size_t p = 0; p < e.rms_mm.size(); ++p) {
+    out.push_back({{"point", points[p].name},
+                   {"rms_mm", Number(e.rms_mm[p])},
+                   {"rms_mean_offset_removed_mm", Number(e.rms_mean_removed_mm[p])},
+                   {"mean_offset_mm",
+                    {Number(e.mean_offset_mm[p].x()), Number(e.mean_offset_mm[p].y()),
+                     Number(e.mean_offset_mm[p].z())}},
+                   {"frames", e.frames[p]}});
+  }
+  return out;
+}
+
+// "tip: RMS 3.2 -> 1.1 mm (mean offset removed: 1.1 mm), 79 frames".
+std::string PointsLine(const TrackedPointErrors& start, const TrackedPointErrors& fitted,
+                       const std::vector<TrackedPoint>& points) {
+  std::string out;
+  for (std::size_t p = 0; p < fitted.rms_mm.size(); ++p) {
+    out += Format("    %s: RMS %s -> %s mm (mean offset removed: %s mm), %zu frames\n",
+                  points[p].name.c_str(),
+                  Cell("%.3f", p < start.rms_mm.size() ? start.rms_mm[p] : NAN).c_str(),
+                  Cell("%.3f", fitted.rms_mm[p]).c_str(),
+                  Cell("%.3f", fitted.rms_mean_removed_mm[p]).c_str(), fitted.frames[p]);
+  }
+  return out;
+}
+
+// The capture frame's placement as a rotation angle about an axis and an offset.
+nlohmann::json PlacementJson(const RigidPlacement& x) {
+  const Eigen::AngleAxisd r(x.R_CW);
+  return {{"rotation_deg", r.angle() * 180.0 / M_PI},
+          {"rotation_axis", {r.axis().x(), r.axis().y(), r.axis().z()}},
+          {"offset_mm", {x.p_CW_m.x() * 1e3, x.p_CW_m.y() * 1e3, x.p_CW_m.z() * 1e3}}};
+}
+
+// The per-joint table of RMS, motion and fit.
+std::string JointTable(const ChannelErrors& errors) {
+  std::ostringstream out;
+  out << "\n  joint   RMS θx [deg]   RMS θy [deg]   motion θx [deg]  motion θy [deg]  fit θx [%]   "
+         "fit θy [%]\n";
+  bool barely_moves = false;
+  for (std::size_t j = 0; j < errors.rms_deg.size(); ++j) {
+    char line[256];
+    std::snprintf(line, sizeof(line), "  %5zu   %-14s %-14s %-16s %-16s %-12s %s\n", j + 1,
+                  Cell("%.4f", errors.rms_deg[j][0]).c_str(),
+                  Cell("%.4f", errors.rms_deg[j][1]).c_str(),
+                  Cell("%.4f", errors.motion_rms_deg[j][0]).c_str(),
+                  Cell("%.4f", errors.motion_rms_deg[j][1]).c_str(),
+                  Cell("%.1f", errors.fit_percent[j][0]).c_str(),
+                  Cell("%.1f", errors.fit_percent[j][1]).c_str());
+    out << line;
+    for (int a = 0; a < 2; ++a)
+      barely_moves = barely_moves || !std::isfinite(errors.fit_percent[j][a]);
+  }
+  if (barely_moves) {
+    out << "  fit -: the axis barely moves (its motion, RMS about its mean, is under a tenth of "
+           "the "
+           "joint's larger or three times its noise); read its RMS error against its motion\n";
+  }
+  return out.str();
+}
+
 }  // namespace
 
 std::string UnidentifiableDirection::Describe() const {
@@ -60,20 +124,36 @@ std::string IdentificationSummary::BriefReport() const {
       rough += (rough.empty() ? "" : ", ") + p.name;
     }
   }
+  // Tracked points: the first experiment's first point, as the tip.
+  std::string points;
+  for (const ExperimentFit& e : experiments) {
+    if (e.fitted_points.rms_mm.empty()) continue;
+    points =
+        Format("%s RMS %s -> %s mm (mean offset removed %s mm)", e.points[0].name.c_str(),
+               Cell("%.3f", e.start_points.rms_mm.empty() ? NAN : e.start_points.rms_mm[0]).c_str(),
+               Cell("%.3f", e.fitted_points.rms_mm[0]).c_str(),
+               Cell("%.3f", e.fitted_points.rms_mean_removed_mm[0]).c_str());
+    break;
+  }
   char text[512];
   std::snprintf(text, sizeof(text),
                 "identification %s after %d iterations (%lld simulations, %d threads, %.1f s): "
-                "RMS %s -> %s deg, fit %s %%%s",
+                "%s%s",
                 TerminationName(termination), iterations, static_cast<long long>(simulations),
-                threads, wall_time_s, Cell("%.4f", start_errors.rms_deg_overall).c_str(),
-                Cell("%.4f", errors.rms_deg_overall).c_str(),
-                Cell("%.1f", errors.fit_percent_overall).c_str(),
+                threads, wall_time_s,
+                !points.empty() && !std::isfinite(errors.rms_deg_overall)
+                    ? points.c_str()
+                    : Format("RMS %s -> %s deg, fit %s %%",
+                             Cell("%.4f", start_errors.rms_deg_overall).c_str(),
+                             Cell("%.4f", errors.rms_deg_overall).c_str(),
+                             Cell("%.1f", errors.fit_percent_overall).c_str())
+                          .c_str(),
                 !adequacy.assessed ? ""
                 : adequacy.adequate()
                     ? "; the model explains the data"
-                    : Format("; the model does NOT explain the data (%zu joint axes above their "
-                             "noise)",
-                             adequacy.above_noise.size())
+                    : Format("; the model does NOT explain the data (%zu %s above their noise)",
+                             adequacy.above_noise.size(),
+                             adequacy.point_channels > 0 ? "measured axes" : "joint axes")
                           .c_str());
   if (!rough.empty()) return text + ("; derivatives NOT smooth in " + rough);
   return text;
@@ -176,29 +256,23 @@ std::string IdentificationSummary::FullReport() const {
           << Cell("%.3g", d.relative_std_error) << ")\n";
     }
   }
-  out << "\n  joint   RMS θx [deg]   RMS θy [deg]   motion θx [deg]  motion θy [deg]  fit θx [%]   "
-         "fit θy [%]\n";
-  bool barely_moves = false;
-  for (std::size_t j = 0; j < errors.rms_deg.size(); ++j) {
-    char line[256];
-    std::snprintf(line, sizeof(line), "  %5zu   %-14s %-14s %-16s %-16s %-12s %s\n", j + 1,
-                  Cell("%.4f", errors.rms_deg[j][0]).c_str(),
-                  Cell("%.4f", errors.rms_deg[j][1]).c_str(),
-                  Cell("%.4f", errors.motion_rms_deg[j][0]).c_str(),
-                  Cell("%.4f", errors.motion_rms_deg[j][1]).c_str(),
-                  Cell("%.1f", errors.fit_percent[j][0]).c_str(),
-                  Cell("%.1f", errors.fit_percent[j][1]).c_str());
-    out << line;
-    for (int a = 0; a < 2; ++a)
-      barely_moves = barely_moves || !std::isfinite(errors.fit_percent[j][a]);
-  }
-  if (barely_moves) {
-    out << "  fit -: the axis barely moves (its motion, RMS about its mean, is under a tenth of "
-           "the "
-           "joint's larger or three times its noise); read its RMS error against its motion\n";
-  }
+  if (std::isfinite(errors.rms_deg_overall)) out << JointTable(errors);
   out << "\n";
   for (const ExperimentFit& e : experiments) {
+    if (!e.fitted_points.rms_mm.empty()) {
+      out << "  " << e.name << ": " << e.noise_source << "\n";
+      out << PointsLine(e.start_points, e.fitted_points, e.points);
+      if (e.placed_in_capture_frame) {
+        const Eigen::AngleAxisd r(e.placement.R_CW);
+        out << Format(
+            "    capture frame placed by the best rigid motion: %.3f deg about (%.3f, "
+            "%.3f, %.3f), offset (%.2f, %.2f, %.2f) mm\n",
+            r.angle() * 180.0 / M_PI, r.axis().x(), r.axis().y(), r.axis().z(),
+            e.placement.p_CW_m.x() * 1e3, e.placement.p_CW_m.y() * 1e3,
+            e.placement.p_CW_m.z() * 1e3);
+      }
+      continue;
+    }
     char line[512];
     double noise = 0.0;
     for (double s : e.noise_deg) noise += s / static_cast<double>(e.noise_deg.size());
@@ -251,18 +325,26 @@ nlohmann::json ToJson(const IdentificationSummary& s) {
   }
   nlohmann::json experiments = nlohmann::json::array();
   for (const ExperimentFit& e : s.experiments) {
-    experiments.push_back({{"name", e.name},
-                           {"path", e.path},
-                           {"angles_from_pipeline", e.angles_from_pipeline},
-                           {"noise_deg", e.noise_deg},
-                           {"noise_source", e.noise_source},
-                           {"start", ChannelJson(e.start)},
-                           {"fitted", ChannelJson(e.fitted)},
-                           {"run",
-                            {{"status", e.run.summary.completed() ? "completed" : "failed"},
-                             {"message", e.run.summary.message},
-                             {"wall_time_s", e.run.summary.wall_time_s},
-                             {"real_time_factor", e.run.summary.real_time_factor}}}});
+    experiments.push_back(
+        {{"name", e.name},
+         {"path", e.path},
+         {"angles_from_pipeline", e.angles_from_pipeline},
+         {"noise_deg", e.noise_deg},
+         {"noise_source", e.noise_source},
+         {"start", ChannelJson(e.start)},
+         {"fitted", ChannelJson(e.fitted)},
+         {"tracked_points",
+          e.points.empty() ? nlohmann::json(nullptr)
+                           : nlohmann::json{{"start", PointsJson(e.start_points, e.points)},
+                                            {"fitted", PointsJson(e.fitted_points, e.points)},
+                                            {"capture_placement", e.placed_in_capture_frame
+                                                                      ? PlacementJson(e.placement)
+                                                                      : nlohmann::json(nullptr)}}},
+         {"run",
+          {{"status", e.run.summary.completed() ? "completed" : "failed"},
+           {"message", e.run.summary.message},
+           {"wall_time_s", e.run.summary.wall_time_s},
+           {"real_time_factor", e.run.summary.real_time_factor}}}});
   }
   nlohmann::json arm = nullptr;
   if (!s.experiments.empty()) {
@@ -318,8 +400,8 @@ std::vector<std::string> WriteFitDirectory(const IdentificationSummary& summary,
   for (std::size_t e = 0; e < experiments.size(); ++e) {
     const ExperimentFit& fit = summary.experiments[e];
     internal::WriteRecordingOutputs(experiments[e], fit.name, fit.run, fit.parameters,
-                                    fit.simulated_rad, "fitted", stems[e], ".fit.h5",
-                                    out.temp_path(), directory, &json["experiments"][e], &written);
+                                    fit.simulated, "fitted", stems[e], ".fit.h5", out.temp_path(),
+                                    directory, &json["experiments"][e], &written);
   }
   WriteTextFileAtomically((tmp / "fit.json").string(), json.dump(2) + "\n");
   written.insert(written.begin(), (fs::path(directory) / "fit.json").string());

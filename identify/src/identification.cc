@@ -44,7 +44,7 @@ struct ResidualIndex {
 // The simulated angles of every experiment at one point of u.
 struct Evaluation {
   std::vector<double> u;
-  std::vector<Eigen::MatrixXd> angles_rad;  // per experiment
+  std::vector<Eigen::MatrixXd> simulated;  // per experiment, laid out as Experiment::measured
   std::vector<sim::SimulationSummary> summaries;
   // Per free parameter of a measurement effect (others: empty), per
   // difference-plan trial, per experiment: the base runs recorded at the
@@ -59,7 +59,7 @@ struct Evaluation {
 struct DifferenceRun {
   std::size_t experiment = 0;
   std::vector<double> values;
-  Eigen::MatrixXd angles_rad;
+  Eigen::MatrixXd simulated;
 };
 
 class FitProblem {
@@ -74,9 +74,9 @@ class FitProblem {
         backend_(backend) {
     for (std::size_t e = 0; e < experiments_.size(); ++e) {
       const Experiment& x = experiments_[e];
-      for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
-        for (Eigen::Index c = 0; c < x.measured_rad.cols(); ++c) {
-          if (std::isfinite(x.measured_rad(f, c))) {
+      for (Eigen::Index f = 0; f < x.measured.rows(); ++f) {
+        for (Eigen::Index c = 0; c < x.measured.cols(); ++c) {
+          if (std::isfinite(x.measured(f, c))) {
             index_.push_back({static_cast<std::uint32_t>(e), static_cast<std::uint32_t>(f),
                               static_cast<std::uint16_t>(c)});
           }
@@ -86,6 +86,17 @@ class FitProblem {
   }
 
   std::size_t num_residuals() const { return index_.size(); }
+  // The parameters each run fits in closed form rather than the minimiser:
+  // a rotation and an offset per experiment placed in the capture frame.
+  std::size_t EliminatedParameters() const {
+    std::size_t n = 0;
+    for (const Experiment& x : experiments_) {
+      if (!x.tracked_points.empty() && x.point_placement == PointPlacement::kFittedRigidMotion) {
+        n += 6;
+      }
+    }
+    return n;
+  }
   std::size_t num_free() const { return free_.size(); }
   const std::vector<ResidualIndex>& index() const { return index_; }
   const std::vector<FreeParameter>& free() const { return free_; }
@@ -143,7 +154,7 @@ class FitProblem {
         if (!free_[i].measurement) continue;
         for (int t = 0; t < 2; ++t) {
           ev.measurement_trials[i][static_cast<std::size_t>(t)].push_back(
-              std::move(results[e].variant_angles_rad[v++]));
+              std::move(results[e].variant_simulated[v++]));
         }
       }
     }
@@ -153,11 +164,11 @@ class FitProblem {
         ev.ok = false;
         ev.failure = experiments_[e].name + ": " + results[e].summary.message;
       }
-      ev.angles_rad.push_back(std::move(results[e].angles_rad));
+      ev.simulated.push_back(std::move(results[e].simulated));
       ev.summaries.push_back(results[e].summary);
       if (keep_trajectories) trajectories_.push_back(std::move(results[e].trajectory));
     }
-    if (ev.ok) ev.residuals = Residuals(ev.angles_rad);
+    if (ev.ok) ev.residuals = Residuals(ev.simulated);
     const std::lock_guard<std::mutex> lock(mutex_);
     cache_.push_back(std::move(ev));
     if (cache_.size() > 8) cache_.erase(cache_.begin());
@@ -251,7 +262,7 @@ class FitProblem {
               trial_runs_.begin(), trial_runs_.end(),
               [&](const DifferenceRun& t) { return t.experiment == e && t.values == q; });
           if (cached != trial_runs_.end()) {
-            run.angles_rad = cached->angles_rad;
+            run.simulated = cached->simulated;
           } else {
             requests.push_back({e, ParametersAt(e, q), false, {}});
             request_of.push_back(runs.size());
@@ -270,7 +281,7 @@ class FitProblem {
                    experiments_[run.experiment].name + ": " + results[k].summary.message;
         return false;
       }
-      run.angles_rad = results[k].angles_rad;
+      run.simulated = results[k].simulated;
     }
     jacobian->resize(static_cast<Eigen::Index>(index_.size()),
                      static_cast<Eigen::Index>(free_.size()));
@@ -287,7 +298,7 @@ class FitProblem {
           continue;
         }
         std::vector<Eigen::MatrixXd> angles;
-        for (std::size_t e = 0; e < ne; ++e) angles.push_back(runs[next++].angles_rad);
+        for (std::size_t e = 0; e < ne; ++e) angles.push_back(runs[next++].simulated);
         r.push_back(Residuals(angles));
       }
       Eigen::VectorXd column;
@@ -326,23 +337,27 @@ class FitProblem {
     for (std::size_t k = 0; k < index_.size(); ++k) {
       const ResidualIndex& at = index_[k];
       const Experiment& x = experiments_[at.experiment];
-      const double sim = angles_rad[at.experiment](at.frame, at.column);
-      const double meas = x.measured_rad(at.frame, at.column);
-      r[static_cast<Eigen::Index>(k)] = (sim - meas) * kDeg / x.NoiseDeg(at.frame, at.column);
+      r[static_cast<Eigen::Index>(k)] =
+          x.WeightedResidual(at.frame, at.column, angles_rad[at.experiment](at.frame, at.column));
     }
     return r;
   }
 
-  // RMS of the unweighted residuals [deg].
-  double RmsDeg(const std::vector<Eigen::MatrixXd>& angles_rad) const {
+  // RMS of the unweighted residuals of the angles [deg], or of the tracked
+  // points' coordinates [mm] (`points`); NaN without any.
+  double Rms(const std::vector<Eigen::MatrixXd>& simulated, bool points) const {
     double sum = 0.0;
+    std::size_t n = 0;
     for (const ResidualIndex& at : index_) {
-      const double d = (angles_rad[at.experiment](at.frame, at.column) -
-                        experiments_[at.experiment].measured_rad(at.frame, at.column)) *
-                       kDeg;
+      const Experiment& x = experiments_[at.experiment];
+      if (x.IsPointColumn(at.column) != points) continue;
+      ++n;
+      const double d =
+          (simulated[at.experiment](at.frame, at.column) - x.measured(at.frame, at.column)) *
+          (points ? 1e3 : kDeg);
       sum += d * d;
     }
-    return std::sqrt(sum / static_cast<double>(std::max<std::size_t>(index_.size(), 1)));
+    return n > 0 ? std::sqrt(sum / static_cast<double>(n)) : kNaN;
   }
 
   // N_eff of weighted residuals laid out as index(): every (experiment,
@@ -352,7 +367,7 @@ class FitProblem {
     std::size_t k = 0;
     for (std::size_t e = 0; e < experiments_.size(); ++e) {
       std::vector<std::vector<double>> per_column(
-          static_cast<std::size_t>(2 * experiments_[e].joints));
+          static_cast<std::size_t>(experiments_[e].measured.cols()));
       for (; k < index_.size() && index_[k].experiment == e; ++k) {
         per_column[index_[k].column].push_back(residuals[static_cast<Eigen::Index>(k)]);
       }
@@ -369,10 +384,11 @@ class FitProblem {
     return std::nullopt;
   }
 
-  std::optional<double> CachedRmsDeg(const double* u) {
+  // Rms of the cached evaluation at u.
+  std::optional<double> CachedRms(const double* u, bool points) {
     const std::lock_guard<std::mutex> lock(mutex_);
     for (const Evaluation& e : cache_) {
-      if (e.ok && std::equal(e.u.begin(), e.u.end(), u)) return RmsDeg(e.angles_rad);
+      if (e.ok && std::equal(e.u.begin(), e.u.end(), u)) return Rms(e.simulated, points);
     }
     return std::nullopt;
   }
@@ -580,7 +596,8 @@ class IterationReporter final : public ceres::IterationCallback {
       IterationProgress p;
       p.iteration = iterations_before_ + s.iteration;
       p.cost = s.cost;
-      p.rms_deg = problem_->CachedRmsDeg(u_).value_or(kNaN);
+      p.rms_deg = problem_->CachedRms(u_, false).value_or(kNaN);
+      p.rms_mm = problem_->CachedRms(u_, true).value_or(kNaN);
       p.relative_decrease = s.iteration == 0 ? 0.0 : s.relative_decrease;
       p.trust_region_radius = s.trust_region_radius;
       p.step_accepted = s.step_is_successful;
@@ -649,7 +666,7 @@ ChannelErrors AngleErrors(const std::vector<const Experiment*>& experiments,
       const std::size_t aa = static_cast<std::size_t>(a);
       std::size_t n = 0;
       for (std::size_t e = 0; e < experiments.size(); ++e) {
-        const Eigen::MatrixXd& meas = experiments[e]->measured_rad;
+        const Eigen::MatrixXd& meas = experiments[e]->measured;
         if (experiments[e]->joints != joints) continue;
         // Each experiment's own mean: fit percent compares with a constant
         // per series, not a mean across experiments.
@@ -891,17 +908,16 @@ Evaluation EvaluateStart(FitProblem& problem, const std::vector<Experiment>& exp
   }
   for (std::size_t e = 0; e < experiments.size(); ++e) {
     const Eigen::MatrixXd& a = resume->start_angles_rad[e];
-    if (a.rows() != experiments[e].measured_rad.rows() ||
-        a.cols() != experiments[e].measured_rad.cols()) {
+    if (a.rows() != experiments[e].measured.rows() || a.cols() != experiments[e].measured.cols()) {
       ThrowInputError("identification", "resume",
                       "the checkpoint's runs do not match experiment " + experiments[e].name);
     }
   }
   Evaluation start;
   start.u = *u;
-  start.angles_rad = resume->start_angles_rad;
+  start.simulated = resume->start_angles_rad;
   start.summaries.resize(experiments.size());
-  start.residuals = problem.Residuals(start.angles_rad);
+  start.residuals = problem.Residuals(start.simulated);
   start.ok = true;
   *u = resume->u;
   return start;
@@ -948,7 +964,7 @@ std::int64_t Minimise(FitProblem& problem, ceres::Problem& ceres_problem,
     checkpoint = *resume;
     summary->cost_history = resume->cost_history;
   } else {
-    checkpoint.start_angles_rad = start_eval.angles_rad;
+    checkpoint.start_angles_rad = start_eval.simulated;
     checkpoint.min_lm_diagonal = solver.min_lm_diagonal;
     checkpoint.jacobi_scaling = solver.jacobi_scaling;
   }
@@ -1022,9 +1038,9 @@ Uncertainty UncertaintyAt(FitProblem& problem, ceres::Problem& ceres_problem,
   std::vector<bool>& identifiable = out.identifiable;
   summary->effective_samples = problem.EffectiveSamples(final_eval.residuals);
   const double n = static_cast<double>(summary->residuals);
-  summary->residual_variance = n > static_cast<double>(p_count)
-                                   ? 2.0 * summary->final_cost / (n - static_cast<double>(p_count))
-                                   : kNaN;
+  // The placements eliminated from the fit use up degrees of freedom too.
+  const double fitted = static_cast<double>(p_count + problem.EliminatedParameters());
+  summary->residual_variance = n > fitted ? 2.0 * summary->final_cost / (n - fitted) : kNaN;
   const double inflation = summary->effective_samples > 0.0 ? n / summary->effective_samples : 1.0;
   const double variance_factor = summary->residual_variance * inflation;
 
@@ -1197,18 +1213,29 @@ void TabulateErrors(const std::vector<Experiment>& experiments, const FitProblem
     fit.angles_from_pipeline = experiments[e].angles_from_pipeline;
     fit.noise_deg = experiments[e].noise_deg;
     fit.noise_source = experiments[e].noise_source;
-    if (start_eval.ok || !start_eval.angles_rad.empty()) {
-      fit.start = AngleErrors({&experiments[e]}, {&start_eval.angles_rad[e]});
+    if (start_eval.ok || !start_eval.simulated.empty()) {
+      fit.start = AngleErrors({&experiments[e]}, {&start_eval.simulated[e]});
     }
-    fit.fitted = AngleErrors({&experiments[e]}, {&final_eval.angles_rad[e]});
+    fit.fitted = AngleErrors({&experiments[e]}, {&final_eval.simulated[e]});
     fit.run.summary = final_eval.summaries[e];
     if (e < trajectories.size()) fit.run.trajectory = std::move(trajectories[e]);
+    if (!experiments[e].tracked_points.empty()) {
+      fit.points = experiments[e].tracked_points;
+      fit.placed_in_capture_frame =
+          experiments[e].point_placement == PointPlacement::kFittedRigidMotion;
+      if (!start_eval.simulated.empty()) {
+        fit.start_points = PointErrors(experiments[e], start_eval.simulated[e]);
+      }
+      fit.fitted_points = PointErrors(experiments[e], final_eval.simulated[e]);
+      Eigen::MatrixXd placed = final_eval.simulated[e];
+      fit.placement = RecordTrackedPoints(experiments[e], fit.run.trajectory, &placed);
+    }
     fit.parameters = problem.ParametersAt(e, p_final);
-    fit.simulated_rad = final_eval.angles_rad[e];
+    fit.simulated = final_eval.simulated[e];
     summary->experiments.push_back(std::move(fit));
     all.push_back(&experiments[e]);
-    start_angles.push_back(&start_eval.angles_rad[e]);
-    final_angles.push_back(&final_eval.angles_rad[e]);
+    start_angles.push_back(&start_eval.simulated[e]);
+    final_angles.push_back(&final_eval.simulated[e]);
   }
   summary->start_errors = AngleErrors(all, start_angles);
   summary->errors = AngleErrors(all, final_angles);

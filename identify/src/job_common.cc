@@ -130,6 +130,18 @@ std::vector<Experiment> LoadExperiments(const std::vector<std::string>& paths,
     const Experiment& e = experiments.back();
     if (!line) continue;
     if (e.angles_from_pipeline) line("mocap " + path + ": " + e.pipeline_report + "\n");
+    if (!e.tracked_points.empty()) {
+      line(
+          Format("%s %s (%s): %zu frames, %.4g s, %zu measured coordinates of %zu tracked "
+                 "point%s, noise %.3g mm%s\n",
+                 role, e.name.c_str(), path.c_str(), e.frame_time_s.size(), e.duration_s(),
+                 e.measured_samples, e.tracked_points.size(),
+                 e.tracked_points.size() == 1 ? "" : "s", e.point_noise_mm,
+                 e.point_placement == PointPlacement::kFittedRigidMotion
+                     ? " (in the capture frame: each run placed by its best rigid motion)"
+                     : ""));
+      continue;
+    }
     double noise = 0.0;
     for (double s : e.noise_deg) noise += s / static_cast<double>(e.noise_deg.size());
     line(Format("%s %s (%s): %zu frames, %.4g s, %zu measured angles, noise %.4f deg (%s)%s\n",

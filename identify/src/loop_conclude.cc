@@ -94,13 +94,13 @@ void FindUnexplained(LoopState* s) {
   summary.final_fit = current;
   summary.after = current.errors;
   summary.rms_after_deg = current.errors.rms_deg_overall;
-  summary.holdout_final_rad = current_holdout.angles_rad;
+  summary.holdout_final_rad = current_holdout.simulated;
   if (!holdout.empty()) {
     summary.holdout_rms_after_deg = current_holdout.rms_deg;
     summary.holdout_after = current_holdout.errors;
   }
   std::vector<Eigen::MatrixXd> fitted;
-  for (const ExperimentFit& f : current.experiments) fitted.push_back(f.simulated_rad);
+  for (const ExperimentFit& f : current.experiments) fitted.push_back(f.simulated);
   if (fitted.empty()) return;
   summary.final_evidence = DiagnoseResidual(training, fitted);
   std::vector<const Experiment*> recordings;

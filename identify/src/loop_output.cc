@@ -380,7 +380,7 @@ std::vector<std::string> WriteLoopDirectory(const LoopSummary& summary,
               ": held-out joint angles [deg]: measured, the declared model's and the final "
               "model's; empty where not measured",
           x.frame_time_s, x.joints,
-          {{"measured", degrees(x.measured_rad)},
+          {{"measured", degrees(x.measured)},
            {"declared", degrees(summary.holdout_declared_rad[e])},
            {"final", degrees(summary.holdout_final_rad[e])}});
       const std::string name = x.name.empty() ? "holdout" + std::to_string(e + 1) : x.name;

@@ -53,9 +53,8 @@ void SensitivityColumns(LoopState* s, RoundState* rs) {
         if (measurement) {
           // Recorded from the fitted run: no simulation.
           const ExperimentFit& f = current.experiments[e];
-          Eigen::MatrixXd a =
-              Eigen::MatrixXd::Constant(f.simulated_rad.rows(), f.simulated_rad.cols(),
-                                        std::numeric_limits<double>::quiet_NaN());
+          Eigen::MatrixXd a = Eigen::MatrixXd::Constant(f.simulated.rows(), f.simulated.cols(),
+                                                        std::numeric_limits<double>::quiet_NaN());
           for (std::size_t k = 0;
                k < f.run.trajectory.size() && static_cast<Eigen::Index>(k) < a.rows(); ++k) {
             const std::vector<Eigen::Vector2d> rec =
@@ -87,7 +86,7 @@ void SensitivityColumns(LoopState* s, RoundState* rs) {
         });
     s->simulations += static_cast<std::int64_t>(requests.size());
     for (std::size_t k = 0; k < results.size(); ++k) {
-      columns[request_column[k]].angles[requests[k].experiment] = std::move(results[k].angles_rad);
+      columns[request_column[k]].angles[requests[k].experiment] = std::move(results[k].simulated);
     }
   }
   for (const Eigen::MatrixXd& a : rs->fitted) rs->base_angles.push_back(&a);
@@ -152,7 +151,7 @@ bool GatherEvidence(LoopState* s, RoundState* rs) {
   lr.rms_deg = current.errors.rms_deg_overall;
   if (!holdout.empty()) lr.holdout_rms_deg = current_holdout.rms_deg;
   std::vector<Eigen::MatrixXd>& fitted = rs->fitted;
-  for (const ExperimentFit& f : current.experiments) fitted.push_back(f.simulated_rad);
+  for (const ExperimentFit& f : current.experiments) fitted.push_back(f.simulated);
   lr.evidence = DiagnoseResidual(training, fitted);
 
   // Not yet added; a block keeps the members not yet added.

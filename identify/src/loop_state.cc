@@ -49,10 +49,10 @@ Eigen::VectorXd Weighted(const std::vector<Experiment>& experiments,
   std::vector<double> out;
   for (std::size_t e = 0; e < experiments.size(); ++e) {
     const Experiment& x = experiments[e];
-    for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
-      for (Eigen::Index c = 0; c < x.measured_rad.cols(); ++c) {
-        if (!std::isfinite(x.measured_rad(f, c))) continue;
-        const double reference = difference_only ? (*base[e])(f, c) : x.measured_rad(f, c);
+    for (Eigen::Index f = 0; f < x.measured.rows(); ++f) {
+      for (Eigen::Index c = 0; c < x.measured.cols(); ++c) {
+        if (!std::isfinite(x.measured(f, c))) continue;
+        const double reference = difference_only ? (*base[e])(f, c) : x.measured(f, c);
         double v = ((*angles[e])(f, c) - reference) * kDeg / x.NoiseDeg(f, c);
         if (!std::isfinite(v)) v = 0.0;
         out.push_back(v);
@@ -124,18 +124,18 @@ HoldoutResult LoopState::RunHoldout(const std::map<std::string, double>& values)
   std::vector<const Experiment*> xs;
   for (std::size_t e = 0; e < holdout.size(); ++e) {
     h.ok = h.ok && results[e].summary.completed();
-    h.angles_rad.push_back(std::move(results[e].angles_rad));
+    h.simulated.push_back(std::move(results[e].simulated));
   }
   std::vector<const Eigen::MatrixXd*> angles;
   for (std::size_t e = 0; e < holdout.size(); ++e) {
     xs.push_back(&holdout[e]);
-    angles.push_back(&h.angles_rad[e]);
+    angles.push_back(&h.simulated[e]);
   }
   h.errors = AngleErrors(xs, angles);
   h.rms_deg = h.errors.rms_deg_overall;
   const Eigen::VectorXd r = Weighted(holdout, angles, false);
   h.mean_square = r.size() > 0 ? r.squaredNorm() / static_cast<double>(r.size()) : 0.0;
-  const ResidualDiagnostics d = DiagnoseResidual(holdout, h.angles_rad);
+  const ResidualDiagnostics d = DiagnoseResidual(holdout, h.simulated);
   h.effective_samples = d.effective_samples;
   return h;
 }
@@ -150,7 +150,7 @@ double LoopState::TrainingCost(const std::map<std::string, double>& values) {
   std::vector<const Eigen::MatrixXd*> angles;
   for (const RunResult& run : results) {
     if (!run.summary.completed()) return std::numeric_limits<double>::quiet_NaN();
-    angles.push_back(&run.angles_rad);
+    angles.push_back(&run.simulated);
   }
   return 0.5 * Weighted(training, angles, false).squaredNorm();
 }
@@ -235,7 +235,7 @@ void FitDeclaredModel(LoopState* s) {
   s->fixed = fit_options.values;
   for (const std::string& name : s->free) s->fixed.erase(name);
   s->current_holdout = s->RunHoldout(ValuesOf(s->current, s->fixed));
-  summary.holdout_declared_rad = s->current_holdout.angles_rad;
+  summary.holdout_declared_rad = s->current_holdout.simulated;
   summary.before = summary.declared.errors;
   summary.rms_before_deg = summary.declared.errors.rms_deg_overall;
   if (!holdout.empty()) {

@@ -37,7 +37,7 @@ inline constexpr const char* kTermsEffect = "joint_moment";
 
 // The held-out experiments at a fit's values.
 struct HoldoutResult {
-  std::vector<Eigen::MatrixXd> angles_rad;
+  std::vector<Eigen::MatrixXd> simulated;
   double rms_deg = 0.0;
   double mean_square = 0.0;  // weighted, per sample
   double effective_samples = 0.0;

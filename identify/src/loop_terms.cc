@@ -87,7 +87,7 @@ CandidateResult DiscoverTerms(LoopState* state, RoundState* rs) {
   bool complete = true;
   for (std::size_t k = 0; k < results.size(); ++k) {
     complete = complete && results[k].summary.completed();
-    angles[request_column[k]][requests[k].experiment] = std::move(results[k].angles_rad);
+    angles[request_column[k]][requests[k].experiment] = std::move(results[k].simulated);
   }
   if (!complete) {
     cand.reason = "a term's sensitivity run failed: no terms sought";

@@ -398,7 +398,7 @@ void PutFingerprint(const std::vector<const std::vector<Experiment>*>& sets, Pac
     out->Put<std::uint64_t>(set->size());
     for (const Experiment& e : *set) {
       out->PutString(e.name);
-      out->PutMatrix(e.measured_rad);
+      out->PutMatrix(e.measured);
     }
   }
 }

@@ -130,15 +130,15 @@ PredictionErrors ComputePredictionErrors(const std::vector<const Experiment*>& r
   std::size_t samples = 0;
   for (std::size_t e = 0; e < recordings.size(); ++e) {
     const Experiment& x = *recordings[e];
-    CCSRM_CHECK(x.joints == joints && predicted[e]->rows() == x.measured_rad.rows() &&
-                predicted[e]->cols() == x.measured_rad.cols());
+    CCSRM_CHECK(x.joints == joints && predicted[e]->rows() == x.measured.rows() &&
+                predicted[e]->cols() == x.measured.cols());
     for (int j = 0; j < joints; ++j) {
       const std::size_t jj = static_cast<std::size_t>(j);
       out.noise_deg[jj] += x.noise_deg[jj];
       ++counted[jj];
       for (int a = 0; a < 2; ++a) {
-        for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
-          const double m = x.measured_rad(f, 2 * j + a);
+        for (Eigen::Index f = 0; f < x.measured.rows(); ++f) {
+          const double m = x.measured(f, 2 * j + a);
           if (!std::isfinite(m)) continue;
           // A run that ended early leaves NaN: the error is then unknown.
           const double d = ((*predicted[e])(f, 2 * j + a) - m) * kDeg;
@@ -246,7 +246,7 @@ PredictionSummary Predict(const std::vector<Experiment>& recordings, const Predi
     r.parameters = parameters[e];
     r.run.summary = results[e].summary;
     r.run.trajectory = std::move(results[e].trajectory);
-    r.predicted_rad = std::move(results[e].angles_rad);
+    r.predicted_rad = std::move(results[e].simulated);
     if (!r.run.summary.completed() && summary.completed) {
       summary.completed = false;
       summary.message = x.name + ": " + r.run.summary.message;

@@ -97,17 +97,17 @@ RunRequest GetRequest(Unpacker* in) {
 
 void PutResult(const RunResult& r, Packer* out) {
   PutSummary(r.summary, out);
-  out->PutMatrix(r.angles_rad);
-  out->Put<std::uint64_t>(r.variant_angles_rad.size());
-  for (const Eigen::MatrixXd& v : r.variant_angles_rad) out->PutMatrix(v);
+  out->PutMatrix(r.simulated);
+  out->Put<std::uint64_t>(r.variant_simulated.size());
+  for (const Eigen::MatrixXd& v : r.variant_simulated) out->PutMatrix(v);
 }
 
 RunResult GetResult(Unpacker* in) {
   RunResult r;
   r.summary = GetSummary(in);
-  r.angles_rad = in->GetMatrix();
-  r.variant_angles_rad.resize(in->Get<std::uint64_t>());
-  for (Eigen::MatrixXd& v : r.variant_angles_rad) v = in->GetMatrix();
+  r.simulated = in->GetMatrix();
+  r.variant_simulated.resize(in->Get<std::uint64_t>());
+  for (Eigen::MatrixXd& v : r.variant_simulated) v = in->GetMatrix();
   return r;
 }
 

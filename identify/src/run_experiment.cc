@@ -21,13 +21,12 @@ RunResult RunExperiment(const Experiment& e, const identify::RunRequest& request
     CCSRM_CHECK(request.measurement_variants.empty());
     const std::size_t frames = result.trajectory.size();
     const int joints = e.model->num_joints();
-    out.angles_rad.resize(static_cast<Eigen::Index>(frames), 2 * joints);
+    out.simulated.resize(static_cast<Eigen::Index>(frames), 2 * joints);
     for (std::size_t f = 0; f < frames; ++f) {
       const std::vector<Eigen::Vector2d>& theta = result.trajectory.frames[f].joint_angles;
       for (int j = 0; j < joints; ++j) {
-        out.angles_rad(static_cast<Eigen::Index>(f), 2 * j) =
-            theta[static_cast<std::size_t>(j)].x();
-        out.angles_rad(static_cast<Eigen::Index>(f), 2 * j + 1) =
+        out.simulated(static_cast<Eigen::Index>(f), 2 * j) = theta[static_cast<std::size_t>(j)].x();
+        out.simulated(static_cast<Eigen::Index>(f), 2 * j + 1) =
             theta[static_cast<std::size_t>(j)].y();
       }
     }
@@ -36,10 +35,10 @@ RunResult RunExperiment(const Experiment& e, const identify::RunRequest& request
     return out;
   }
   const auto record = [&](const sim::ArmParameters& parameters) {
-    Eigen::MatrixXd angles = Eigen::MatrixXd::Constant(e.measured_rad.rows(), e.measured_rad.cols(),
+    Eigen::MatrixXd angles = Eigen::MatrixXd::Constant(e.measured.rows(), e.measured.cols(),
                                                        std::numeric_limits<double>::quiet_NaN());
     const std::size_t frames =
-        std::min(result.trajectory.size(), static_cast<std::size_t>(e.measured_rad.rows()));
+        std::min(result.trajectory.size(), static_cast<std::size_t>(e.measured.rows()));
     for (std::size_t f = 0; f < frames; ++f) {
       // What motion capture records: measurement effects (mocap_offset) included.
       const std::vector<Eigen::Vector2d> recorded =
@@ -49,12 +48,13 @@ RunResult RunExperiment(const Experiment& e, const identify::RunRequest& request
         angles(static_cast<Eigen::Index>(f), 2 * j + 1) = recorded[static_cast<std::size_t>(j)].y();
       }
     }
+    if (!e.tracked_points.empty()) RecordTrackedPoints(e, result.trajectory, &angles);
     e.AsMeasured(&angles);
     return angles;
   };
-  out.angles_rad = record(request.parameters);
+  out.simulated = record(request.parameters);
   for (const sim::ArmParameters& variant : request.measurement_variants) {
-    out.variant_angles_rad.push_back(record(variant));
+    out.variant_simulated.push_back(record(variant));
   }
   out.summary = std::move(result.summary);
   if (request.keep_trajectory) out.trajectory = std::move(result.trajectory);

@@ -31,7 +31,7 @@ std::vector<RunOutcome> RunOnBackend(const std::vector<RunRequest>& requests,
   std::vector<RunResult> results = backend->RunBatch(batch, finished);
   std::vector<RunOutcome> outcomes(requests.size());
   for (std::size_t k = 0; k < results.size(); ++k) {
-    const Eigen::MatrixXd& theta = results[k].angles_rad;
+    const Eigen::MatrixXd& theta = results[k].simulated;
     std::vector<double>& angles = outcomes[k].angles_deg;
     angles.reserve(static_cast<std::size_t>(theta.size()));
     for (Eigen::Index f = 0; f < theta.rows(); ++f) {

@@ -42,7 +42,7 @@ Experiment FrameExperiment(const std::string& name, const sim::ArmModel& model,
   e.sample_time_s = simulation.sample_times;
   e.simulated_s = simulation.duration_s;
   e.joints = model.num_joints();
-  e.measured_rad.resize(0, 2 * e.joints);
+  e.measured.resize(0, 2 * e.joints);
   return e;
 }
 

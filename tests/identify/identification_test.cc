@@ -263,17 +263,17 @@ TEST(AngleErrors, FitPercentOnlyWhereTheAxisMoves) {
   e.joints = 2;
   e.noise_deg = {0.03, 0.03};
   const int frames = 200;
-  e.measured_rad = Eigen::MatrixXd(frames, 4);
+  e.measured = Eigen::MatrixXd(frames, 4);
   Eigen::MatrixXd simulated(frames, 4);
   const double rad = M_PI / 180.0;
   for (int f = 0; f < frames; ++f) {
     const double phase = 2.0 * M_PI * f / frames;
-    e.measured_rad.row(f) << 5.0 * std::sin(phase), 0.2 + 0.05 * std::sin(3 * phase),
+    e.measured.row(f) << 5.0 * std::sin(phase), 0.2 + 0.05 * std::sin(3 * phase),
         0.05 * std::sqrt(2.0) * std::sin(phase), 0.0;
-    e.measured_rad.row(f) *= rad;
+    e.measured.row(f) *= rad;
     // The fit is off by 0.1° everywhere: 98 % of θx's motion, but more than
     // θy's whole motion (a fit percent of -183 % there).
-    simulated.row(f) = e.measured_rad.row(f).array() + 0.1 * rad;
+    simulated.row(f) = e.measured.row(f).array() + 0.1 * rad;
   }
   const ChannelErrors errors = AngleErrors({&e}, {&simulated});
   EXPECT_NEAR(errors.motion_rms_deg[0][0], 5.0 / std::sqrt(2.0), 1e-9);

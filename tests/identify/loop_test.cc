@@ -37,10 +37,10 @@ constexpr double kNoiseDeg = testing_support::kLoopNoiseDeg;
 
 // The experiment's own angles shifted back by `frames`, plus a pattern.
 Eigen::MatrixXd Shifted(const Experiment& e, int frames) {
-  Eigen::MatrixXd out = e.measured_rad;
+  Eigen::MatrixXd out = e.measured;
   for (Eigen::Index f = 0; f < out.rows(); ++f) {
     const Eigen::Index g = std::clamp<Eigen::Index>(f + frames, 0, out.rows() - 1);
-    out.row(f) = e.measured_rad.row(g);
+    out.row(f) = e.measured.row(g);
   }
   return out;
 }
@@ -68,7 +68,7 @@ TEST(ResidualDiagnostics, WhiteNoiseIsWhiteAndAConstantOffsetIsNamed) {
   const std::vector<Experiment> x = LoopRecordings(Nominal().parameters, {3});
   // The "simulation" is the recording plus fresh white noise of 0.03 deg,
   // except on joint 4 θy, which it misses by a constant 0.05 deg.
-  Eigen::MatrixXd simulated = x[0].measured_rad;
+  Eigen::MatrixXd simulated = x[0].measured;
   std::mt19937 rng(11);
   std::normal_distribution<double> noise(0.0, kNoiseDeg * M_PI / 180.0);
   for (Eigen::Index f = 0; f < simulated.rows(); ++f) {

@@ -38,11 +38,11 @@ EdgeRms Edges(const std::vector<Experiment>& recordings, const PredictionSummary
     const Experiment& x = recordings[e];
     const Eigen::MatrixXd& predicted = prediction.recordings[e].predicted_rad;
     const double start = x.sample_time_s.front(), end = x.sample_time_s.back();
-    for (Eigen::Index f = 0; f < x.measured_rad.rows(); ++f) {
+    for (Eigen::Index f = 0; f < x.measured.rows(); ++f) {
       const double t = x.sample_time_s[static_cast<std::size_t>(f)];
       const int zone = t - start < 1.0 ? 0 : end - t < 1.0 ? 2 : 1;
-      for (Eigen::Index c = 0; c < x.measured_rad.cols(); ++c) {
-        double r = (predicted(f, c) - x.measured_rad(f, c)) * 180.0 / M_PI;
+      for (Eigen::Index c = 0; c < x.measured.cols(); ++c) {
+        double r = (predicted(f, c) - x.measured(f, c)) * 180.0 / M_PI;
         if (!std::isfinite(r)) continue;
         if (weighed) r *= x.noise_deg[static_cast<std::size_t>(c / 2)] / x.NoiseDeg(f, c);
         sq[zone] += r * r;

@@ -124,7 +124,7 @@ ModelAdequacy JudgeWhiteResidual(double ratio, double noise_effective_samples) {
   Experiment x;
   x.name = "white";
   x.joints = 1;
-  x.measured_rad = Eigen::MatrixXd::Zero(2000, 2);
+  x.measured = Eigen::MatrixXd::Zero(2000, 2);
   x.noise_deg = {0.03};
   x.noise_effective_samples = {noise_effective_samples};
   Eigen::MatrixXd sim(2000, 2);

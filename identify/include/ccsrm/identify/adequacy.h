@@ -37,8 +37,11 @@ inline constexpr double kAboveNoiseSignificance = 0.01;
 // A channel whose residual stands above its noise.
 struct ChannelAboveNoise {
   std::string recording;
-  int joint = 0;  // 1-based
-  int axis = 0;   // 0 θx, 1 θy
+  int joint = 0;  // 1-based; 0 for a tracked point's coordinate
+  int axis = 0;   // 0 θx, 1 θy; of a tracked point 0 x, 1 y, 2 z
+  // A tracked point's name (Experiment::tracked_points): rms_deg and
+  // noise_deg are then in mm.
+  std::string point;
   double rms_deg = 0.0;
   double noise_deg = 0.0;
   double effective_samples = 0.0;        // N_eff of its residual
@@ -50,7 +53,10 @@ struct ModelAdequacy {
   bool assessed = false;  // false: no complete run to compare
   double above_noise_ratio = kAboveNoiseRatio;
   double significance = kAboveNoiseSignificance;  // family-wise, over `channels`
-  std::size_t channels = 0;  // tested: recordings × joints × 2 with a measured sample
+  // tested: recordings × joints × 2 with a measured sample, and of those
+  // tracked points' coordinates
+  std::size_t channels = 0;
+  std::size_t point_channels = 0;
   std::vector<ChannelAboveNoise> above_noise;  // in channel order
   // The largest RMS residual over noise of any channel (1 at the noise).
   double worst_ratio = 0.0;
@@ -72,7 +78,7 @@ struct ModelAdequacy {
 };
 
 // Judges `simulated` (one matrix per recording, laid out and made comparable
-// as Experiment::measured_rad) against the recordings' measured angles.
+// as Experiment::measured) against the recordings' measured angles.
 ModelAdequacy AssessModelAdequacy(const std::vector<const Experiment*>& recordings,
                                   const std::vector<const Eigen::MatrixXd*>& simulated,
                                   double above_noise_ratio = kAboveNoiseRatio,

@@ -105,7 +105,7 @@ struct ResidualDiagnostics {
 };
 
 // Diagnoses the residual of simulated angles [rad] (one matrix per
-// experiment, laid out as Experiment::measured_rad and passed through
+// experiment, laid out as Experiment::measured and passed through
 // Experiment::AsMeasured) against the experiments' measured angles.
 ResidualDiagnostics DiagnoseResidual(const std::vector<Experiment>& experiments,
                                      const std::vector<Eigen::MatrixXd>& simulated_rad);

@@ -12,6 +12,7 @@
 #include "ccsrm/sim/config.h"
 #include "ccsrm/sim/model.h"
 #include "ccsrm/sim/protocol.h"
+#include "ccsrm/sim/simulator.h"
 
 namespace ccsrm::identify {
 
@@ -33,6 +34,11 @@ struct ExperimentLoadOptions {
   // flattened must not give one joint a weight thousands of times the
   // others'. Default: a tenth of the 0.03 deg floor.
   double min_noise_deg = 0.003;
+  // Measurement noise of a tracked point's coordinates, standard deviation
+  // per axis [mm]: the weight of tracked-point residuals. Default: 0.5 mm, a
+  // capture system's marker noise with the marker's own placement on its
+  // body (the recorded robot's rest tip scatters by 0.3 mm in z).
+  double point_noise_mm = 0.5;
   // The arm's nominal configuration to use instead of the file's own
   // config_yaml (`ccsrm loop --config FILE`, `ccsrm predict --config FILE`,
   // as `ccsrm mocap process --config` stores one), parsed once by the caller
@@ -43,6 +49,27 @@ struct ExperimentLoadOptions {
   std::shared_ptr<const sim::Config> config;
 
   bool IsValid(std::string* error) const;
+};
+
+// A point tracked on one body (a tip marker): compared in its position
+// when the recording holds no link poses (issue 46).
+struct TrackedPoint {
+  std::string name;                                        // the marker's
+  int link = 0;                                            // 0 the base, else 1-based link index
+  Eigen::Vector3d position_B_m = Eigen::Vector3d::Zero();  // in that body's frame
+};
+
+// How a run's tracked points are put in the frame they were recorded in.
+enum class PointPlacement {
+  kWorld,  // recorded in W: compared as simulated
+  // Recorded in the capture system's own frame, placed relative to W by a
+  // rigid motion nobody measured: each run is placed by the rotation and
+  // offset that best fit its points to the measured ones (least squares,
+  // Umeyama's closed form). The placement is so eliminated from the fit
+  // (variable projection: the finite-difference Jacobian of the placed
+  // residual is the reduced problem's), and its 6 values are estimated with
+  // every run.
+  kFittedRigidMotion,
 };
 
 // What a simulation of the experiment needs, and what it is compared with.
@@ -62,12 +89,17 @@ struct Experiment {
   std::vector<double> frame_time_s;
   std::vector<double> sample_time_s;
   int joints = 0;
-  // Measured angles [rad], row per frame, column 2 j + a (joint j 0-based,
-  // axis a: 0 θx, 1 θy); NaN where not measured.
-  Eigen::MatrixXd measured_rad;
+  // What was measured, row per frame: column 2 j + a the angle of joint j
+  // (0-based) about axis a (0 θx, 1 θy) [rad], then column 2 J + 3 p + c
+  // coordinate c of tracked point p [m]; NaN where not measured. An
+  // experiment of tracked points has every angle column NaN.
+  Eigen::MatrixXd measured;
+  std::vector<TrackedPoint> tracked_points;
+  PointPlacement point_placement = PointPlacement::kWorld;
+  double point_noise_mm = 0.5;    // ExperimentLoadOptions::point_noise_mm
   std::vector<double> noise_deg;  // per joint, far from a recording's ends and gaps
   // The noise of each measured angle over its joint's noise_deg, laid out as
-  // measured_rad: 1 without a recorded low-pass; with one, the filter's own
+  // measured: 1 without a recorded low-pass; with one, the filter's own
   // white-noise gain at the frame over its interior gain
   // (mocap::ZeroLagNoiseGain), up to about 2 at a run's ends, where the
   // zero-lag low-pass sits on a pivot of fewer samples. NaN where nothing
@@ -86,7 +118,7 @@ struct Experiment {
   // computed them at load, with default settings.
   bool angles_from_pipeline = false;
   std::string pipeline_report;       // the pipeline's one-line quality summary, when it ran
-  std::size_t measured_samples = 0;  // finite entries of measured_rad
+  std::size_t measured_samples = 0;  // finite entries of measured
 
   // The zero-lag low-pass the mocap pipeline applied to the measured angles,
   // from the file's quality figures (filter_cutoff_hz, ...); unset when the
@@ -99,7 +131,7 @@ struct Experiment {
   };
   std::optional<LowPass> low_pass;
 
-  // Makes simulated angles [rad], laid out as measured_rad, comparable with
+  // Makes simulated angles [rad], laid out as measured, comparable with
   // the measured ones: NaN where nothing was measured, then the pipeline's
   // low-pass on every run of frames between gaps, as the pipeline did to the
   // true angles. Without the filter, a 1 Hz low-pass would shave the fast
@@ -107,11 +139,22 @@ struct Experiment {
   // would trade damping for that difference.
   void AsMeasured(Eigen::MatrixXd* angles_rad) const;
 
-  // The noise [deg] of measured_rad(frame, column): what a residual there is
-  // weighed by, so that a recording's ends count for what they know.
+  // The noise [deg] of measured(frame, column) for an angle column: what a
+  // residual there is weighed by, so that a recording's ends count for what
+  // they know.
   double NoiseDeg(Eigen::Index frame, Eigen::Index column) const {
     const double joint = noise_deg[static_cast<std::size_t>(column / 2)];
     return relative_noise.size() == 0 ? joint : joint * relative_noise(frame, column);
+  }
+
+  bool IsPointColumn(Eigen::Index column) const { return column >= 2 * joints; }
+  // (simulated - measured) at (frame, column) over its noise: the weighted
+  // residual of an angle in degrees over degrees, of a tracked point's
+  // coordinate in mm over mm.
+  double WeightedResidual(Eigen::Index frame, Eigen::Index column, double simulated) const {
+    const double d = simulated - measured(frame, column);
+    if (IsPointColumn(column)) return d * 1e3 / point_noise_mm;
+    return d * (180.0 / 3.14159265358979323846) / NoiseDeg(frame, column);
   }
 
   // Simulated time [s] of a run sampled on the solver's output grid rather
@@ -138,7 +181,34 @@ struct Experiment {
 Experiment MakeExperiment(const datasets::ExperimentFile& file, const std::string& path,
                           const ExperimentLoadOptions& options);
 
-// Fills e->relative_noise from e->low_pass and the gaps of e->measured_rad.
+// The rigid motion that carries points simulated in W onto the measured
+// ones: measured ≈ R_CW simulated + p_CW.
+struct RigidPlacement {
+  Eigen::Matrix3d R_CW = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p_CW_m = Eigen::Vector3d::Zero();
+};
+
+// Fills the tracked-point columns of `simulated` (laid out as e.measured)
+// with the points of each trajectory frame, placed as e.point_placement says
+// (the best rigid motion when the points were recorded in the capture frame,
+// over every frame and point measured). Returns the placement used (the
+// identity in W, and when fewer than three points are measured).
+RigidPlacement RecordTrackedPoints(const Experiment& e, const sim::Trajectory& trajectory,
+                                   Eigen::MatrixXd* simulated);
+
+// The errors of simulated tracked points against the measured ones, per point
+// over the frames where it was measured [mm]: the RMS of the Euclidean
+// distance, and the same after removing the mean offset (the publishing
+// project's metric on the recorded robot, issue 46).
+struct TrackedPointErrors {
+  std::vector<double> rms_mm;
+  std::vector<double> rms_mean_removed_mm;
+  std::vector<Eigen::Vector3d> mean_offset_mm;  // mean of simulated - measured
+  std::vector<std::size_t> frames;
+};
+TrackedPointErrors PointErrors(const Experiment& e, const Eigen::MatrixXd& simulated);
+
+// Fills e->relative_noise from e->low_pass and the gaps of e->measured.
 // MakeExperiment does; an experiment built in code with a low-pass calls it
 // after setting both.
 void SetRelativeNoise(Experiment* e);

@@ -69,7 +69,8 @@ std::vector<std::string> Spec6ParameterNames();
 struct IterationProgress {
   int iteration = 0;
   double cost = 0.0;  // 1/2 Σ r², r in units of the noise
-  double rms_deg = 0.0;
+  double rms_deg = 0.0;  // of the angles; NaN without measured angles
+  double rms_mm = 0.0;   // of tracked points' coordinates; NaN without any
   double relative_decrease = 0.0;  // of the cost, this iteration (0 at the start)
   double trust_region_radius = 0.0;
   bool step_accepted = true;
@@ -284,7 +285,7 @@ inline constexpr double kFitMotionShare = 0.1;
 inline constexpr double kFitMotionNoiseRatio = 3.0;
 
 // The errors of simulated angles [rad] (one matrix per experiment, laid out
-// as Experiment::measured_rad) against the experiments' measured angles,
+// as Experiment::measured) against the experiments' measured angles,
 // every experiment together (the noise of a joint: its experiments' mean
 // Experiment::noise_deg).
 ChannelErrors AngleErrors(const std::vector<const Experiment*>& experiments,
@@ -301,7 +302,15 @@ struct ExperimentFit {
   // The final run: summary, and the trajectory at the experiment's sample times.
   sim::SimulationResult run;
   sim::ArmParameters parameters;  // the parameters of that run
-  Eigen::MatrixXd simulated_rad;  // as Experiment::measured_rad
+  Eigen::MatrixXd simulated;      // as Experiment::measured
+  // Of an experiment of tracked points: their errors at the start values and
+  // at the fitted ones, and the capture frame's placement at the fitted
+  // ones (the identity for points recorded in W).
+  std::vector<TrackedPoint> points;
+  TrackedPointErrors start_points;
+  TrackedPointErrors fitted_points;
+  bool placed_in_capture_frame = false;
+  RigidPlacement placement;
 };
 
 struct IdentificationSummary {

@@ -98,7 +98,7 @@ struct PredictionErrors {
 };
 
 // The errors of `predicted` (one matrix per recording, laid out as
-// Experiment::measured_rad) against the recordings' measured angles.
+// Experiment::measured) against the recordings' measured angles.
 PredictionErrors ComputePredictionErrors(const std::vector<const Experiment*>& recordings,
                                          const std::vector<const Eigen::MatrixXd*>& predicted);
 
@@ -109,7 +109,7 @@ struct RecordingPrediction {
   std::string noise_source;
   sim::ArmParameters parameters;  // of the run
   sim::SimulationResult run;      // trajectory at the recording's sample times
-  Eigen::MatrixXd predicted_rad;  // as Experiment::measured_rad, made comparable (AsMeasured)
+  Eigen::MatrixXd predicted_rad;  // as Experiment::measured, made comparable (AsMeasured)
   PredictionErrors errors;
 };
 

@@ -23,7 +23,7 @@ struct RunRequest {
   bool keep_trajectory = false;  // also return every sampled frame
   // Parameter sets that differ from `parameters` only in measurement
   // effects' parameters (mocap_offset): the same run is recorded once more
-  // through each, without simulating again (RunResult::variant_angles_rad).
+  // through each, without simulating again (RunResult::variant_simulated).
   std::vector<sim::ArmParameters> measurement_variants;
   // Return the physical joint angles of every frame the run sampled instead
   // of the recorded ones at the experiment's frames (RunResult::angles_rad):
@@ -35,15 +35,15 @@ struct RunRequest {
 struct RunResult {
   sim::SimulationSummary summary;
   // The simulated angles at the experiment's sample times [rad], laid out as
-  // Experiment::measured_rad and made comparable with them
+  // Experiment::measured and made comparable with them
   // (Experiment::AsMeasured: the measurement's gaps and low-pass); rows
   // beyond a run that ended early are NaN. With RunRequest::every_frame:
   // the joint angles θx, θy of joint j in columns 2 j, 2 j + 1, one row per
   // frame the run reached, nothing recorded or filtered.
-  Eigen::MatrixXd angles_rad;
+  Eigen::MatrixXd simulated;
   sim::Trajectory trajectory;  // only with keep_trajectory
   // The angles as recorded through each of the request's measurement_variants.
-  std::vector<Eigen::MatrixXd> variant_angles_rad;
+  std::vector<Eigen::MatrixXd> variant_simulated;
 };
 
 // Called after each finished run, one call at a time.

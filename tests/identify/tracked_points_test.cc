@@ -1,0 +1,221 @@
+// Experiments that track a point (a tip marker) instead of every link's
+// pose, recorded in the capture system's own frame (issue 46): loaded as
+// tracked points, each run placed by the rigid motion that fits it best,
+// and fitted in millimetres.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "ccsrm/common/error.h"
+#include "ccsrm/identify/experiment.h"
+#include "ccsrm/identify/identification.h"
+#include "ccsrm/mocap/pose_log.h"
+#include "shared_data.h"
+#include "synthetic_experiment.h"
+
+namespace ccsrm::identify {
+namespace {
+
+using ::testing::HasSubstr;
+using testing_support::Nominal;
+using testing_support::Record;
+
+// The truth of the settled-pose fits: T_p 65 N against the nominal 50.
+sim::ArmParameters Truth() {
+  sim::ArmParameters p = Nominal().parameters;
+  p.T_p = 65.0;
+  return p;
+}
+
+// The capture frame of the recordings: 20 deg about a tilted axis, 0.3 m
+// away from W.
+Eigen::Matrix3d CaptureRotation() {
+  return Eigen::AngleAxisd(20.0 * M_PI / 180.0, Eigen::Vector3d(1.0, 2.0, 0.5).normalized())
+      .toRotationMatrix();
+}
+const Eigen::Vector3d kCaptureOffsetM(0.10, -0.05, 0.30);
+const Eigen::Vector3d kTipInLastLinkM(0.0, 0.0, 0.02);
+
+// 13 settled poses of the compressed protocol's ramp and hold with the
+// truth's tip marker (on the last link) in the capture frame, with
+// `noise_mm` of white noise per coordinate: a pose log's experiment.
+datasets::ExperimentFile TipRecording(double noise_mm, unsigned seed) {
+  datasets::ExperimentFile file = Record(Truth(), 0.03, seed, Nominal(), 0.0, 0.25);
+  const Experiment angles = MakeExperiment(file, "angles.h5", {});
+  sim::SimulationOptions options;
+  options.duration_s = angles.duration_s();
+  options.sample_times = angles.sample_time_s;
+  options.solver = angles.config.solver;
+  options.quasi_static = true;
+  const sim::SimulationResult run = sim::Simulate(*angles.model, Truth(), *angles.inputs, options);
+  EXPECT_TRUE(run.summary.completed()) << run.summary.message;
+  const int last = angles.model->num_links();
+  const std::size_t frames = run.trajectory.size();
+  file.measured_joint_angles.reset();
+  file.measured_joint_twist.reset();
+  file.marker_names = {"tip"};
+  file.rigid_bodies = {{"link" + std::to_string(last), {"tip"}, datasets::Array({1, 3})}};
+  for (int a = 0; a < 3; ++a) file.rigid_bodies[0].local_position.at(0, a) = kTipInLastLinkM[a];
+  file.marker_frame = datasets::MarkerFrame::kCapture;
+  file.mocap_markers = datasets::Array({frames, 1, 3});
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, noise_mm * 1e-3);
+  for (std::size_t f = 0; f < frames; ++f) {
+    const Eigen::Matrix<double, 7, 1>& pose =
+        run.trajectory.frames[f].link_pose[static_cast<std::size_t>(last - 1)];
+    const Eigen::Vector3d p_WT =
+        pose.head<3>() +
+        Eigen::Quaterniond(pose[3], pose[4], pose[5], pose[6]).normalized() * kTipInLastLinkM;
+    const Eigen::Vector3d p_CT = CaptureRotation() * p_WT + kCaptureOffsetM;
+    for (int a = 0; a < 3; ++a) file.mocap_markers.at(f, 0, a) = p_CT[a] + noise(rng);
+  }
+  return file;
+}
+
+TEST(TrackedPoints, AMarkerOnItsOwnLoadsAsATrackedPointInTheCaptureFrame) {
+  const Experiment e = MakeExperiment(TipRecording(0.2, 1), "tip.h5", {});
+  ASSERT_EQ(e.tracked_points.size(), 1u);
+  EXPECT_EQ(e.tracked_points[0].name, "tip");
+  EXPECT_EQ(e.tracked_points[0].link, e.model->num_links());
+  EXPECT_EQ(e.point_placement, PointPlacement::kFittedRigidMotion);
+  EXPECT_EQ(e.measured.cols(), 2 * e.joints + 3);
+  EXPECT_EQ(e.measured_samples, 3 * e.frame_time_s.size());
+  // No angle is measured: every residual is the tip's.
+  EXPECT_FALSE(e.measured.leftCols(2 * e.joints).array().isFinite().any());
+  EXPECT_TRUE(e.measured.rightCols(3).array().isFinite().all());
+}
+
+TEST(TrackedPoints, AMarkerOnABodyTheArmLacksIsRefused) {
+  datasets::ExperimentFile file = TipRecording(0.2, 1);
+  file.rigid_bodies[0].name = "link99";
+  try {
+    MakeExperiment(file, "tip.h5", {});
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_THAT(error.what(), HasSubstr("tip.h5: /mocap/rigid_bodies/link99: names no body"));
+  }
+}
+
+// The fit recovers the truth from the tip alone, the capture frame's
+// placement estimated with every run: T_p within three of its standard
+// errors and 1 % (the bound of the fit from the joint angles,
+// Identification.RecoversThePretensionFromSettledPoses); the placement
+// within four of the errors n poses with σ of noise allow where the data
+// are: σ/√n of offset at the tip's mean position, σ / (r √n) of rotation
+// about the axis the path spreads least around (r its RMS distance from
+// that axis through the mean: the two smaller principal spreads); and the tip's residual the
+// noise itself: its Euclidean RMS √3 σ, less the 7 fitted values' share of
+// the 3 n coordinates, within the ±25 % a chi-square of 32 degrees of
+// freedom spans at 95 %.
+TEST(TrackedPoints, RecoverThePretensionAndThePlacementOfTheCaptureFrame) {
+  constexpr double kNoiseMm = 0.2;
+  ExperimentLoadOptions load;
+  load.point_noise_mm = kNoiseMm;
+  const Experiment e = MakeExperiment(TipRecording(kNoiseMm, 3), "tip.h5", load);
+  IdentificationOptions o;
+  o.free_parameters = {"T_p"};
+  o.threads = 2;
+  const IdentificationSummary s = Identify({e}, o);
+  const ParameterEstimate* t_p = s.Find("T_p");
+  ASSERT_NE(t_p, nullptr);
+  const double truth = Truth().T_p;
+  EXPECT_LE(std::abs(t_p->value - truth), 3.0 * t_p->std_error) << t_p->value;
+  EXPECT_LE(std::abs(t_p->value - truth), 0.01 * truth) << t_p->value;
+
+  ASSERT_EQ(s.experiments.size(), 1u);
+  const ExperimentFit& fit = s.experiments[0];
+  ASSERT_TRUE(fit.placed_in_capture_frame);
+  const Eigen::MatrixXd tip_C = e.measured.rightCols(3);
+  const Eigen::RowVector3d mean_C = tip_C.colwise().mean();
+  const double poses = static_cast<double>(tip_C.rows());
+  const Eigen::MatrixXd centred = (tip_C.rowwise() - mean_C) * 1e3;  // mm
+  const Eigen::Vector3d spread =                                     // ascending
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(centred.transpose() * centred / poses)
+          .eigenvalues();
+  const double radius_mm = std::sqrt(spread[0] + spread[1]);
+  const double rotation_error_deg =
+      Eigen::AngleAxisd(fit.placement.R_CW * CaptureRotation().transpose()).angle() * 180.0 / M_PI;
+  // The fitted placement against the true one, at the tip's mean position.
+  const Eigen::Vector3d mean_W =
+      CaptureRotation().transpose() * (mean_C.transpose() - kCaptureOffsetM);
+  const double offset_error_mm =
+      (fit.placement.R_CW * mean_W + fit.placement.p_CW_m - mean_C.transpose()).norm() * 1e3;
+  EXPECT_LT(rotation_error_deg, 4.0 * kNoiseMm / (radius_mm * std::sqrt(poses)) * 180.0 / M_PI);
+  EXPECT_LT(offset_error_mm, 4.0 * kNoiseMm * std::sqrt(3.0 / poses));
+
+  ASSERT_EQ(fit.fitted_points.rms_mm.size(), 1u);
+  const double n = 3.0 * static_cast<double>(fit.fitted_points.frames[0]);
+  const double expected = std::sqrt(3.0 * (n - 7.0) / n) * kNoiseMm;
+  EXPECT_GT(fit.fitted_points.rms_mm[0], 0.75 * expected);
+  EXPECT_LT(fit.fitted_points.rms_mm[0], 1.25 * expected);
+  EXPECT_GT(fit.start_points.rms_mm[0], 2.0 * fit.fitted_points.rms_mm[0]);
+  EXPECT_TRUE(s.adequacy.adequate()) << s.adequacy.Verdict();
+  std::printf(
+      "T_p %.4f N (truth %.1f), std error %.3g N; placement off by %.4f deg and %.4f mm; tip "
+      "RMS %.3f -> %.3f mm (noise %.3f expected), path radius %.1f mm; %lld runs\n",
+      t_p->value, truth, t_p->std_error, rotation_error_deg, offset_error_mm,
+      fit.start_points.rms_mm[0], fit.fitted_points.rms_mm[0], expected, radius_mm,
+      static_cast<long long>(s.simulations));
+}
+
+// The tendon-driven robot's recordings (issue 46, ../shared/data/tdcr):
+// the first 30 poses of its training log after its pulls (rows 135-164,
+// segment 1's first pulls, 22 s), through the servo map identified from
+// tendon_pull.csv, fitted in the backbone's stiffness scale with the
+// capture frame's placement. The nominal rod bends the arm too far (30 mm
+// of tip per mm of pull against the robot's 26: docs/tdcr-recordings.md),
+// so the fit stiffens it and the tip's error falls; what the fitted model
+// must give is a tip within a tenth of the slice's own travel (the RMS
+// distance of the measured tip from its mean): a model that misses by more
+// has not explained the motion.
+TEST(TendonDrivenRobot, ASliceOfItsTrainingLogFitsItsBackboneStiffness) {
+  CCSRM_SHARED_FILE_OR_SKIP(pulls, "data/tdcr/ftdcr_v4/tendon_pull.csv");
+  CCSRM_SHARED_FILE_OR_SKIP(train, "data/tdcr/ftdcr_v4/train.csv");
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / "ccsrm_tracked_points_robot";
+  std::filesystem::create_directories(dir);
+  mocap::PoseLogImportRequest request;
+  request.log = train;
+  request.actuator_map = (dir / "actuators.yaml").string();
+  request.config = std::string(CCSRM_SOURCE_DIR) + "/configs/ftdcr_v4.yaml";
+  request.first_row = 135;
+  request.last_row = 164;
+  std::ofstream(request.actuator_map) << mocap::IdentifyTendonMap(mocap::ReadPoseLog(pulls))
+                                             .ActuatorMapYaml(pulls, "timestamp", "mm");
+  const mocap::ImportedPoseLog imported = mocap::ImportPoseLog(request);
+  const Experiment e = MakeExperiment(imported.experiment, train, {});
+  ASSERT_TRUE(e.settled_poses);
+  ASSERT_EQ(e.tracked_points.size(), 1u);
+  EXPECT_EQ(e.frame_time_s.size(), 30u);
+
+  IdentificationOptions o;
+  o.free_parameters = {"k_b"};
+  o.threads = 2;
+  const IdentificationSummary s = Identify({e}, o);
+  std::printf("%s\n", s.BriefReport().c_str());
+  ASSERT_TRUE(s.converged()) << s.message;
+  const ParameterEstimate* k_b = s.Find("k_b");
+  ASSERT_NE(k_b, nullptr);
+  EXPECT_TRUE(k_b->identifiable);
+  const TrackedPointErrors& start = s.experiments[0].start_points;
+  const TrackedPointErrors& fitted = s.experiments[0].fitted_points;
+  const Eigen::MatrixXd tip = e.measured.rightCols(3) * 1e3;  // mm
+  const double travel_mm =
+      std::sqrt((tip.rowwise() - tip.colwise().mean()).rowwise().squaredNorm().mean());
+  EXPECT_LT(fitted.rms_mean_removed_mm[0], start.rms_mean_removed_mm[0]);
+  EXPECT_LT(fitted.rms_mean_removed_mm[0], 0.1 * travel_mm);
+  std::printf(
+      "k_b %.3f (std error %.3g); tip %.3f -> %.3f mm (mean offset removed), travel %.1f "
+      "mm; %lld runs\n",
+      k_b->value, k_b->std_error, start.rms_mean_removed_mm[0], fitted.rms_mean_removed_mm[0],
+      travel_mm, static_cast<long long>(s.simulations));
+}
+
+}  // namespace
+}  // namespace ccsrm::identify
