@@ -15,9 +15,9 @@ constexpr double kDeg = 180.0 / 3.14159265358979323846;
 
 double Ratio(const ChannelAboveNoise& c) { return c.rms_deg / c.noise_deg; }
 
-// "joint 3 θx, 0.0412 deg RMS against 0.0300 deg of noise" or the same of a
-// tracked point's coordinate in mm.
-std::string ChannelText(const ChannelAboveNoise& c) {
+}  // namespace
+
+std::string Describe(const ChannelAboveNoise& c) {
   if (!c.point.empty()) {
     return Format("point %s %c, %.3f mm RMS against %.3f mm of noise", c.point.c_str(),
                   "xyz"[c.axis], c.rms_deg, c.noise_deg);
@@ -25,6 +25,8 @@ std::string ChannelText(const ChannelAboveNoise& c) {
   return Format("joint %d %s, %.4f deg RMS against %.4f deg of noise", c.joint,
                 c.axis == 0 ? "θx" : "θy", c.rms_deg, c.noise_deg);
 }
+
+namespace {
 
 // The channel's test as noise: its weighted residuals' mean square against
 // the noise's F (or chi-square without a noise estimate's own samples).
@@ -73,7 +75,7 @@ std::string ModelAdequacy::Verdict() const {
       "the model does NOT explain the data: %zu of %zu %s stand above their noise "
       "(worst: %s %s, %.2fx)",
       above_noise.size(), channels, point_channels > 0 ? "measured axes" : "joint axes",
-      w.recording.c_str(), ChannelText(w).c_str(), Ratio(w));
+      w.recording.c_str(), Describe(w).c_str(), Ratio(w));
 }
 
 ModelAdequacy AssessModelAdequacy(const std::vector<const Experiment*>& recordings,

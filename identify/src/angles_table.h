@@ -36,7 +36,9 @@ std::vector<std::string> OutputStems(const std::vector<std::string>& names);
 // prediction's): <stem><run_suffix>, the run with `parameters` on the
 // recording's configuration, left out when the run has no frame; and
 // <stem>.angles.csv, the measured angles, `simulated_rad` under `kind`
-// ("fitted", "predicted") and their residual. Both go into `tmp_dir`; their
+// ("fitted", "predicted") and their residual (for an experiment of tracked
+// points <stem>.points.csv instead, PointsCsvText, named in
+// (*entry)["points_file"]). Both go into `tmp_dir`; their
 // names into (*entry)["run_file"] (null without a run) and
 // ["angles_file"], their final paths (in `directory`) onto *written.
 void WriteRecordingOutputs(const Experiment& x, const std::string& name,
@@ -45,5 +47,21 @@ void WriteRecordingOutputs(const Experiment& x, const std::string& name,
                            const std::string& stem, const std::string& run_suffix,
                            const std::string& tmp_dir, const std::string& directory,
                            nlohmann::json* entry, std::vector<std::string>* written);
+
+// A recording's tracked-point errors for a report: per point its RMS (from
+// `start` when given) and its RMS with the mean offset removed, and the
+// capture frame's placement when given; as lines of text and as JSON.
+std::string TrackedPointsText(const std::vector<TrackedPoint>& points,
+                              const TrackedPointErrors* start, const TrackedPointErrors& errors,
+                              const RigidPlacement* placement, bool placement_given = false);
+nlohmann::json TrackedPointsJson(const std::vector<TrackedPoint>& points,
+                                 const TrackedPointErrors* start, const TrackedPointErrors& errors,
+                                 const RigidPlacement* placement, bool placement_given = false);
+
+// The measured and simulated (`kind`) tracked points of x and their residual,
+// in mm, one row per frame: time_s, then per point measured, kind and
+// residual x, y, z.
+std::string PointsCsvText(const Experiment& x, const Eigen::MatrixXd& simulated,
+                          const std::string& name, const std::string& kind);
 
 }  // namespace ccsrm::identify::internal

@@ -406,6 +406,38 @@ void Experiment::AsMeasured(Eigen::MatrixXd* angles_rad) const {
   }
 }
 
+namespace {
+
+// The rigid motion that best carries the first `frames` rows of the
+// simulated tracked points onto the measured ones (Umeyama's closed form over
+// every point both have); false with fewer than three.
+bool FitPlacement(const Experiment& e, const Eigen::MatrixXd& simulated, std::size_t frames,
+                  RigidPlacement* placement) {
+  const Eigen::Index angles = 2 * e.joints;
+  const Eigen::Index points = static_cast<Eigen::Index>(e.tracked_points.size());
+  std::vector<Eigen::Vector3d> from, to;
+  for (std::size_t f = 0; f < frames; ++f) {
+    const Eigen::Index row = static_cast<Eigen::Index>(f);
+    for (Eigen::Index p = 0; p < points; ++p) {
+      const Eigen::Vector3d s = simulated.block<1, 3>(row, angles + 3 * p).transpose();
+      const Eigen::Vector3d m = e.measured.block<1, 3>(row, angles + 3 * p).transpose();
+      if (s.allFinite() && m.allFinite()) from.push_back(s), to.push_back(m);
+    }
+  }
+  if (from.size() < 3) return false;
+  Eigen::Matrix3Xd src(3, static_cast<Eigen::Index>(from.size())), dst(3, src.cols());
+  for (std::size_t k = 0; k < from.size(); ++k) {
+    src.col(static_cast<Eigen::Index>(k)) = from[k];
+    dst.col(static_cast<Eigen::Index>(k)) = to[k];
+  }
+  const Eigen::Matrix4d X_CW = Eigen::umeyama(src, dst, /*with_scaling=*/false);
+  placement->R_CW = X_CW.topLeftCorner<3, 3>();
+  placement->p_CW_m = X_CW.topRightCorner<3, 1>();
+  return true;
+}
+
+}  // namespace
+
 RigidPlacement RecordTrackedPoints(const Experiment& e, const sim::Trajectory& trajectory,
                                    Eigen::MatrixXd* simulated) {
   const Eigen::Index angles = 2 * e.joints;
@@ -428,26 +460,12 @@ RigidPlacement RecordTrackedPoints(const Experiment& e, const sim::Trajectory& t
     }
   }
   RigidPlacement placement;
-  if (e.point_placement != PointPlacement::kFittedRigidMotion) return placement;
-  // Umeyama's closed form over every (frame, point) both have.
-  std::vector<Eigen::Vector3d> from, to;
-  for (std::size_t f = 0; f < frames; ++f) {
-    const Eigen::Index row = static_cast<Eigen::Index>(f);
-    for (Eigen::Index p = 0; p < points; ++p) {
-      const Eigen::Vector3d s = simulated->block<1, 3>(row, angles + 3 * p).transpose();
-      const Eigen::Vector3d m = e.measured.block<1, 3>(row, angles + 3 * p).transpose();
-      if (s.allFinite() && m.allFinite()) from.push_back(s), to.push_back(m);
-    }
+  if (e.point_placement == PointPlacement::kWorld) return placement;
+  if (e.point_placement == PointPlacement::kGiven) {
+    placement = e.given_placement;
+  } else if (!FitPlacement(e, *simulated, frames, &placement)) {
+    return placement;
   }
-  if (from.size() < 3) return placement;
-  Eigen::Matrix3Xd src(3, static_cast<Eigen::Index>(from.size())), dst(3, src.cols());
-  for (std::size_t k = 0; k < from.size(); ++k) {
-    src.col(static_cast<Eigen::Index>(k)) = from[k];
-    dst.col(static_cast<Eigen::Index>(k)) = to[k];
-  }
-  const Eigen::Matrix4d X_CW = Eigen::umeyama(src, dst, /*with_scaling=*/false);
-  placement.R_CW = X_CW.topLeftCorner<3, 3>();
-  placement.p_CW_m = X_CW.topRightCorner<3, 1>();
   for (std::size_t f = 0; f < frames; ++f) {
     for (Eigen::Index p = 0; p < points; ++p) {
       auto xyz = simulated->block<1, 3>(static_cast<Eigen::Index>(f), angles + 3 * p);

@@ -1,8 +1,11 @@
 #include "ccsrm/identify/fit_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
+
+#include <Eigen/Geometry>
 
 #include "ccsrm/common/atomic_file.h"
 #include "ccsrm/common/error.h"
@@ -16,6 +19,39 @@ constexpr const char* kFitSchema = "ccsrm-fit/1";
 
 double NumberOr(const json& j, const char* key, double absent) {
   return j.contains(key) && j[key].is_number() ? j[key].get<double>() : absent;
+}
+
+// experiments[k].tracked_points.capture_placement: {rotation_deg,
+// rotation_axis, offset_mm}, or null.
+std::optional<RigidPlacement> PlacementOf(const json& e, const std::string& path, std::size_t k) {
+  if (!e.is_object() || !e.contains("tracked_points") || !e["tracked_points"].is_object())
+    return std::nullopt;
+  const json& points = e["tracked_points"];
+  if (!points.contains("capture_placement") || points["capture_placement"].is_null())
+    return std::nullopt;
+  const json& x = points["capture_placement"];
+  const std::string at =
+      "key 'experiments[" + std::to_string(k) + "].tracked_points.capture_placement'";
+  const auto vector3 = [&](const char* key) {
+    if (!x.contains(key) || !x[key].is_array() || x[key].size() != 3 ||
+        !std::all_of(x[key].begin(), x[key].end(), [](const json& v) { return v.is_number(); })) {
+      ThrowInputError(path, at + "." + key, "expected three numbers");
+    }
+    return Eigen::Vector3d(x[key][0].get<double>(), x[key][1].get<double>(),
+                           x[key][2].get<double>());
+  };
+  const Eigen::Vector3d axis = vector3("rotation_axis");
+  const Eigen::Vector3d offset_mm = vector3("offset_mm");
+  const double angle_deg = NumberOr(x, "rotation_deg", std::nan(""));
+  if (!std::isfinite(angle_deg) || !offset_mm.allFinite() ||
+      !(std::abs(axis.norm() - 1.0) < 1e-6)) {
+    ThrowInputError(path, at,
+                    "expected a finite rotation_deg, a unit rotation_axis and a finite offset_mm");
+  }
+  RigidPlacement placement;
+  placement.R_CW = Eigen::AngleAxisd(angle_deg * M_PI / 180.0, axis).toRotationMatrix();
+  placement.p_CW_m = offset_mm * 1e-3;
+  return placement;
 }
 
 }  // namespace
@@ -60,6 +96,9 @@ FitFile FitFileFromJson(const json& fit, const std::string& path) {
   file.residual_variance = NumberOr(fit, "residual_variance", kAbsent);
   if (fit.contains("experiments") && fit["experiments"].is_array()) {
     for (const json& e : fit["experiments"]) {
+      if (!file.capture_placement) {
+        file.capture_placement = PlacementOf(e, path, file.noise_deg.size());
+      }
       std::vector<double>& noise = file.noise_deg.emplace_back();
       if (!e.is_object() || !e.contains("noise_deg") || !e["noise_deg"].is_array()) continue;
       for (const json& v : e["noise_deg"]) {

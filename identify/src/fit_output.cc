@@ -1,5 +1,4 @@
 // The identification summary as text, JSON and a fit directory.
-#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -36,42 +35,6 @@ nlohmann::json ChannelJson(const ChannelErrors& e) {
           {"fit_percent", Number(e.fit_percent_overall)},
           {"per_joint", joints},
           {"axes", {"theta_x", "theta_y"}}};
-}
-
-nlohmann::json PointsJson(const TrackedPointErrors& e, const std::vector<TrackedPoint>& points) {
-  nlohmann::json out = nlohmann::json::array();
-  for (std::size_t p = 0; p < e.rms_mm.size(); ++p) {
-    out.push_back({{"point", points[p].name},
-                   {"rms_mm", Number(e.rms_mm[p])},
-                   {"rms_mean_offset_removed_mm", Number(e.rms_mean_removed_mm[p])},
-                   {"mean_offset_mm",
-                    {Number(e.mean_offset_mm[p].x()), Number(e.mean_offset_mm[p].y()),
-                     Number(e.mean_offset_mm[p].z())}},
-                   {"frames", e.frames[p]}});
-  }
-  return out;
-}
-
-// "tip: RMS 3.2 -> 1.1 mm (mean offset removed: 1.1 mm), 79 frames".
-std::string PointsLine(const TrackedPointErrors& start, const TrackedPointErrors& fitted,
-                       const std::vector<TrackedPoint>& points) {
-  std::string out;
-  for (std::size_t p = 0; p < fitted.rms_mm.size(); ++p) {
-    out += Format("    %s: RMS %s -> %s mm (mean offset removed: %s mm), %zu frames\n",
-                  points[p].name.c_str(),
-                  Cell("%.3f", p < start.rms_mm.size() ? start.rms_mm[p] : NAN).c_str(),
-                  Cell("%.3f", fitted.rms_mm[p]).c_str(),
-                  Cell("%.3f", fitted.rms_mean_removed_mm[p]).c_str(), fitted.frames[p]);
-  }
-  return out;
-}
-
-// The capture frame's placement as a rotation angle about an axis and an offset.
-nlohmann::json PlacementJson(const RigidPlacement& x) {
-  const Eigen::AngleAxisd r(x.R_CW);
-  return {{"rotation_deg", r.angle() * 180.0 / M_PI},
-          {"rotation_axis", {r.axis().x(), r.axis().y(), r.axis().z()}},
-          {"offset_mm", {x.p_CW_m.x() * 1e3, x.p_CW_m.y() * 1e3, x.p_CW_m.z() * 1e3}}};
 }
 
 // The per-joint table of RMS, motion and fit.
@@ -261,16 +224,8 @@ std::string IdentificationSummary::FullReport() const {
   for (const ExperimentFit& e : experiments) {
     if (!e.fitted_points.rms_mm.empty()) {
       out << "  " << e.name << ": " << e.noise_source << "\n";
-      out << PointsLine(e.start_points, e.fitted_points, e.points);
-      if (e.placed_in_capture_frame) {
-        const Eigen::AngleAxisd r(e.placement.R_CW);
-        out << Format(
-            "    capture frame placed by the best rigid motion: %.3f deg about (%.3f, "
-            "%.3f, %.3f), offset (%.2f, %.2f, %.2f) mm\n",
-            r.angle() * 180.0 / M_PI, r.axis().x(), r.axis().y(), r.axis().z(),
-            e.placement.p_CW_m.x() * 1e3, e.placement.p_CW_m.y() * 1e3,
-            e.placement.p_CW_m.z() * 1e3);
-      }
+      out << internal::TrackedPointsText(e.points, &e.start_points, e.fitted_points,
+                                         e.placed_in_capture_frame ? &e.placement : nullptr);
       continue;
     }
     char line[512];
@@ -334,12 +289,10 @@ nlohmann::json ToJson(const IdentificationSummary& s) {
          {"start", ChannelJson(e.start)},
          {"fitted", ChannelJson(e.fitted)},
          {"tracked_points",
-          e.points.empty() ? nlohmann::json(nullptr)
-                           : nlohmann::json{{"start", PointsJson(e.start_points, e.points)},
-                                            {"fitted", PointsJson(e.fitted_points, e.points)},
-                                            {"capture_placement", e.placed_in_capture_frame
-                                                                      ? PlacementJson(e.placement)
-                                                                      : nlohmann::json(nullptr)}}},
+          e.points.empty()
+              ? nlohmann::json(nullptr)
+              : internal::TrackedPointsJson(e.points, &e.start_points, e.fitted_points,
+                                            e.placed_in_capture_frame ? &e.placement : nullptr)},
          {"run",
           {{"status", e.run.summary.completed() ? "completed" : "failed"},
            {"message", e.run.summary.message},

@@ -51,6 +51,7 @@ PredictionModel ModelFromFit(const FitFile& fit) {
   model.values = fit.values;
   model.free = fit.free;
   model.arm = fit.arm;
+  model.capture_placement = fit.capture_placement;
   return model;
 }
 
@@ -148,10 +149,16 @@ PredictionErrors ComputePredictionErrors(const std::vector<const Experiment*>& r
           } else if (std::isfinite(largest)) {
             largest = std::max(largest, std::abs(d));
           }
-          const double r = d / x.NoiseDeg(f, 2 * j + a);  // identification's residual
-          weighted_sq += r * r;
-          ++samples;
         }
+      }
+    }
+    // Identification's weighted residual, over every measured column.
+    for (Eigen::Index c = 0; c < x.measured.cols(); ++c) {
+      for (Eigen::Index f = 0; f < x.measured.rows(); ++f) {
+        if (!std::isfinite(x.measured(f, c))) continue;
+        const double r = x.WeightedResidual(f, c, (*predicted[e])(f, c));
+        weighted_sq += r * r;
+        ++samples;
       }
     }
   }
@@ -256,6 +263,20 @@ PredictionSummary Predict(const std::vector<Experiment>& recordings, const Predi
   for (std::size_t e = 0; e < recordings.size(); ++e) {
     RecordingPrediction& r = summary.recordings[e];
     const Experiment& x = recordings[e];
+    if (!x.tracked_points.empty()) {
+      r.tracked_points = x.tracked_points;
+      r.placed_in_capture_frame = x.point_placement != PointPlacement::kWorld;
+      Experiment placed = x;
+      if (model.capture_placement && x.point_placement == PointPlacement::kFittedRigidMotion) {
+        // The run placed itself; the fit's placement replaces that one.
+        placed.point_placement = PointPlacement::kGiven;
+        placed.given_placement = *model.capture_placement;
+        r.placement_from_fit = true;
+      }
+      r.placement = RecordTrackedPoints(placed, r.run.trajectory, &r.predicted_rad);
+      placed.AsMeasured(&r.predicted_rad);
+      r.points = PointErrors(x, r.predicted_rad);
+    }
     r.errors = ComputePredictionErrors({&x}, {&r.predicted_rad});
     all.push_back(&x);
     predicted.push_back(&r.predicted_rad);

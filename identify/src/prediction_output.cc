@@ -52,13 +52,21 @@ std::string EffectList(const std::vector<std::string>& effects) {
 }  // namespace
 
 std::string PredictionSummary::BriefReport() const {
+  // Without measured angles: the first recording's first tracked point.
+  std::string size = "RMS " + Cell("%.4f", errors.channels.rms_deg_overall) + " deg, max " +
+                     Cell("%.4f", errors.max_abs_deg_overall) + " deg";
+  if (!std::isfinite(errors.channels.rms_deg_overall) && !recordings.empty() &&
+      !recordings.front().points.rms_mm.empty()) {
+    const RecordingPrediction& r = recordings.front();
+    size = r.tracked_points[0].name + " RMS " + Cell("%.3f", r.points.rms_mm[0]) +
+           " mm (mean offset removed " + Cell("%.3f", r.points.rms_mean_removed_mm[0]) + " mm)";
+  }
   char text[640];
   std::snprintf(text, sizeof(text),
-                "prediction of %zu recording%s with %s (effects: %s): RMS %s deg, max %s deg, "
+                "prediction of %zu recording%s with %s (effects: %s): %s, "
                 "weighted RMS %s (1 = the noise floor); %zu of %zu channels above the noise%s",
                 recordings.size(), recordings.size() == 1 ? "" : "s", model.source.c_str(),
-                EffectList(effects).c_str(), Cell("%.4f", errors.channels.rms_deg_overall).c_str(),
-                Cell("%.4f", errors.max_abs_deg_overall).c_str(),
+                EffectList(effects).c_str(), size.c_str(),
                 Cell("%.3f", errors.weighted_rms).c_str(), adequacy.above_noise.size(),
                 adequacy.channels,
                 completed ? "" : (" (a run did not complete: " + message + ")").c_str());
@@ -80,10 +88,13 @@ std::string PredictionSummary::FullReport() const {
   for (const PredictionModel::Effects& e : model.effects) out << "; effects from " << e.file;
   out << "\n  " << simulations << " simulations on " << threads << " thread"
       << (threads == 1 ? "" : "s") << ", " << Cell("%.1f", wall_time_s) << " s\n\n";
-  out << "  joint   RMS θx [deg]   RMS θy [deg]   max θx [deg]   max θy [deg]   noise [deg]   "
-         "RMS/noise θx  RMS/noise θy\n";
   const PredictionErrors& e = errors;
-  for (std::size_t j = 0; j < e.channels.rms_deg.size(); ++j) {
+  const bool angles = std::isfinite(e.channels.rms_deg_overall);
+  if (angles) {
+    out << "  joint   RMS θx [deg]   RMS θy [deg]   max θx [deg]   max θy [deg]   noise [deg]   "
+           "RMS/noise θx  RMS/noise θy\n";
+  }
+  for (std::size_t j = 0; angles && j < e.channels.rms_deg.size(); ++j) {
     char line[256];
     std::snprintf(line, sizeof(line), "  %5zu   %-14s %-14s %-14s %-14s %-13s %-13s %s\n", j + 1,
                   Cell("%.4f", e.channels.rms_deg[j][0]).c_str(),
@@ -96,6 +107,15 @@ std::string PredictionSummary::FullReport() const {
   }
   out << "\n";
   for (const RecordingPrediction& r : recordings) {
+    if (!r.points.rms_mm.empty()) {
+      out << "  " << r.name << ": weighted RMS " << Cell("%.3f", r.errors.weighted_rms) << ", "
+          << r.noise_source << (r.run.summary.completed() ? "" : ", run: " + r.run.summary.message)
+          << "\n"
+          << internal::TrackedPointsText(r.tracked_points, nullptr, r.points,
+                                         r.placed_in_capture_frame ? &r.placement : nullptr,
+                                         r.placement_from_fit);
+      continue;
+    }
     double noise = 0.0;
     for (double s : r.errors.noise_deg) noise += s / static_cast<double>(r.errors.noise_deg.size());
     out << "  " << r.name << ": RMS " << Cell("%.4f", r.errors.channels.rms_deg_overall)
@@ -121,8 +141,7 @@ std::string PredictionSummary::FullReport() const {
         out << " ... and " << above_noise.size() - 16 << " more";
         break;
       }
-      out << (k == 0 ? " " : "; ") << c.recording << " joint " << c.joint
-          << (c.axis == 0 ? " θx " : " θy ") << Cell("%.4f", c.rms_deg) << " deg ("
+      out << (k == 0 ? " " : "; ") << c.recording << " " << Describe(c) << " ("
           << Cell("%.1f", c.rms_deg / c.noise_deg) << "x)";
     }
     out << "\n";
@@ -135,17 +154,24 @@ nlohmann::json ToJson(const PredictionSummary& s) {
   for (const auto& [name, value] : s.model.values) values[name] = value;
   nlohmann::json recordings = nlohmann::json::array();
   for (const RecordingPrediction& r : s.recordings) {
-    recordings.push_back({{"name", r.name},
-                          {"path", r.path},
-                          {"angles_from_pipeline", r.angles_from_pipeline},
-                          {"noise_deg", r.errors.noise_deg},
-                          {"noise_source", r.noise_source},
-                          {"errors", ErrorsJson(r.errors)},
-                          {"run",
-                           {{"status", r.run.summary.completed() ? "completed" : "failed"},
-                            {"message", r.run.summary.message},
-                            {"wall_time_s", r.run.summary.wall_time_s},
-                            {"real_time_factor", r.run.summary.real_time_factor}}}});
+    recordings.push_back(
+        {{"name", r.name},
+         {"path", r.path},
+         {"angles_from_pipeline", r.angles_from_pipeline},
+         {"noise_deg", r.errors.noise_deg},
+         {"noise_source", r.noise_source},
+         {"errors", ErrorsJson(r.errors)},
+         {"tracked_points",
+          r.tracked_points.empty()
+              ? nlohmann::json(nullptr)
+              : internal::TrackedPointsJson(r.tracked_points, nullptr, r.points,
+                                            r.placed_in_capture_frame ? &r.placement : nullptr,
+                                            r.placement_from_fit)},
+         {"run",
+          {{"status", r.run.summary.completed() ? "completed" : "failed"},
+           {"message", r.run.summary.message},
+           {"wall_time_s", r.run.summary.wall_time_s},
+           {"real_time_factor", r.run.summary.real_time_factor}}}});
   }
   nlohmann::json effects_files = nlohmann::json::array();
   for (const PredictionModel::Effects& e : s.model.effects) effects_files.push_back(e.file);

@@ -15,6 +15,7 @@
 #include "ccsrm/common/error.h"
 #include "ccsrm/identify/experiment.h"
 #include "ccsrm/identify/identification.h"
+#include "ccsrm/identify/prediction.h"
 #include "ccsrm/mocap/pose_log.h"
 #include "shared_data.h"
 #include "synthetic_experiment.h"
@@ -156,6 +157,27 @@ TEST(TrackedPoints, RecoverThePretensionAndThePlacementOfTheCaptureFrame) {
   EXPECT_LT(fit.fitted_points.rms_mm[0], 1.25 * expected);
   EXPECT_GT(fit.start_points.rms_mm[0], 2.0 * fit.fitted_points.rms_mm[0]);
   EXPECT_TRUE(s.adequacy.adequate()) << s.adequacy.Verdict();
+
+  // Another recording of the same arm in the same capture frame, predicted
+  // from the fit's folder: placed as the fit placed its own (nothing fitted
+  // to it), so its tip residual is the noise, √3 σ within the ±25 % of a
+  // chi-square of 39 degrees of freedom and the fit's small errors.
+  const std::filesystem::path folder =
+      std::filesystem::temp_directory_path() / "ccsrm_tracked_points_fit";
+  std::filesystem::remove_all(folder);
+  WriteFitDirectory(s, {e}, folder.string());
+  const PredictionModel model = LoadPredictionModel(folder.string());
+  ASSERT_TRUE(model.capture_placement.has_value());
+  const Experiment other = MakeExperiment(TipRecording(kNoiseMm, 4), "other.h5", load);
+  PredictionOptions po;
+  po.threads = 1;
+  const PredictionSummary predicted = Predict({other}, model, po);
+  ASSERT_EQ(predicted.recordings.size(), 1u);
+  const RecordingPrediction& r = predicted.recordings[0];
+  EXPECT_TRUE(r.placement_from_fit);
+  EXPECT_GT(r.points.rms_mm[0], 0.75 * std::sqrt(3.0) * kNoiseMm);
+  EXPECT_LT(r.points.rms_mm[0], 1.25 * std::sqrt(3.0) * kNoiseMm);
+  std::printf("prediction of another recording: tip RMS %.3f mm\n", r.points.rms_mm[0]);
   std::printf(
       "T_p %.4f N (truth %.1f), std error %.3g N; placement off by %.4f deg and %.4f mm; tip "
       "RMS %.3f -> %.3f mm (noise %.3f expected), path radius %.1f mm; %lld runs\n",

@@ -49,6 +49,10 @@ struct ChannelAboveNoise {
   double p_value = 0.0;                  // of its F (or chi-square) as noise
 };
 
+// "joint 3 θx, 0.0412 deg RMS against 0.0300 deg of noise", or the same of
+// a tracked point's coordinate in mm.
+std::string Describe(const ChannelAboveNoise& channel);
+
 struct ModelAdequacy {
   bool assessed = false;  // false: no complete run to compare
   double above_noise_ratio = kAboveNoiseRatio;

@@ -59,6 +59,13 @@ struct TrackedPoint {
   Eigen::Vector3d position_B_m = Eigen::Vector3d::Zero();  // in that body's frame
 };
 
+// The rigid motion that carries points simulated in W onto the measured
+// ones: measured ≈ R_CW simulated + p_CW.
+struct RigidPlacement {
+  Eigen::Matrix3d R_CW = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p_CW_m = Eigen::Vector3d::Zero();
+};
+
 // How a run's tracked points are put in the frame they were recorded in.
 enum class PointPlacement {
   kWorld,  // recorded in W: compared as simulated
@@ -70,6 +77,9 @@ enum class PointPlacement {
   // residual is the reduced problem's), and its 6 values are estimated with
   // every run.
   kFittedRigidMotion,
+  // Recorded in the capture frame, placed by a known rigid motion
+  // (Experiment::given_placement: a fit's, for a prediction).
+  kGiven,
 };
 
 // What a simulation of the experiment needs, and what it is compared with.
@@ -96,8 +106,9 @@ struct Experiment {
   Eigen::MatrixXd measured;
   std::vector<TrackedPoint> tracked_points;
   PointPlacement point_placement = PointPlacement::kWorld;
-  double point_noise_mm = 0.5;    // ExperimentLoadOptions::point_noise_mm
-  std::vector<double> noise_deg;  // per joint, far from a recording's ends and gaps
+  RigidPlacement given_placement;  // used with PointPlacement::kGiven
+  double point_noise_mm = 0.5;     // ExperimentLoadOptions::point_noise_mm
+  std::vector<double> noise_deg;   // per joint, far from a recording's ends and gaps
   // The noise of each measured angle over its joint's noise_deg, laid out as
   // measured: 1 without a recorded low-pass; with one, the filter's own
   // white-noise gain at the frame over its interior gain
@@ -181,18 +192,12 @@ struct Experiment {
 Experiment MakeExperiment(const datasets::ExperimentFile& file, const std::string& path,
                           const ExperimentLoadOptions& options);
 
-// The rigid motion that carries points simulated in W onto the measured
-// ones: measured ≈ R_CW simulated + p_CW.
-struct RigidPlacement {
-  Eigen::Matrix3d R_CW = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d p_CW_m = Eigen::Vector3d::Zero();
-};
-
 // Fills the tracked-point columns of `simulated` (laid out as e.measured)
 // with the points of each trajectory frame, placed as e.point_placement says
 // (the best rigid motion when the points were recorded in the capture frame,
-// over every frame and point measured). Returns the placement used (the
-// identity in W, and when fewer than three points are measured).
+// over every frame and point measured; the given one under kGiven). Returns
+// the placement used (the identity in W, and when fewer than three points are
+// measured to fit one).
 RigidPlacement RecordTrackedPoints(const Experiment& e, const sim::Trajectory& trajectory,
                                    Eigen::MatrixXd* simulated);
 

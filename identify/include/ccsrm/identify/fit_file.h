@@ -11,6 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "ccsrm/identify/experiment.h"
+
 #include "ccsrm/sim/parameters.h"
 
 namespace ccsrm::identify {
@@ -33,6 +35,10 @@ struct FitFile {
   // Per experiment, the noise of each joint [deg] as estimated for the fit
   // (entries that are not positive numbers left out).
   std::vector<std::vector<double>> noise_deg;
+  // The capture frame's placement the fit found: that of its first
+  // experiment of tracked points recorded in the capture frame (the same
+  // capture system places a prediction's recordings so); unset without one.
+  std::optional<RigidPlacement> capture_placement;
 };
 
 // Reads `path`. Throws InputError "<path>: <key>: <problem>" for a file that

@@ -68,9 +68,9 @@ std::vector<std::string> Spec6ParameterNames();
 // Reported after every iteration of the minimiser (iteration 0 is the start).
 struct IterationProgress {
   int iteration = 0;
-  double cost = 0.0;  // 1/2 Σ r², r in units of the noise
-  double rms_deg = 0.0;  // of the angles; NaN without measured angles
-  double rms_mm = 0.0;   // of tracked points' coordinates; NaN without any
+  double cost = 0.0;               // 1/2 Σ r², r in units of the noise
+  double rms_deg = 0.0;            // of the angles; NaN without measured angles
+  double rms_mm = 0.0;             // of tracked points' coordinates; NaN without any
   double relative_decrease = 0.0;  // of the cost, this iteration (0 at the start)
   double trust_region_radius = 0.0;
   bool step_accepted = true;

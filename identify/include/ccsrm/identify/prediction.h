@@ -50,6 +50,12 @@ struct PredictionModel {
     std::string file;
   };
   std::vector<Effects> effects;
+  // The capture frame's placement the fit found (FitFile::capture_placement):
+  // a recording of tracked points in the capture frame is placed by it, so
+  // that its errors are a prediction's, not a fit's of six more values.
+  // Unset (a parameter file, a fit of angles): each such recording is placed
+  // by its own best rigid motion, and the report says so.
+  std::optional<RigidPlacement> capture_placement;
 };
 
 // Reads the model from `path`: a fit.json (schema ccsrm-fit/1, as `ccsrm
@@ -93,7 +99,8 @@ struct PredictionErrors {
   std::vector<double> noise_deg;                   // per joint (mean over the recordings)
   double max_abs_deg_overall = 0.0;
   // sqrt(mean of ((predicted - measured) / noise)^2) over every measured
-  // sample: identification's weighted residual, 1 at the noise floor.
+  // sample (angles and tracked points' coordinates): identification's
+  // weighted residual, 1 at the noise floor.
   double weighted_rms = 0.0;
 };
 
@@ -111,6 +118,15 @@ struct RecordingPrediction {
   sim::SimulationResult run;      // trajectory at the recording's sample times
   Eigen::MatrixXd predicted_rad;  // as Experiment::measured, made comparable (AsMeasured)
   PredictionErrors errors;
+  // Of a recording of tracked points: their errors (the publishing
+  // project's metric among them: the RMS with the mean offset removed), and
+  // where the run was placed when the points were recorded in the capture
+  // frame (by the rigid motion that fits this recording best).
+  std::vector<TrackedPoint> tracked_points;
+  TrackedPointErrors points;
+  bool placed_in_capture_frame = false;
+  bool placement_from_fit = false;  // else fitted to this recording
+  RigidPlacement placement;
 };
 
 struct PredictionSummary {
