@@ -46,6 +46,13 @@ int RunSimulate(const SimulateArgs& a) {
   }
   const sim::SimulationResult result =
       sim::Simulate(run.model, run.config.parameters, run.inputs, options);
+  if (result.trajectory.size() == 0) {
+    // A run file needs a frame: say why there is none instead.
+    std::printf("%s", result.summary.FullReport().c_str());
+    std::fprintf(stderr, "ccsrm: simulation diverged before its first frame: %s (%s not written)\n",
+                 result.summary.message.c_str(), a.out.c_str());
+    return 3;
+  }
   datasets::WriteRunFile(a.out,
                          sim_io::ToRunFile(run.model, result, sim_io::PaperRunFileInfo(run)));
   std::printf("%s", sim::DescribeRun(run).c_str());

@@ -410,6 +410,11 @@ bool SettledPoseSolver::Newton(double t, const SettledFriction& from, Eigen::Vec
 
 namespace {
 
+// Inputs at their first sample beyond this [m] are reached in a lead-in from
+// zero: a micrometre, far below the replay's 0.5 mm increments and any
+// actuator's resolution (the robot's servos: 15 µm).
+constexpr double kLeadInThresholdM = 1e-6;
+
 // The quasi-static replay's loop over the sample times.
 class SettledPoseLoop {
  public:
@@ -430,8 +435,10 @@ class SettledPoseLoop {
   }
 
   SimulationResult Run() {
-    // The arm at rest under the inputs at t = 0 (gravity, a pull at 0).
-    if (!SolveAt(0.0)) Stop(solver_.failure() + " at t = 0 s");
+    // The arm at rest under the inputs at their start (gravity, a pull
+    // there).
+    t_ = inputs_.start_time();
+    if (!SolveAt(t_)) Stop(solver_.failure() + " at t = " + FormatTime(t_));
     while (running_ && !sampler_.done()) {
       const double t_out = sampler_.next_time();
       if (t_out > t_) Advance(t_out);
@@ -567,11 +574,25 @@ SimulationResult SimulateSettledPoses(const ArmModel& model, const ArmParameters
   if (!why.empty()) ThrowInputError("simulation options", "quasi_static", why);
   // Between settled poses the actuators go from one set point to the next:
   // straight lines, not the spline of a continuous motion, whose swings
-  // past the samples friction would remember as loops.
-  if (inputs.interpolation() == CableInputs::Interpolation::kLinear)
+  // past the samples friction would remember as loops. A record that starts
+  // pulled (a log's slice) is reached from the straight arm at zero inputs
+  // along a straight line in a lead-in before its first sample, so that the
+  // friction there is that of one monotone loading, not of a pull the
+  // holes never felt.
+  const bool lead_in = inputs.length_change().row(0).cwiseAbs().maxCoeff() > kLeadInThresholdM;
+  if (inputs.interpolation() == CableInputs::Interpolation::kLinear && !lead_in)
     return SettledPoseLoop(model, parameters, inputs, options).Run();
-  const CableInputs lines(inputs.time(), inputs.length_change(),
-                          CableInputs::Interpolation::kLinear);
+  const Eigen::Index n = inputs.time().size();
+  const Eigen::Index extra = lead_in ? 1 : 0;
+  Eigen::VectorXd time(n + extra);
+  Eigen::MatrixXd length(n + extra, inputs.length_change().cols());
+  if (lead_in) {
+    time[0] = inputs.start_time() - 1.0;
+    length.row(0).setZero();
+  }
+  time.tail(n) = inputs.time();
+  length.bottomRows(n) = inputs.length_change();
+  const CableInputs lines(std::move(time), std::move(length), CableInputs::Interpolation::kLinear);
   return SettledPoseLoop(model, parameters, lines, options).Run();
 }
 
