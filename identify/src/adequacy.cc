@@ -149,7 +149,7 @@ nlohmann::json ToJson(const ModelAdequacy& a) {
     above.push_back({{"recording", c.recording},
                      {"joint", c.joint},
                      {"point", c.point},
-                     {"axis", c.axis == 0 ? "x" : "y"},
+                     {"axis", std::string(1, "xyz"[c.axis])},
                      {"rms_deg", c.rms_deg},
                      {"noise_deg", c.noise_deg},
                      {"effective_samples", c.effective_samples},

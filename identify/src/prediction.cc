@@ -162,7 +162,8 @@ PredictionErrors ComputePredictionErrors(const std::vector<const Experiment*>& r
       }
     }
   }
-  out.max_abs_deg_overall = 0.0;
+  // Unknown (NaN) without a measured angle: recordings of tracked points.
+  out.max_abs_deg_overall = std::isfinite(out.channels.rms_deg_overall) ? 0.0 : kNaN;
   for (int j = 0; j < joints; ++j) {
     const std::size_t jj = static_cast<std::size_t>(j);
     if (counted[jj] > 0) out.noise_deg[jj] /= counted[jj];

@@ -25,4 +25,18 @@ struct AnglesCsv {
 AnglesCsv ReadAnglesCsv(const std::string& file, const std::vector<std::string>& kinds,
                         const std::string& named_by);
 
+// <name>.points.csv of `ccsrm identify` and `ccsrm predict` for a recording
+// of tracked points: time_s, then per point p, for each kind (measured,
+// fitted or predicted, residual) and axis x, y, z, <kind>_<p>_<axis>_mm.
+struct PointsCsv {
+  std::vector<double> time_s;           // strictly increasing
+  std::vector<std::string> points;      // names, in column order
+  std::vector<datasets::Array> series;  // per kind, T × P × 3 [mm], NaN where empty
+};
+
+// Reads `file` with the columns of `kinds`; throws InputError as
+// ReadAnglesCsv does.
+PointsCsv ReadPointsCsv(const std::string& file, const std::vector<std::string>& kinds,
+                        const std::string& named_by);
+
 }  // namespace ccsrm::reports::internal

@@ -80,6 +80,46 @@ void ReadAnglesFile(const std::string& file, FitExperiment* e) {
   e->residual_deg = std::move(angles.series[2]);
 }
 
+// An experiment of tracked points: its errors from fit.json, its positions
+// from the points file it names.
+void ReadTrackedPoints(const JsonReader& in, const json& entry, const std::string& at,
+                       const fs::path& folder, FitExperiment* e) {
+  e->points_file = in.Text(entry, at, "points_file");
+  if (e->points_file.find('/') != std::string::npos || e->points_file == ".." ||
+      e->points_file == ".") {
+    in.Fail(at + ".points_file",
+            "expected a file name in the fit folder, not '" + e->points_file + "'");
+  }
+  PointsCsv points =
+      ReadPointsCsv((folder / e->points_file).string(), {"measured", "fitted", "residual"},
+                    "the points file fit.json names");
+  e->time_s = std::move(points.time_s);
+  e->points = std::move(points.points);
+  e->measured_mm = std::move(points.series[0]);
+  e->fitted_mm = std::move(points.series[1]);
+  e->residual_mm = std::move(points.series[2]);
+  const std::string key = at + ".tracked_points";
+  const json& tracked = in.Object(entry, at, "tracked_points");
+  for (const char* which : {"start_errors", "errors"}) {
+    const json& errors = in.List(tracked, key, which);
+    if (errors.size() != e->points.size()) {
+      in.Fail(key + "." + which, "must have one entry per point of " + e->points_file + " (" +
+                                     std::to_string(e->points.size()) + ")");
+    }
+    for (std::size_t p = 0; p < errors.size(); ++p) {
+      const std::string item = key + "." + which + "[" + std::to_string(p) + "]";
+      const double rms = in.NumberAt(errors[p], item, "rms_mm", true);
+      if (std::string(which) == "start_errors") {
+        e->point_start_rms_mm.push_back(rms);
+      } else {
+        e->point_rms_mm.push_back(rms);
+        e->point_rms_mean_removed_mm.push_back(
+            in.NumberAt(errors[p], item, "rms_mean_offset_removed_mm", true));
+      }
+    }
+  }
+}
+
 FitExperiment ReadExperiment(const JsonReader& in, const json& entry, std::size_t index,
                              const fs::path& folder) {
   const std::string at = "experiments[" + std::to_string(index) + "]";
@@ -99,6 +139,10 @@ FitExperiment ReadExperiment(const JsonReader& in, const json& entry, std::size_
     in.Fail(at + ".run_file", "expected a file name or null");
   }
   if (run_file.is_string()) e.run_file = run_file.get<std::string>();
+  if (in.At(entry, at, "angles_file").is_null()) {
+    ReadTrackedPoints(in, entry, at, folder, &e);
+    return e;
+  }
   e.angles_file = in.Text(entry, at, "angles_file");
   // Both files sit in the fit folder: a name with a folder in it is not one
   // identify writes.

@@ -79,6 +79,15 @@ struct FitExperiment {
   // not measured).
   std::vector<double> time_s;
   datasets::Array measured_deg, fitted_deg, residual_deg;
+  // An experiment of tracked points (fit.json 'tracked_points'; then
+  // angles_file is empty): its points file, the points, their measured,
+  // fitted and residual positions [mm] (T × P × 3), and per point the RMS
+  // error at the start and fitted, and fitted with the mean offset removed
+  // [mm].
+  std::string points_file;
+  std::vector<std::string> points;
+  datasets::Array measured_mm, fitted_mm, residual_mm;
+  std::vector<double> point_start_rms_mm, point_rms_mm, point_rms_mean_removed_mm;
   // From run_file's stored configuration (ReadArmFacts); one group of every
   // joint, with the reason in `problems`, when it cannot be read.
   std::vector<JointGroup> segments;

@@ -158,11 +158,22 @@ Section SummarySection(const FitFolder& fit) {
           Plural(fit.simulations, "simulation") + ", " +
           Show(fit.wall_time_s, NumberFormat::Fixed(1)) + " s on " + Plural(fit.threads, "thread") +
           "). ";
-  text += "The RMS error of the joint angles went from " + Show(fit.rms_deg_start, kRms) +
-          " deg at the start values to " + Show(fit.rms_deg, kRms) +
-          " deg, and the fitted angles reproduce " + Show(fit.fit_percent, kPercent) +
-          " % of the measured motion (fit percent over the axes that move; " +
-          Show(fit.start_errors.fit_percent, kPercent) + " % at the start). ";
+  if (std::isfinite(fit.rms_deg)) {
+    text += "The RMS error of the joint angles went from " + Show(fit.rms_deg_start, kRms) +
+            " deg at the start values to " + Show(fit.rms_deg, kRms) +
+            " deg, and the fitted angles reproduce " + Show(fit.fit_percent, kPercent) +
+            " % of the measured motion (fit percent over the axes that move; " +
+            Show(fit.start_errors.fit_percent, kPercent) + " % at the start). ";
+  }
+  for (const FitExperiment& e : fit.experiments) {
+    for (std::size_t p = 0; p < e.points.size(); ++p) {
+      text += "The RMS error of " + e.name + "'s " + e.points[p] + " went from " +
+              Show(e.point_start_rms_mm[p], NumberFormat::Fixed(2)) +
+              " mm at the start values to " + Show(e.point_rms_mm[p], NumberFormat::Fixed(2)) +
+              " mm (" + Show(e.point_rms_mean_removed_mm[p], NumberFormat::Fixed(2)) +
+              " mm with the mean offset removed). ";
+    }
+  }
   text += "Residual variance " + Show(fit.residual_variance, NumberFormat::Significant(3)) +
           ": 1 means the remaining differences are as large as the measurement noise; much more "
           "than 1 means the model misses part of the motion.";
@@ -194,8 +205,38 @@ Section SummarySection(const FitFolder& fit) {
 
 // ------------------------------------------------- measured against fitted
 
+// An experiment of tracked points: their paths measured and fitted.
+Section ExperimentPointsSection(const FitExperiment& e, const std::string& stem, bool several) {
+  Section section{"points-" + stem,
+                  several ? "Measured and fitted points: " + e.name : "Measured and fitted points",
+                  {}};
+  std::string errors;
+  for (std::size_t p = 0; p < e.points.size(); ++p) {
+    errors += (p == 0 ? "" : "; ") + e.points[p] + ": RMS " +
+              Show(e.point_start_rms_mm[p], NumberFormat::Fixed(3)) + " mm at the start, " +
+              Show(e.point_rms_mm[p], NumberFormat::Fixed(3)) + " mm fitted (" +
+              Show(e.point_rms_mean_removed_mm[p], NumberFormat::Fixed(3)) +
+              " mm with the mean offset removed)";
+  }
+  section.blocks.push_back(Paragraph{"Experiment " + e.name + " (" + e.path + "), from " +
+                                         e.points_file +
+                                         ": the measured tracked points and the fitted run's, "
+                                         "placed in the frame they were recorded in. " +
+                                         errors + ".",
+                                     false});
+  section.blocks.push_back(FigureBlock{
+      internal::TrackedPointsFigure("points_" + stem, e.time_s, e.points, e.measured_mm,
+                                    e.fitted_mm, "fitted"),
+      "Tracked points: measured and fitted",
+      "Top left: the points' paths seen from above (x against y); then x, y and z against "
+      "time. Dashed: measured; solid: the fitted model's.",
+      ""});
+  return section;
+}
+
 Section ExperimentAnglesSection(const FitExperiment& e, std::size_t index, bool several) {
   const std::string stem = FigureStem(several ? e.name + "_" + std::to_string(index + 1) : e.name);
+  if (!e.points.empty()) return ExperimentPointsSection(e, stem, several);
   Section section{"angles-" + stem,
                   several ? "Measured and fitted angles: " + e.name : "Measured and fitted angles",
                   {}};
@@ -684,7 +725,8 @@ Document BuildFitDocument(const std::string& folder, const ReportOptions& option
   }
   document.sections.push_back(ParameterSection(fit));
   document.sections.push_back(IdentifiabilitySection(fit));
-  document.sections.push_back(ErrorSection(fit));
+  // Experiments of tracked points only: no joint was measured.
+  if (std::isfinite(fit.errors.rms_deg)) document.sections.push_back(ErrorSection(fit));
   document.sections.push_back(ConvergenceSection(fit));
   document.sections.push_back(ExperimentSection(fit));
   return document;

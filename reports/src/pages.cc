@@ -233,6 +233,48 @@ Figure MeasuredAgainstSimulatedFigure(const std::string& name, const std::vector
   return figure;
 }
 
+Figure TrackedPointsFigure(const std::string& name, const std::vector<double>& time,
+                           const std::vector<std::string>& points, const datasets::Array& measured,
+                           const datasets::Array& simulated, const std::string& simulated_word) {
+  Figure figure;
+  figure.name = name;
+  figure.columns = 2;
+  figure.panel_width_px = 640;
+  figure.panel_height_px = 360;
+  const auto add = [&](Panel* panel, std::size_t p, const std::vector<double>& x_measured,
+                       const std::vector<double>& y_measured,
+                       const std::vector<double>& x_simulated,
+                       const std::vector<double>& y_simulated) {
+    const int k = static_cast<int>(p) + 1;
+    Series m{"", x_measured, y_measured, palette::Indexed(k), SeriesStyle::kDashed};
+    m.line_width = 1.0;
+    panel->series.push_back(std::move(m));
+    panel->series.push_back(
+        Series{points[p] + " " + simulated_word, x_simulated, y_simulated, palette::Indexed(k)});
+  };
+  Panel top;
+  top.title = "seen from above: solid " + simulated_word + ", dashed measured";
+  top.x = Axis{"x", "mm"};
+  top.y = Axis{"y", "mm"};
+  for (std::size_t p = 0; p < points.size(); ++p) {
+    add(&top, p, ComponentOf(measured, p, 0), ComponentOf(measured, p, 1),
+        ComponentOf(simulated, p, 0), ComponentOf(simulated, p, 1));
+  }
+  figure.panels.push_back(std::move(top));
+  for (std::size_t c = 0; c < 3; ++c) {
+    Panel panel;
+    const std::string axis(1, static_cast<char>('x' + c));
+    panel.title = axis + " against time";
+    panel.x = TimeAxis();
+    panel.y = Axis{axis, "mm"};
+    for (std::size_t p = 0; p < points.size(); ++p) {
+      add(&panel, p, time, ComponentOf(measured, p, c), time, ComponentOf(simulated, p, c));
+    }
+    figure.panels.push_back(std::move(panel));
+  }
+  return figure;
+}
+
 Figure ResidualsFigure(const std::string& name, const std::vector<double>& time,
                        const datasets::Array& residual, const std::vector<JointGroup>& segments) {
   Figure figure;

@@ -51,6 +51,15 @@ Figure MeasuredAgainstSimulatedFigure(const std::string& name, const std::vector
                                       const std::vector<JointGroup>& segments,
                                       const std::string& simulated_word);
 
+// Tracked points measured against simulated (fit and prediction pages of a
+// recording of tracked points): the points' paths seen from above (x
+// against y, in the frame they were recorded in), then x, y and z against
+// time; point k in palette::Indexed(k), measured dashed, simulated solid.
+// `measured` and `simulated` are T × P × 3 [mm] on `time`.
+Figure TrackedPointsFigure(const std::string& name, const std::vector<double>& time,
+                           const std::vector<std::string>& points, const datasets::Array& measured,
+                           const datasets::Array& simulated, const std::string& simulated_word);
+
 // Residuals (simulated − measured, T × J × 2 [deg]) per segment, θx left
 // and θy right.
 Figure ResidualsFigure(const std::string& name, const std::vector<double>& time,

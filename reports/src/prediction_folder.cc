@@ -40,6 +40,42 @@ PredictionErrors ReadErrors(const JsonReader& in, const json& object, const std:
   return errors;
 }
 
+// A recording of tracked points: its errors and placement from pred.json,
+// its positions from the points file it names.
+void ReadTrackedPoints(const JsonReader& in, const json& entry, const std::string& at,
+                       const fs::path& folder, PredictionRecording* r) {
+  r->points_file = in.Text(entry, at, "points_file");
+  if (r->points_file.find('/') != std::string::npos || r->points_file == ".." ||
+      r->points_file == ".") {
+    in.Fail(at + ".points_file",
+            "expected a file name in the prediction folder, not '" + r->points_file + "'");
+  }
+  PointsCsv points =
+      ReadPointsCsv((folder / r->points_file).string(), {"measured", "predicted", "residual"},
+                    "the points file pred.json names");
+  r->time_s = std::move(points.time_s);
+  r->points = std::move(points.points);
+  r->measured_mm = std::move(points.series[0]);
+  r->predicted_mm = std::move(points.series[1]);
+  r->residual_mm = std::move(points.series[2]);
+  const std::string key = at + ".tracked_points";
+  const json& tracked = in.Object(entry, at, "tracked_points");
+  const json& errors = in.List(tracked, key, "errors");
+  if (errors.size() != r->points.size()) {
+    in.Fail(key + ".errors", "must have one entry per point of " + r->points_file + " (" +
+                                 std::to_string(r->points.size()) + ")");
+  }
+  for (std::size_t p = 0; p < errors.size(); ++p) {
+    const std::string e = key + ".errors[" + std::to_string(p) + "]";
+    r->point_rms_mm.push_back(in.NumberAt(errors[p], e, "rms_mm", true));
+    r->point_rms_mean_removed_mm.push_back(
+        in.NumberAt(errors[p], e, "rms_mean_offset_removed_mm", true));
+  }
+  const json& placement = in.At(tracked, key, "capture_placement");
+  if (!placement.is_null())
+    r->placement_from = in.Text(placement, key + ".capture_placement", "from");
+}
+
 PredictionRecording ReadRecording(const JsonReader& in, const json& entry, std::size_t index,
                                   const fs::path& folder) {
   const std::string at = "recordings[" + std::to_string(index) + "]";
@@ -58,6 +94,10 @@ PredictionRecording ReadRecording(const JsonReader& in, const json& entry, std::
     in.Fail(at + ".run_file", "expected a file name or null");
   }
   if (run_file.is_string()) r.run_file = run_file.get<std::string>();
+  if (in.At(entry, at, "angles_file").is_null()) {
+    ReadTrackedPoints(in, entry, at, folder, &r);
+    return r;
+  }
   r.angles_file = in.Text(entry, at, "angles_file");
   // Both files sit in the folder: a name with a folder in it is not one
   // ccsrm predict writes.
@@ -126,9 +166,12 @@ PredictionFolder ReadPredictionFolder(const std::string& folder) {
     PredictionChannel c;
     c.recording = in.Text(above[i], at, "recording");
     c.joint = static_cast<int>(in.NumberAt(above[i], at, "joint"));
+    if (above[i].contains("point")) c.point = in.Text(above[i], at, "point");
     const std::string axis = in.Text(above[i], at, "axis");
-    if (axis != "x" && axis != "y") in.Fail(at + ".axis", "expected \"x\" or \"y\"");
-    c.axis = axis == "x" ? 0 : 1;
+    if (axis != "x" && axis != "y" && !(axis == "z" && !c.point.empty()))
+      in.Fail(at + ".axis",
+              c.point.empty() ? "expected \"x\" or \"y\"" : "expected \"x\", \"y\" or \"z\"");
+    c.axis = axis[0] - 'x';
     c.rms_deg = in.NumberAt(above[i], at, "rms_deg", true);
     c.noise_deg = in.NumberAt(above[i], at, "noise_deg", true);
     c.effective_samples = in.NumberAt(above[i], at, "effective_samples", true);

@@ -45,10 +45,20 @@ struct PredictionRecording {
   std::string noise_source;
   PredictionErrors errors;
   std::string run_status, run_message;
-  std::string run_file;  // empty: none written (the run failed)
-  std::string angles_file;
+  std::string run_file;     // empty: none written (the run failed)
+  std::string angles_file;  // empty for a recording of tracked points
   std::vector<double> time_s;
   datasets::Array measured_deg, predicted_deg, residual_deg;  // T × J × 2
+  // A recording of tracked points (pred.json 'tracked_points'): its file,
+  // the points, their measured, predicted and residual positions [mm]
+  // (T × P × 3), per point the RMS error and the same with the mean offset
+  // removed [mm], and what placed the capture frame ("fit", "this
+  // recording"; empty: recorded in W).
+  std::string points_file;
+  std::vector<std::string> points;
+  datasets::Array measured_mm, predicted_mm, residual_mm;
+  std::vector<double> point_rms_mm, point_rms_mean_removed_mm;
+  std::string placement_from;
   std::vector<JointGroup> segments;
   std::vector<std::string> problems;
 };
@@ -57,6 +67,7 @@ struct PredictionChannel {  // an entry of `above_noise`
   std::string recording;
   int joint = 0;
   int axis = 0;
+  std::string point;  // a tracked point's coordinate (axis 0..2): rms and noise in mm
   double rms_deg = kUnknown;
   double noise_deg = kUnknown;
   double effective_samples = kUnknown;

@@ -31,11 +31,14 @@ using internal::Show;
 
 const NumberFormat kRms = NumberFormat::Fixed(4);  // deg
 const NumberFormat kRatio = NumberFormat::Fixed(2);
+const NumberFormat kMm = NumberFormat::Fixed(2);  // tracked points
 const NumberFormat kPercent = NumberFormat::Fixed(1);
 const NumberFormat kValue = NumberFormat::Significant(6);
 
-std::string ChannelName(int joint, int axis) {
-  return "joint " + std::to_string(joint) + " " + AxisName(axis);
+std::string ChannelName(const internal::PredictionChannel& c) {
+  if (!c.point.empty())
+    return "point " + c.point + " " + std::string(1, static_cast<char>('x' + c.axis));
+  return "joint " + std::to_string(c.joint) + " " + AxisName(c.axis);
 }
 
 // ----------------------------------------------------------------- summary
@@ -57,11 +60,23 @@ Section SummarySection(const PredictionFolder& p) {
       ListNames(names) + ") with the model of " + p.model_source + " (" + p.model_kind +
       (p.free.empty() ? std::string() : "; fitted: " + ListNames(p.free)) +
       "; effects: " + (p.effects.empty() ? "none" : ListNames(p.effects)) + "). ";
+  std::string size;
+  if (std::isfinite(p.errors.rms_deg)) {
+    size = "the RMS error of the joint angles is " + Show(p.errors.rms_deg, kRms) +
+           " deg, the largest " + Show(p.errors.max_abs_deg, kRms) + " deg";
+  }
+  for (const PredictionRecording& r : p.recordings) {
+    for (std::size_t k = 0; k < r.points.size(); ++k) {
+      size += (size.empty() ? "the RMS error of " : ", of ") + r.name + "'s " + r.points[k] +
+              " is " + Show(r.point_rms_mm[k], kMm) + " mm (" +
+              Show(r.point_rms_mean_removed_mm[k], kMm) + " mm with the mean offset removed)";
+    }
+  }
   text +=
       "Each recording was simulated from its own recorded inputs and compared at its own "
-      "mocap frames as identification compares: the RMS error of the joint angles is " +
-      Show(p.errors.rms_deg, kRms) + " deg, the largest " + Show(p.errors.max_abs_deg, kRms) +
-      " deg, and the error in units of the measurement noise (identification's weighted "
+      "mocap frames as identification compares: " +
+      size +
+      ", and the error in units of the measurement noise (identification's weighted "
       "residual) has an RMS of " +
       Show(p.errors.weighted_rms, kRatio) + ": 1 is the noise floor. ";
   const std::string rule = "an RMS error above " + Show(p.above_noise_ratio, kRatio) +
@@ -79,8 +94,8 @@ Section SummarySection(const PredictionFolder& p) {
     });
     std::vector<std::string> named;
     for (std::size_t k = 0; k < worst.size() && k < 6; ++k) {
-      named.push_back(ChannelName(worst[k]->joint, worst[k]->axis) + " of " + worst[k]->recording +
-                      " (" + Show(worst[k]->rms_deg / worst[k]->noise_deg, NumberFormat::Fixed(1)) +
+      named.push_back(ChannelName(*worst[k]) + " of " + worst[k]->recording + " (" +
+                      Show(worst[k]->rms_deg / worst[k]->noise_deg, NumberFormat::Fixed(1)) +
                       " times its noise)");
     }
     text += Plural(static_cast<double>(p.above_noise.size()), "channel") +
@@ -125,8 +140,44 @@ Section SummarySection(const PredictionFolder& p) {
 
 // ------------------------------------------------ measured against predicted
 
+// A recording of tracked points: their paths measured and predicted, and
+// their errors.
+Section PointsSection(const PredictionRecording& r, const std::string& stem, bool several) {
+  Section section{
+      "points-" + stem,
+      several ? "Measured and predicted points: " + r.name : "Measured and predicted points",
+      {}};
+  std::string errors;
+  for (std::size_t p = 0; p < r.points.size(); ++p) {
+    errors += (p == 0 ? "" : "; ") + r.points[p] + ": RMS " + Show(r.point_rms_mm[p], kMm) +
+              " mm, " + Show(r.point_rms_mean_removed_mm[p], kMm) +
+              " mm with the mean offset removed";
+  }
+  const std::string placed =
+      r.placement_from == "fit" ? "placed in the capture frame as the fit placed its own recordings"
+      : r.placement_from.empty()
+          ? "recorded in the arm's frame"
+          : "placed in the capture frame by the rigid motion that fits this recording best "
+            "(the model gave none: six values fitted to the data compared)";
+  section.blocks.push_back(Paragraph{
+      "Recording " + r.name + " (" + r.path + "), from " + r.points_file +
+          ": the measured tracked points and those the model predicts from the recording's "
+          "inputs, " +
+          placed + ". " + errors + ".",
+      false});
+  section.blocks.push_back(FigureBlock{
+      internal::TrackedPointsFigure("points_" + stem, r.time_s, r.points, r.measured_mm,
+                                    r.predicted_mm, "predicted"),
+      "Tracked points: measured and predicted",
+      "Top left: the points' paths seen from above (x against y); then x, y and z against "
+      "time. Dashed: measured; solid: predicted.",
+      ""});
+  return section;
+}
+
 Section RecordingSection(const PredictionRecording& r, std::size_t index, bool several) {
   const std::string stem = FigureStem(several ? r.name + "_" + std::to_string(index + 1) : r.name);
+  if (!r.points.empty()) return PointsSection(r, stem, several);
   Section section{
       "angles-" + stem,
       several ? "Measured and predicted angles: " + r.name : "Measured and predicted angles",
@@ -257,7 +308,10 @@ Section ErrorSection(const PredictionFolder& p) {
                    {"fit_y_percent", "fit θy", "%", kPercent},
                    {"samples_x", "samples θx", "", NumberFormat::Integer()},
                    {"samples_y", "samples θy", "", NumberFormat::Integer()}};
-  for (const auto& j : p.errors.per_joint) {
+  // Recordings of tracked points only: no joint was measured.
+  const bool angles = std::isfinite(p.errors.rms_deg);
+  for (const auto& j :
+       angles ? p.errors.per_joint : std::vector<internal::PredictionErrors::Joint>{}) {
     table.AddRow({Cell::Number(j.joint), Cell::Number(j.rms_deg[0]), Cell::Number(j.max_abs_deg[0]),
                   Cell::Number(j.rms_deg[1]), Cell::Number(j.max_abs_deg[1]),
                   Cell::Number(j.noise_deg), Cell::Number(j.rms_over_noise[0]),
@@ -266,15 +320,16 @@ Section ErrorSection(const PredictionFolder& p) {
                   Cell::Number(j.fit_percent[1]), Cell::Number(j.samples[0]),
                   Cell::Number(j.samples[1])});
   }
-  section.blocks.push_back(FigureBlock{
-      ErrorFigure(p), "Error against the noise, per joint",
-      "RMS (blue) and largest (grey) prediction error of θx (left) and θy (right) per joint over "
-      "every recording; red: " +
-          Show(p.above_noise_ratio, kRatio) +
-          " times the joint's measurement noise. A blue bar above the red mark is a channel the "
-          "model does not predict to the noise floor.",
-      ""});
-  section.blocks.push_back(std::move(table));
+  if (angles)
+    section.blocks.push_back(FigureBlock{
+        ErrorFigure(p), "Error against the noise, per joint",
+        "RMS (blue) and largest (grey) prediction error of θx (left) and θy (right) per joint over "
+        "every recording; red: " +
+            Show(p.above_noise_ratio, kRatio) +
+            " times the joint's measurement noise. A blue bar above the red mark is a channel the "
+            "model does not predict to the noise floor.",
+        ""});
+  if (angles) section.blocks.push_back(std::move(table));
 
   Table above;
   above.id = "above_noise";
@@ -287,18 +342,18 @@ Section ErrorSection(const PredictionFolder& p) {
       "freedom (N_eff: the frames' worth of independent samples, after the measurement's "
       "filter), its p-value below the significance over the channels.";
   above.columns = {{"recording", "recording", "", kRms},
-                   {"joint", "joint", "", NumberFormat::Integer()},
-                   {"axis", "axis", "", kRms},
-                   {"rms_deg", "RMS", "deg", kRms},
-                   {"noise_deg", "noise", "deg", kRms},
+                   {"channel", "channel", "", kRms},
+                   {"unit", "unit", "", kRms},
+                   {"rms", "RMS", "", kRms},
+                   {"noise", "noise", "", kRms},
                    {"ratio", "RMS/noise", "", kRatio},
                    {"effective_samples", "N_eff", "", NumberFormat::Fixed(1)},
                    {"p_value", "p-value", "", NumberFormat::Significant(2)}};
   for (const internal::PredictionChannel& c : p.above_noise) {
-    above.AddRow({Cell::Text(c.recording), Cell::Number(c.joint), Cell::Text(AxisName(c.axis)),
-                  Cell::Number(c.rms_deg), Cell::Number(c.noise_deg),
-                  Cell::Number(c.rms_deg / c.noise_deg), Cell::Number(c.effective_samples),
-                  Cell::Number(c.p_value)});
+    above.AddRow({Cell::Text(c.recording), Cell::Text(ChannelName(c)),
+                  Cell::Text(c.point.empty() ? "deg" : "mm"), Cell::Number(c.rms_deg),
+                  Cell::Number(c.noise_deg), Cell::Number(c.rms_deg / c.noise_deg),
+                  Cell::Number(c.effective_samples), Cell::Number(c.p_value)});
   }
   if (!above.rows.empty()) section.blocks.push_back(std::move(above));
   return section;

@@ -11,12 +11,15 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <variant>
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/identify/experiment.h"
 #include "ccsrm/identify/identification.h"
+#include "ccsrm/identify/job.h"
 #include "ccsrm/identify/prediction.h"
 #include "ccsrm/mocap/pose_log.h"
+#include "ccsrm/reports/report.h"
 #include "shared_data.h"
 #include "synthetic_experiment.h"
 
@@ -103,6 +106,24 @@ TEST(TrackedPoints, AMarkerOnABodyTheArmLacksIsRefused) {
   }
 }
 
+TEST(TrackedPoints, TheLoopRefusesThemInOneLine) {
+  // Its diagnostics read joint angles: a recording of tracked points would
+  // be judged on none.
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / "ccsrm_tracked_points_loop.h5";
+  datasets::WriteExperimentFile(path.string(), TipRecording(0.2, 1));
+  LoopJobOptions job;
+  job.data = {path.string()};
+  job.runs.threads = 1;
+  try {
+    RunLoopJob(job);
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_THAT(error.what(),
+                HasSubstr(path.string() + ": /mocap/rigid_bodies: holds tracked points"));
+  }
+}
+
 // The fit recovers the truth from the tip alone, the capture frame's
 // placement estimated with every run: T_p within three of its standard
 // errors and 1 % (the bound of the fit from the joint angles,
@@ -178,6 +199,33 @@ TEST(TrackedPoints, RecoverThePretensionAndThePlacementOfTheCaptureFrame) {
   EXPECT_GT(r.points.rms_mm[0], 0.75 * std::sqrt(3.0) * kNoiseMm);
   EXPECT_LT(r.points.rms_mm[0], 1.25 * std::sqrt(3.0) * kNoiseMm);
   std::printf("prediction of another recording: tip RMS %.3f mm\n", r.points.rms_mm[0]);
+
+  // Both folders read back into their report pages: the points' section
+  // with its figure, and the tip's error in the summary.
+  const std::filesystem::path predicted_folder =
+      std::filesystem::temp_directory_path() / "ccsrm_tracked_points_pred";
+  std::filesystem::remove_all(predicted_folder);
+  WritePredictionDirectory(predicted, {other}, predicted_folder.string());
+  const reports::Document pages[] = {
+      reports::BuildFitDocument(folder.string(), {}),
+      reports::BuildPredictionDocument(predicted_folder.string(), {})};
+  for (const reports::Document& page : pages) {
+    bool points = false;
+    for (const reports::Section& section : page.sections) {
+      if (section.id.rfind("points-", 0) != 0) continue;
+      points = true;
+      bool figure = false;
+      for (const reports::Block& block : section.blocks)
+        figure = figure || std::holds_alternative<reports::FigureBlock>(block);
+      EXPECT_TRUE(figure) << page.kind;
+    }
+    EXPECT_TRUE(points) << page.kind;
+    std::string summary;
+    for (const reports::Block& block : page.sections[0].blocks) {
+      if (const auto* text = std::get_if<reports::Paragraph>(&block)) summary += text->text;
+    }
+    EXPECT_THAT(summary, HasSubstr("mm with the mean offset removed")) << page.kind;
+  }
   std::printf(
       "T_p %.4f N (truth %.1f), std error %.3g N; placement off by %.4f deg and %.4f mm; tip "
       "RMS %.3f -> %.3f mm (noise %.3f expected), path radius %.1f mm; %lld runs\n",
