@@ -343,8 +343,9 @@ class FitProblem {
     return r;
   }
 
-  // RMS of the unweighted residuals of the angles [deg], or of the tracked
-  // points' coordinates [mm] (`points`); NaN without any.
+  // RMS of the unweighted residuals of the angles [deg], or with `points`
+  // the tracked points' Euclidean RMS error [mm] (the sum of their three
+  // coordinates' squares over the points measured); NaN without any.
   double Rms(const std::vector<Eigen::MatrixXd>& simulated, bool points) const {
     double sum = 0.0;
     std::size_t n = 0;
@@ -357,7 +358,8 @@ class FitProblem {
           (points ? 1e3 : kDeg);
       sum += d * d;
     }
-    return n > 0 ? std::sqrt(sum / static_cast<double>(n)) : kNaN;
+    const double per = points ? static_cast<double>(n) / 3.0 : static_cast<double>(n);
+    return n > 0 ? std::sqrt(sum / per) : kNaN;
   }
 
   // N_eff of weighted residuals laid out as index(): every (experiment,
@@ -506,6 +508,7 @@ class IterationReporter final : public ceres::IterationCallback {
     const bool small = StepWithinStandardErrors(s.cost);
     const bool insignificant = DecreaseInsignificant(s.cost);
     previous_.assign(u_, u_ + problem_->num_free());
+    last_accepted_iteration_ = iterations_before_ + s.iteration;
     previous_cost_ = s.cost;
     if (small) stop_reason_ = StepRuleMessage(options_.converged_step_fraction);
     if (!small && insignificant) {
@@ -525,6 +528,10 @@ class IterationReporter final : public ceres::IterationCallback {
 
   // Why the callback stopped the fit; empty when it did not.
   const std::string& stop_reason() const { return stop_reason_; }
+  // The point of the last accepted step (the start before one), and the
+  // iteration that took it (0: none).
+  const std::vector<double>& last_accepted() const { return previous_; }
+  int last_accepted_iteration() const { return last_accepted_iteration_; }
   int iterations_before() const { return iterations_before_; }
   std::int64_t simulations_before() const { return simulations_before_; }
 
@@ -621,6 +628,7 @@ class IterationReporter final : public ceres::IterationCallback {
   int iterations_before_ = 0;
   std::int64_t simulations_before_ = 0;
   std::vector<double> previous_;
+  int last_accepted_iteration_ = 0;
   double previous_cost_ = 0.0;
   std::string stop_reason_;
 };
@@ -986,6 +994,14 @@ std::int64_t Minimise(FitProblem& problem, ceres::Problem& ceres_problem,
       progress.stop_reason().empty() ? ceres_summary.message : progress.stop_reason();
   if (summary->termination == IdentificationTermination::kFailed && !cost.last_failure().empty()) {
     summary->message += " (" + cost.last_failure() + ")";
+  }
+  // Ceres leaves a failed solve's parameters where they started: the fit
+  // reports the last point it accepted instead, where every run completed.
+  if (summary->termination == IdentificationTermination::kFailed &&
+      progress.last_accepted_iteration() > 0) {
+    *u = progress.last_accepted();
+    summary->message += "; the values are those of the last accepted iteration (" +
+                        std::to_string(progress.last_accepted_iteration()) + ")";
   }
   summary->iterations =
       progress.iterations_before() + static_cast<int>(ceres_summary.iterations.size()) - 1;

@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -60,6 +62,52 @@ TEST(Identification, RecoversThePretensionFromSettledPoses) {
   EXPECT_LE(std::abs(t_p->value - truth), 0.01 * truth) << t_p->value;
   std::printf("T_p %.4f N (truth %.1f), std error %.3g N, %lld runs\n", t_p->value, truth,
               t_p->std_error, static_cast<long long>(s.simulations));
+}
+
+// A backend whose `fail`-th run fails (a replay that finds no settled pose
+// at one parameter value); the others run on this machine.
+class FailingBackend final : public SimulationBackend {
+ public:
+  FailingBackend(const std::vector<Experiment>* experiments, std::size_t fail)
+      : inner_(MakeThreadBackend(experiments, 1)), fail_(fail) {}
+  std::vector<RunResult> RunBatch(const std::vector<RunRequest>& requests,
+                                  const RunFinishedCallback& on_finished) override {
+    std::vector<RunResult> results = inner_->RunBatch(requests, on_finished);
+    for (RunResult& r : results) {
+      if (++runs_ != fail_) continue;
+      r.summary.status = sim::SimulationStatus::kDiverged;
+      r.summary.message = "no settled pose (test)";
+      r.simulated.setConstant(std::numeric_limits<double>::quiet_NaN());
+    }
+    return results;
+  }
+  int parallelism() const override { return 1; }
+
+ private:
+  std::unique_ptr<SimulationBackend> inner_;
+  std::size_t fail_ = 0, runs_ = 0;
+};
+
+// A fit one of whose finite-difference runs fails after it has accepted a
+// step (its sixth run here: a derivative after the first accepted step)
+// reports the last point it accepted (Ceres leaves a failed solve's
+// parameters at the start): the work done is not lost, and the fit still
+// says it failed.
+TEST(Identification, AFitWhoseRunsFailKeepsItsLastAcceptedPoint) {
+  const std::vector<Experiment> experiments = {
+      MakeExperiment(Record(Truth(), 0.03, 11, testing_support::Nominal(), 0.0, 0.25), "settled.h5",
+                     ExperimentLoadOptions())};
+  IdentificationOptions o;
+  o.free_parameters = {"T_p"};
+  o.threads = 1;
+  o.backend = std::make_shared<FailingBackend>(&experiments, 6);
+  const IdentificationSummary s = Identify(experiments, o);
+  EXPECT_EQ(s.termination, IdentificationTermination::kFailed);
+  EXPECT_THAT(s.message, HasSubstr("the values are those of the last accepted iteration"));
+  const ParameterEstimate* t_p = s.Find("T_p");
+  ASSERT_NE(t_p, nullptr);
+  // From the nominal 50 N towards the truth's 65 N.
+  EXPECT_GT(t_p->value, t_p->start + 1.0) << s.message;
 }
 
 // A backend that only counts what it is asked to run.

@@ -29,13 +29,8 @@ namespace {
 using ::testing::HasSubstr;
 using testing_support::Nominal;
 using testing_support::Record;
+using testing_support::Truth;  // T_p 65 N against the nominal 50
 
-// The truth of the settled-pose fits: T_p 65 N against the nominal 50.
-sim::ArmParameters Truth() {
-  sim::ArmParameters p = Nominal().parameters;
-  p.T_p = 65.0;
-  return p;
-}
 
 // The capture frame of the recordings: 20 deg about a tilted axis, 0.3 m
 // away from W.

@@ -70,7 +70,7 @@ struct IterationProgress {
   int iteration = 0;
   double cost = 0.0;               // 1/2 Σ r², r in units of the noise
   double rms_deg = 0.0;            // of the angles; NaN without measured angles
-  double rms_mm = 0.0;             // of tracked points' coordinates; NaN without any
+  double rms_mm = 0.0;             // tracked points' Euclidean RMS error; NaN without any
   double relative_decrease = 0.0;  // of the cost, this iteration (0 at the start)
   double trust_region_radius = 0.0;
   bool step_accepted = true;
