@@ -522,7 +522,9 @@ class SettledPoseLoop {
   }
 
   void CheckCancellationAndReport() {
-    const std::string stop = control_.Check(t_, steps_, 0);
+    // A lead-in's times precede the record's (at 0): its progress is the
+    // start's.
+    const std::string stop = control_.Check(std::max(t_, 0.0), steps_, 0);
     if (stop.empty() || !running_) return;
     running_ = false;
     cancelled_ = true;
