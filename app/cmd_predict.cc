@@ -27,6 +27,7 @@ int RunPredict(const PredictArgs& a) {
   job.effects_path = a.effects;
   job.config_path = a.config;
   job.noise_deg = NoiseOption(a.noise_deg);
+  job.point_noise_mm = a.point_noise_mm;
   job.threads = a.threads;
   job.out = a.out;
   job.reporting = TerminalReporting(a.quiet, "");

@@ -17,6 +17,12 @@ void AddJobOptions(CLI::App* command, JobArgs* args) {
                    "Measurement noise of the joint angles [deg] (default: estimated per joint "
                    "from the measured twist)")
       ->check(Above(0.0, "deg"));
+  command
+      ->add_option("--point-noise-mm", args->point_noise_mm,
+                   "Measurement noise of a tracked point's coordinates [mm] (experiments of "
+                   "tracked points, e.g. a pose log's tip)")
+      ->default_val(args->point_noise_mm)
+      ->check(Above(0.0, "mm"));
   command->add_option("--out", args->out, "Output folder")->required();
   command->add_flag("--quiet", args->quiet, "No progress lines");
 }
@@ -38,6 +44,7 @@ void FillFitJob(const JobArgs& args, const std::string& indent, identify::FitJob
   }
   job->max_iterations = args.max_iterations;
   job->noise_deg = NoiseOption(args.noise_deg);
+  job->point_noise_mm = args.point_noise_mm;
   job->runs = {args.threads, args.run_timeout_s};
   job->out = args.out;
   job->resume = args.resume;

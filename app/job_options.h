@@ -19,13 +19,14 @@ struct JobArgs {
   int max_iterations = identify::IdentificationOptions().max_iterations;
   int threads = identify::DefaultThreads();
   double noise_deg = 0.0;  // 0: estimated
+  double point_noise_mm = identify::ExperimentLoadOptions().point_noise_mm;
   std::string out;
   bool quiet = false;
   double run_timeout_s = identify::MpiOptions().run_timeout_s;
   bool resume = false;
 };
 
-// --threads, --noise-deg, --out and --quiet, with their help (--data,
+// --threads, --noise-deg, --point-noise-mm, --out and --quiet, with their help (--data,
 // --free and --resume differ by command).
 void AddJobOptions(CLI::App* command, JobArgs* args);
 

@@ -115,11 +115,12 @@ void ApplyFitJob(const FitJobOptions& job, IdentificationOptions* fit) {
 }  // namespace internal
 
 std::vector<Experiment> LoadExperiments(const std::vector<std::string>& paths,
-                                        std::optional<double> noise_deg, const char* role,
-                                        const std::string& config_path,
+                                        std::optional<double> noise_deg, double point_noise_mm,
+                                        const char* role, const std::string& config_path,
                                         const std::function<void(const std::string&)>& line) {
   ExperimentLoadOptions load;
   load.noise_deg = noise_deg;
+  load.point_noise_mm = point_noise_mm;
   // The configuration given is parsed here, once for every experiment (its
   // own errors first, naming it).
   if (!config_path.empty())

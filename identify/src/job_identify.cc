@@ -14,9 +14,11 @@ namespace {
 std::string ResultOptions(const IdentifyJobOptions& o) {
   const std::vector<std::string>* free = o.parameters.free ? &*o.parameters.free : nullptr;
   return "free=" + DigestText(free, "(default)") + "\nsets=" + DigestText(o.parameters.values) +
-         Format("\nmax_iterations=%d relative_step=%.17g noise_deg=%.17g central=%d",
-                o.max_iterations, o.relative_step, o.noise_deg.value_or(0.0),
-                o.central_differences_throughout ? 1 : 0);
+         Format(
+             "\nmax_iterations=%d relative_step=%.17g noise_deg=%.17g central=%d "
+             "point_noise_mm=%.17g",
+             o.max_iterations, o.relative_step, o.noise_deg.value_or(0.0),
+             o.central_differences_throughout ? 1 : 0, o.point_noise_mm);
 }
 
 }  // namespace
@@ -51,7 +53,8 @@ IdentifyJobResult RunIdentifyJob(const IdentifyJobOptions& job) {
   }
 
   IdentifyJobResult result;
-  result.experiments = LoadExperiments(job.data, job.noise_deg, "experiment", "", say);
+  result.experiments =
+      LoadExperiments(job.data, job.noise_deg, job.point_noise_mm, "experiment", "", say);
   const auto backends = JobBackends({&result.experiments}, job.runs, say);
   if (backends.empty()) {  // another rank of an MPI job: it served rank 0's runs
     result.served = true;

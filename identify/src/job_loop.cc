@@ -20,8 +20,8 @@ std::string ResultOptions(const LoopJobOptions& o) {
   return Format("data=%zu holdout=%zu", o.data.size(), o.holdout.size()) +
          "\ncandidates=" + DigestText(candidates, "(default)") +
          "\nfree=" + DigestText(free, "(default)") + "\nsets=" + DigestText(o.parameters.values) +
-         Format("\nmax_rounds=%d max_iterations=%d noise_deg=%.17g", o.max_rounds, o.max_iterations,
-                o.noise_deg.value_or(0.0));
+         Format("\nmax_rounds=%d max_iterations=%d noise_deg=%.17g point_noise_mm=%.17g",
+                o.max_rounds, o.max_iterations, o.noise_deg.value_or(0.0), o.point_noise_mm);
 }
 
 std::string JournalPath(const std::string& out) {
@@ -58,8 +58,10 @@ LoopJobResult RunLoopJob(const LoopJobOptions& job) {
   }
 
   LoopJobResult result;
-  result.training = LoadExperiments(job.data, job.noise_deg, "training", job.config_path, say);
-  result.holdout = LoadExperiments(job.holdout, job.noise_deg, "held out", job.config_path, say);
+  result.training = LoadExperiments(job.data, job.noise_deg, job.point_noise_mm, "training",
+                                    job.config_path, say);
+  result.holdout = LoadExperiments(job.holdout, job.noise_deg, job.point_noise_mm, "held out",
+                                   job.config_path, say);
   // The loop's diagnostics and its effects' evidence read joint angles.
   for (const std::vector<Experiment>* set : {&result.training, &result.holdout}) {
     for (const Experiment& e : *set) {

@@ -22,7 +22,8 @@ PredictJobResult RunPredictJob(const PredictJobOptions& job) {
     model.effects.push_back({ReadTextFile(job.effects_path), job.effects_path});
   }
   PredictJobResult result;
-  result.recordings = LoadExperiments(job.data, job.noise_deg, "recording", job.config_path, say);
+  result.recordings = LoadExperiments(job.data, job.noise_deg, job.point_noise_mm, "recording",
+                                      job.config_path, say);
   say(Format("predicting %zu recording%s with %s (%s) on %d thread%s\n", result.recordings.size(),
              Plural(result.recordings.size()), model.source.c_str(), model.kind.c_str(),
              options.threads, Plural(static_cast<std::size_t>(options.threads))));

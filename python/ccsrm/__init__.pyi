@@ -312,6 +312,7 @@ def identify(
     max_iterations: int = 30,
     relative_step: float = 0.01,
     noise_deg: float | None = None,
+    point_noise_mm: float = 0.5,
     central_throughout: bool = False,
     out: _Path | None = None,
     resume: bool = False,

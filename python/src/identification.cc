@@ -101,6 +101,7 @@ py::dict IterationDict(const identify::IterationProgress& p) {
   d["iteration"] = p.iteration;
   d["cost"] = p.cost;
   d["rms_deg"] = p.rms_deg;
+  d["rms_mm"] = p.rms_mm;
   d["step_accepted"] = p.step_accepted;
   d["simulations"] = p.simulations;
   d["wall_time_s"] = p.wall_time_s;
@@ -174,10 +175,11 @@ std::shared_ptr<Fit> RunIdentify(const py::object& data, const py::object& free,
                                  const py::object& params, const py::object& set,
                                  std::optional<int> threads, int max_iterations,
                                  double relative_step, std::optional<double> noise_deg,
-                                 bool central_throughout, const py::object& out, bool resume,
-                                 const py::object& progress) {
+                                 double point_noise_mm, bool central_throughout,
+                                 const py::object& out, bool resume, const py::object& progress) {
   identify::IdentifyJobOptions job;
   FillFitJob(data, free, params, set, threads, max_iterations, noise_deg, out, resume, &job);
+  job.point_noise_mm = point_noise_mm;
   job.relative_step = relative_step;
   job.central_differences_throughout = central_throughout;
   ProgressRelay relay(progress);
@@ -301,16 +303,20 @@ void AddIdentification(py::module_& m) {
         py::arg("threads") = py::none(),
         py::arg("max_iterations") = identify::IdentificationOptions().max_iterations,
         py::arg("relative_step") = identify::IdentificationOptions().relative_step,
-        py::arg("noise_deg") = py::none(), py::arg("central_throughout") = false,
-        py::arg("out") = py::none(), py::arg("resume") = false, py::arg("progress") = py::none(),
+        py::arg("noise_deg") = py::none(),
+        py::arg("point_noise_mm") = identify::ExperimentLoadOptions().point_noise_mm,
+        py::arg("central_throughout") = false, py::arg("out") = py::none(),
+        py::arg("resume") = false, py::arg("progress") = py::none(),
         "Fits parameters to recorded experiments as `ccsrm identify` does, with its options: "
         "data (one or more ccsrm-dataset/1 files), free (names, a list or 'mu,T_p'; default "
         "SPEC 6's nine), params (a parameter file), set (dict or 'name=value' strings), "
         "threads (default every core), max_iterations, relative_step, noise_deg (default "
-        "estimated), central_throughout, out (also write the fit folder, under the command's "
+        "estimated), point_noise_mm (of tracked points' coordinates), central_throughout, out "
+        "(also write the fit folder, under the command's "
         "output policy: an earlier fit folder is replaced, anything else refused), resume "
         "(continue the fit stopped in out from its checkpoint), progress (called "
-        "after every iteration with a dict: iteration, cost, rms_deg, step_accepted, "
+        "after every iteration with a dict: iteration, cost, rms_deg, rms_mm (tracked points; "
+        "NaN without), step_accepted, "
         "simulations, wall_time_s, values). Returns a Fit. The "
         "GIL is released during the fit.");
   py::class_<Loop, std::shared_ptr<Loop>>(

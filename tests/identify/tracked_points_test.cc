@@ -31,7 +31,6 @@ using testing_support::Nominal;
 using testing_support::Record;
 using testing_support::Truth;  // T_p 65 N against the nominal 50
 
-
 // The capture frame of the recordings: 20 deg about a tilted axis, 0.3 m
 // away from W.
 Eigen::Matrix3d CaptureRotation() {
@@ -117,6 +116,24 @@ TEST(TrackedPoints, TheLoopRefusesThemInOneLine) {
     EXPECT_THAT(error.what(),
                 HasSubstr(path.string() + ": /mocap/rigid_bodies: holds tracked points"));
   }
+}
+
+TEST(TrackedPoints, TheirNoiseIsGivenToEveryJob) {
+  // `--point-noise-mm` of identify and predict (and Python's point_noise_mm):
+  // the weight of every tracked point's residual, said in the load line.
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / "ccsrm_tracked_points_noise.h5";
+  datasets::WriteExperimentFile(path.string(), TipRecording(0.2, 1));
+  std::string said;
+  const std::vector<Experiment> loaded =
+      LoadExperiments({path.string()}, std::nullopt, 0.2, "experiment", "",
+                      [&said](const std::string& line) { said += line; });
+  ASSERT_EQ(loaded.size(), 1u);
+  EXPECT_EQ(loaded[0].point_noise_mm, 0.2);
+  EXPECT_THAT(said, HasSubstr("1 tracked point, noise 0.2 mm"));
+  // 1 mm of error is 5 of its noise.
+  const Eigen::Index x = 2 * loaded[0].joints;
+  EXPECT_NEAR(loaded[0].WeightedResidual(0, x, loaded[0].measured(0, x) + 1e-3), 5.0, 1e-9);
 }
 
 // The fit recovers the truth from the tip alone, the capture frame's

@@ -78,6 +78,9 @@ struct FitJobOptions {
   int max_iterations = IdentificationOptions().max_iterations;  // per fit
   // Measurement noise of the joint angles [deg]; unset: estimated per joint.
   std::optional<double> noise_deg;
+  // Measurement noise of tracked points' coordinates [mm]
+  // (ExperimentLoadOptions::point_noise_mm).
+  double point_noise_mm = ExperimentLoadOptions().point_noise_mm;
   JobRuns runs;
   // The job's folder; empty: not written (then no checkpoint or journal
   // either).
@@ -184,6 +187,7 @@ struct PredictJobOptions {
   std::string effects_path;  // effects switched on over the model; empty: none
   std::string config_path;   // instead of each recording's own; empty: none
   std::optional<double> noise_deg;
+  double point_noise_mm = ExperimentLoadOptions().point_noise_mm;  // as FitJobOptions'
   int threads = PredictionOptions().threads;
   std::string out;  // the prediction folder; empty: not written
   JobReporting reporting;
@@ -205,15 +209,15 @@ OutputKind LoopFolderOutput();        // loop.json, ccsrm-loop/1
 OutputKind PredictionFolderOutput();  // pred.json, ccsrm-prediction/1
 OutputKind DesignFolderOutput();      // design.json, ccsrm-design/1
 
-// Loads each experiment (ExperimentLoadOptions) and reports one line about
+// Loads each experiment (ExperimentLoadOptions: the given noises) and reports one line about
 // it through `line` (and the mocap pipeline's when it computed the angles).
 // `role` begins the line ("experiment", "held out"). With `config_path`,
 // every experiment uses that arm instead of its own config_yaml: the file is
 // parsed here once for all of them (ExperimentLoadOptions::config), its own
 // errors first, naming it.
 std::vector<Experiment> LoadExperiments(const std::vector<std::string>& paths,
-                                        std::optional<double> noise_deg, const char* role,
-                                        const std::string& config_path,
+                                        std::optional<double> noise_deg, double point_noise_mm,
+                                        const char* role, const std::string& config_path,
                                         const std::function<void(const std::string&)>& line);
 
 // The backends of the experiment sets (ShareRuns): every rank of an MPI job
