@@ -199,9 +199,8 @@ std::shared_ptr<Fit> RunIdentify(const py::object& data, const py::object& free,
   return fit;
 }
 
-}  // namespace
-
-void AddIdentification(py::module_& m) {
+// ParameterEstimate and Fit, what ccsrm.identify returns.
+void AddFitClasses(py::module_& m) {
   using identify::ParameterEstimate;
   py::class_<ParameterEstimate>(m, "ParameterEstimate", "One parameter of a fit.")
       .def_readonly("name", &ParameterEstimate::name)
@@ -297,28 +296,10 @@ void AddIdentification(py::module_& m) {
           "folder is replaced only when it is an earlier fit folder holding nothing but what "
           "ccsrm wrote, or with overwrite=True.")
       .def("__repr__", [](const Fit& f) { return "<ccsrm.Fit " + f.summary.BriefReport() + ">"; });
+}
 
-  m.def("identify", &RunIdentify, py::arg("data"), py::kw_only(), py::arg("free") = py::none(),
-        py::arg("params") = py::none(), py::arg("set") = py::none(),
-        py::arg("threads") = py::none(),
-        py::arg("max_iterations") = identify::IdentificationOptions().max_iterations,
-        py::arg("relative_step") = identify::IdentificationOptions().relative_step,
-        py::arg("noise_deg") = py::none(),
-        py::arg("point_noise_mm") = identify::ExperimentLoadOptions().point_noise_mm,
-        py::arg("central_throughout") = false, py::arg("out") = py::none(),
-        py::arg("resume") = false, py::arg("progress") = py::none(),
-        "Fits parameters to recorded experiments as `ccsrm identify` does, with its options: "
-        "data (one or more ccsrm-dataset/1 files), free (names, a list or 'mu,T_p'; default "
-        "SPEC 6's nine), params (a parameter file), set (dict or 'name=value' strings), "
-        "threads (default every core), max_iterations, relative_step, noise_deg (default "
-        "estimated), point_noise_mm (of tracked points' coordinates), central_throughout, out "
-        "(also write the fit folder, under the command's "
-        "output policy: an earlier fit folder is replaced, anything else refused), resume "
-        "(continue the fit stopped in out from its checkpoint), progress (called "
-        "after every iteration with a dict: iteration, cost, rms_deg, rms_mm (tracked points; "
-        "NaN without), step_accepted, "
-        "simulations, wall_time_s, values). Returns a Fit. The "
-        "GIL is released during the fit.");
+// ccsrm.Loop and ccsrm.loop.
+void AddLoop(py::module_& m) {
   py::class_<Loop, std::shared_ptr<Loop>>(
       m, "Loop",
       "The result of ccsrm.loop: the declared model's fit, the effects added round by round "
@@ -391,6 +372,34 @@ void AddIdentification(py::module_& m) {
         "command's output policy), resume (run again over the journal of the loop stopped in "
         "out), progress (called with each progress line). Returns a Loop. The GIL is "
         "released while it runs.");
+}
+
+}  // namespace
+
+void AddIdentification(py::module_& m) {
+  AddFitClasses(m);
+  m.def("identify", &RunIdentify, py::arg("data"), py::kw_only(), py::arg("free") = py::none(),
+        py::arg("params") = py::none(), py::arg("set") = py::none(),
+        py::arg("threads") = py::none(),
+        py::arg("max_iterations") = identify::IdentificationOptions().max_iterations,
+        py::arg("relative_step") = identify::IdentificationOptions().relative_step,
+        py::arg("noise_deg") = py::none(),
+        py::arg("point_noise_mm") = identify::ExperimentLoadOptions().point_noise_mm,
+        py::arg("central_throughout") = false, py::arg("out") = py::none(),
+        py::arg("resume") = false, py::arg("progress") = py::none(),
+        "Fits parameters to recorded experiments as `ccsrm identify` does, with its options: "
+        "data (one or more ccsrm-dataset/1 files), free (names, a list or 'mu,T_p'; default "
+        "SPEC 6's nine), params (a parameter file), set (dict or 'name=value' strings), "
+        "threads (default every core), max_iterations, relative_step, noise_deg (default "
+        "estimated), point_noise_mm (of tracked points' coordinates), central_throughout, out "
+        "(also write the fit folder, under the command's "
+        "output policy: an earlier fit folder is replaced, anything else refused), resume "
+        "(continue the fit stopped in out from its checkpoint), progress (called "
+        "after every iteration with a dict: iteration, cost, rms_deg, rms_mm (tracked points; "
+        "NaN without), step_accepted, "
+        "simulations, wall_time_s, values). Returns a Fit. The "
+        "GIL is released during the fit.");
+  AddLoop(m);
   m.def("default_threads", &identify::DefaultThreads, "Simulations at a time by default.");
 }
 
