@@ -26,8 +26,17 @@ constexpr double kKeepJacobianContraction = 0.7;
 // taken as converged (about 2e-8 m).
 constexpr double kStallTolerance = 10.0;
 // Forward-difference steps: sqrt(machine epsilon) of the coordinate's
-// size, at least of 1 cm.
+// size, at least of 1 cm; on the cables' coordinates a tenth of a
+// picometre. An element's stiffness rises from the weak 1e-4 EA at zero
+// strain at a curvature of 4 EA over the toe (1e-4 of strain), so a step's
+// strain must stay far below 1e-8 for the difference to see the stiffness
+// at the point: sqrt(eps) of a coordinate (1e-9 m over millimetre
+// elements, a strain of 1e-6) measured 200 times the weak stiffness there,
+// and Newton's corrections on a cable going slack pointed nowhere. The
+// step's rounding (positions of 0.3 m to 6e-17 m) costs a relative 1e-3
+// on a taut element's entries.
 constexpr double kDifferenceStep = 1.5e-8;
+constexpr double kCableDifferenceStepM = 1e-13;
 // The active set of the contacts' branches: at most this many passes, and
 // a slip against a contact's branch by less than this [m] (the solves'
 // accuracy) is none.
@@ -208,6 +217,7 @@ SettledPoseSolver::SettledPoseSolver(const ArmModel& model, ArmDynamics* dynamic
       element_material_.emplace_back(model.node_offset(c, e) + 3, model.node_offset(c, e + 1) + 3);
   }
   lu_.analyzePattern(jacobian_);
+  cable_columns_ = model.num_links() > 0 ? model.link_offset(1) : n_;
 }
 
 bool SettledPoseSolver::Residual(double t, const SettledFriction& from, const Eigen::VectorXd& x,
@@ -241,7 +251,8 @@ bool SettledPoseSolver::ComputeJacobian(double t, const SettledFriction& from,
   for (const std::vector<int>& colour : colours_) {
     perturbed_ = x;
     for (int c : colour) {
-      perturbed_[c] += kDifferenceStep * std::max(std::abs(x[c]), 1e-2);
+      perturbed_[c] += c < cable_columns_ ? kCableDifferenceStepM
+                                          : kDifferenceStep * std::max(std::abs(x[c]), 1e-2);
       step[c] = perturbed_[c] - x[c];  // the step as represented
     }
     if (!Residual(t, from, perturbed_, &r_try_)) return false;

@@ -97,6 +97,8 @@ class SettledPoseSolver {
   // Per cable element, the material coordinates' columns of its two nodes
   // (a step may shorten an element's material by at most half).
   std::vector<std::pair<int, int>> element_material_;
+  // The cables' coordinates are the first columns (kCableDifferenceStepM).
+  int cable_columns_ = 0;
   // The Jacobian is unsymmetric and indefinite (a saddle point in the
   // multipliers). Eigen's supernodal LU with COLAMD: on the robot's arm
   // (3 400 unknowns) 3.5x faster than SuiteSparse's KLU through Eigen.

@@ -59,7 +59,10 @@ TEST(SettledPoseSolver, ColouredJacobianIsTheDenseFiniteDifferenceOne) {
   double largest = 0.0, worst_difference = 0.0;
   for (int c = 0; c < size; ++c) {
     Eigen::VectorXd xc = x;
-    const double step = 1.5e-8 * std::max(std::abs(x[c]), c < n ? 1e-2 : 1.0);
+    // The solver's steps: a picometre on the cables' coordinates, sqrt(eps)
+    // of the size elsewhere.
+    const double step =
+        c < model.link_offset(1) ? 1e-13 : 1.5e-8 * std::max(std::abs(x[c]), c < n ? 1e-2 : 1.0);
     xc[c] += step;
     ASSERT_TRUE(dynamics.SettledResidual(t, xc.data(), from, perturbed.data()));
     const Eigen::VectorXd column = (perturbed - base) / (xc[c] - x[c]);
@@ -72,6 +75,56 @@ TEST(SettledPoseSolver, ColouredJacobianIsTheDenseFiniteDifferenceOne) {
   // The point of the pattern: far fewer residuals than columns.
   EXPECT_LT(solver.num_colours(), size / 5);
   std::printf("%d unknowns in %d colours\n", size, solver.num_colours());
+}
+
+TEST(SettledPoseSolver, ForwardDifferencesResolveTheToeOfACableAtTheVergeOfSlack) {
+  // A cable just taut (every element at zero strain), where its elements'
+  // stiffness is the settled residual's weak one (1e-4 EA) and rises into
+  // the slack toe (1e-4 of strain) at a curvature of 4 EA / toe. A
+  // difference step of sqrt(eps) of a coordinate (1.5e-9 m on
+  // millimetre elements, a strain of 1e-6) would see a stiffness of 2e-2
+  // EA, two hundred times the true one, and Newton's corrections on a
+  // cable going slack would point nowhere (the robot's log, issue 46). The
+  // Jacobian's material columns must match the residual's central
+  // differences to a tenth of the weak stiffness.
+  Config config = test_support::SmallArm(5);
+  UsePreslidingFriction(&config.solver);
+  const ArmModel model(config.arm);
+  const CableInputs inputs = test_support::PullAndHold(model, 0, 1e-3, 1.0, 2.0);
+  internal::ArmDynamics dynamics(model, config.parameters, inputs, config.solver);
+  internal::SettledPoseSolver solver(model, &dynamics);
+  const int n = dynamics.num_coordinates(), size = solver.size();
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(size);
+  x.head(n) = dynamics.InitialState().head(n);
+  const int cable = 0, nodes = static_cast<int>(model.cables()[cable].nodes.size());
+  double shortest = 1.0;
+  for (int k = 1; k < nodes; ++k) {
+    const int a = model.node_offset(cable, k - 1), b = model.node_offset(cable, k);
+    x[b + 3] = x[a + 3] + (x.segment<3>(b) - x.segment<3>(a)).norm();
+    shortest = std::min(shortest, x[b + 3] - x[a + 3]);
+  }
+  const internal::SettledFriction from = dynamics.InitialSettledFriction();
+  ASSERT_TRUE(solver.ComputeJacobian(0.0, from, x)) << solver.failure();
+  const Eigen::MatrixXd jacobian = Eigen::MatrixXd(solver.jacobian());
+  const double ea = config.arm.driving.youngs_modulus_pa * config.arm.driving.cross_section_m2;
+  const double weak = internal::ArmDynamics::kSettledElementStiffness * ea / shortest;
+  Eigen::VectorXd plus(size), minus(size);
+  double worst = 0.0;
+  for (int k = 0; k < nodes; ++k) {
+    const int c = model.node_offset(cable, k) + 3;
+    // A strain of 1e-10 each way: the toe's force there is 1e-6 of the
+    // weak one's slope over the step.
+    constexpr double kStep = 1e-13;
+    Eigen::VectorXd xc = x;
+    xc[c] = x[c] + kStep;
+    ASSERT_TRUE(dynamics.SettledResidual(0.0, xc.data(), from, plus.data()));
+    xc[c] = x[c] - kStep;
+    ASSERT_TRUE(dynamics.SettledResidual(0.0, xc.data(), from, minus.data()));
+    const Eigen::VectorXd column = (plus - minus) / (2.0 * kStep);
+    worst = std::max(worst, (column - jacobian.col(c)).head(n).cwiseAbs().maxCoeff());
+  }
+  std::printf("worst material entry off by %.3g N/m; weak stiffness %.3g N/m\n", worst, weak);
+  EXPECT_LE(worst, 0.1 * weak);
 }
 
 TEST(SettledPoseSolver, EquilibriumOfSlackCablesIsRegular) {
