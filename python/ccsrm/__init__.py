@@ -44,6 +44,8 @@ from ._core import (  # noqa: F401  (the public API)
     load_config,
     loop,
     parameter_table,
+    predict,
+    Prediction,
     process_markers,
     read_dataset,
     read_markers,

@@ -1,6 +1,6 @@
-// ccsrm.identify and ccsrm.loop: `ccsrm identify` and `ccsrm loop` from
-// Python (identify::Identify and identify::CloseLoop on experiments loaded by
-// identify::LoadExperiment), their summaries and JSON.
+// ccsrm.identify, ccsrm.loop and ccsrm.predict: `ccsrm identify`, `ccsrm
+// loop` and `ccsrm predict` from Python (their jobs, identify/job.h), their
+// summaries and JSON.
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
@@ -109,6 +109,12 @@ py::dict IterationDict(const identify::IterationProgress& p) {
   return d;
 }
 
+// A prediction and the recordings it predicted.
+struct Prediction {
+  identify::PredictionSummary summary;
+  std::vector<identify::Experiment> recordings;
+};
+
 // A loop and the experiments it ran on.
 struct Loop {
   identify::LoopSummary summary;
@@ -169,6 +175,27 @@ std::shared_ptr<Loop> RunLoop(const py::object& data, const py::object& holdout,
   }
   relay.RaiseIfFailed();
   return loop;
+}
+
+std::shared_ptr<Prediction> RunPredict(const py::object& data, const py::object& params,
+                                       const py::object& effects, const py::object& config,
+                                       std::optional<int> threads, std::optional<double> noise_deg,
+                                       double point_noise_mm, const py::object& out) {
+  identify::PredictJobOptions job;
+  job.data = Paths(data);
+  job.params_path = PathString(params);
+  job.effects_path = OptionalPath(effects);
+  job.config_path = OptionalPath(config);
+  if (threads) job.threads = *threads;
+  job.noise_deg = noise_deg;
+  job.point_noise_mm = point_noise_mm;
+  job.out = OptionalPath(out);
+  auto prediction = std::make_shared<Prediction>();
+  py::gil_scoped_release release;
+  identify::PredictJobResult r = identify::RunPredictJob(job);
+  prediction->summary = std::move(r.summary);
+  prediction->recordings = std::move(r.recordings);
+  return prediction;
 }
 
 std::shared_ptr<Fit> RunIdentify(const py::object& data, const py::object& free,
@@ -374,6 +401,90 @@ void AddLoop(py::module_& m) {
         "released while it runs.");
 }
 
+// ccsrm.Prediction and ccsrm.predict.
+void AddPrediction(py::module_& m) {
+  const auto json_dict = [](const Prediction& p) {
+    return py::module_::import("json").attr("loads")(identify::ToJson(p.summary).dump());
+  };
+  py::class_<Prediction, std::shared_ptr<Prediction>>(
+      m, "Prediction",
+      "The result of ccsrm.predict: each recording simulated from its own inputs with the "
+      "model and compared as identification compares, with pred.json.")
+      .def_property_readonly("completed", [](const Prediction& p) { return p.summary.completed; })
+      .def_property_readonly(
+          "message", [](const Prediction& p) { return p.summary.message; },
+          "'every run completed', or the first run that did not, '<recording>: <why>'.")
+      .def_property_readonly(
+          "adequate", [](const Prediction& p) { return p.summary.adequacy.adequate(); },
+          "Whether the model explains the recordings (no channel above its noise).")
+      .def_property_readonly("verdict",
+                             [](const Prediction& p) { return p.summary.adequacy.Verdict(); })
+      .def_property_readonly(
+          "rms_deg", [](const Prediction& p) { return p.summary.errors.channels.rms_deg_overall; },
+          "RMS error of the predicted joint angles over every recording [deg] (NaN without "
+          "angles).")
+      .def_property_readonly(
+          "weighted_rms", [](const Prediction& p) { return p.summary.errors.weighted_rms; },
+          "RMS of the residuals over their noise, 1 at the noise floor.")
+      .def_property_readonly(
+          "tracked_points",
+          [](const Prediction& p) {
+            py::dict d;
+            for (const identify::RecordingPrediction& r : p.summary.recordings) {
+              if (r.tracked_points.empty()) continue;
+              py::dict e;
+              e["rms_mm"] = r.points.rms_mm;
+              e["rms_mean_removed_mm"] = r.points.rms_mean_removed_mm;
+              e["placement_from_fit"] = r.placement_from_fit;
+              d[py::str(r.name)] = e;
+            }
+            return d;
+          },
+          "Per recording of tracked points: the points' RMS error [mm], the same with the mean "
+          "offset removed (the publishing project's metric) and whether the capture placement "
+          "came from the fit.")
+      .def_property_readonly("simulations",
+                             [](const Prediction& p) { return p.summary.simulations; })
+      .def_property_readonly("wall_time_s",
+                             [](const Prediction& p) { return p.summary.wall_time_s; })
+      .def("brief_report", [](const Prediction& p) { return p.summary.BriefReport(); })
+      .def(
+          "full_report", [](const Prediction& p) { return p.summary.FullReport(); },
+          "The report `ccsrm predict` prints.")
+      .def(
+          "json", [](const Prediction& p) { return identify::ToJson(p.summary).dump(2) + "\n"; },
+          "pred.json's summary (schema ccsrm-prediction/1).")
+      .def("to_dict", json_dict, "json() as a dict.")
+      .def(
+          "write",
+          [](const Prediction& p, const py::object& directory, bool overwrite) {
+            const std::string dir = PathString(directory);
+            CheckWriterPath(dir, identify::PredictionFolderOutput(), overwrite);
+            py::gil_scoped_release release;
+            return identify::WritePredictionDirectory(p.summary, p.recordings, dir);
+          },
+          py::arg("directory"), py::kw_only(), py::arg("overwrite") = false,
+          "Writes the prediction folder `ccsrm predict --out` writes. An existing folder is "
+          "replaced only when it is an earlier prediction folder holding nothing but what ccsrm "
+          "wrote, or with overwrite=True.")
+      .def("__repr__", [](const Prediction& p) {
+        return "<ccsrm.Prediction " + p.summary.BriefReport() + ">";
+      });
+
+  m.def("predict", &RunPredict, py::arg("data"), py::kw_only(), py::arg("params"),
+        py::arg("effects") = py::none(), py::arg("config") = py::none(),
+        py::arg("threads") = py::none(), py::arg("noise_deg") = py::none(),
+        py::arg("point_noise_mm") = identify::ExperimentLoadOptions().point_noise_mm,
+        py::arg("out") = py::none(),
+        "Predicts recordings with a fitted model as `ccsrm predict` does, with its options: "
+        "data (one or more ccsrm-dataset/1 files), params (a fit.json, a fit or loop folder, or "
+        "a parameter file), effects (a YAML file switching effects on over the model), config "
+        "(an arm instead of each recording's own), threads, noise_deg, point_noise_mm, out "
+        "(also write the prediction folder, under the command's output policy). Returns a "
+        "Prediction; a run that does not complete is reported in it (completed, message), not "
+        "raised. The GIL is released while it runs.");
+}
+
 }  // namespace
 
 void AddIdentification(py::module_& m) {
@@ -400,6 +511,7 @@ void AddIdentification(py::module_& m) {
         "simulations, wall_time_s, values). Returns a Fit. The "
         "GIL is released during the fit.");
   AddLoop(m);
+  AddPrediction(m);
   m.def("default_threads", &identify::DefaultThreads, "Simulations at a time by default.");
 }
 

@@ -141,3 +141,39 @@ def test_resume_needs_a_stopped_fit_and_the_loop_takes_a_config(experiment, tmp_
     with pytest.raises(ccsrm.InputError) as e:
         ccsrm.loop(experiment, free="T_p", config=other, max_rounds=1)
     assert "describes an arm of" in str(e.value)
+
+
+def test_predict_equals_command_lines_pred_json(exe, experiment, tmp_path):
+    # A parameter file as the model: the generated experiment's truth, so
+    # the prediction's residual is the mocap pipeline's and its noise's.
+    params = tmp_path / "truth.yaml"
+    params.write_text("T_p: 60\n")
+    out = tmp_path / "pred_cli"
+    run_ccsrm(exe, "predict", "--data", experiment, "--params", params, "--threads", 1, "--quiet",
+              "--out", out)
+    cli = json.loads((out / "pred.json").read_text())
+    prediction = ccsrm.predict(experiment, params=params, threads=1, out=tmp_path / "pred_py")
+    written = json.loads((tmp_path / "pred_py" / "pred.json").read_text())
+    assert without_timing(written) == without_timing(cli)
+    assert prediction.completed and prediction.message == "every run completed"
+    assert prediction.verdict == cli["verdict"] and prediction.adequate == cli["adequate"]
+    assert prediction.verdict in prediction.full_report()
+    # The summary's JSON is pred.json without the names of the folder's files.
+    for r in written["recordings"]:
+        for key in [k for k in r if k.endswith("_file")]:
+            r.pop(key)
+    assert without_timing(prediction.to_dict()) == without_timing(written)
+    # Joint angles here, no tracked points.
+    assert prediction.rms_deg > 0 and prediction.tracked_points == {}
+    # write() goes through the same output policy: an earlier prediction
+    # folder is replaced, a folder of the user's refused.
+    assert sorted(prediction.write(tmp_path / "pred_py")) == sorted(
+        str(p) for p in (tmp_path / "pred_py").iterdir() if p.name != "ccsrm-manifest.txt")
+    user = tmp_path / "thesis"
+    user.mkdir()
+    (user / "notes.txt").write_text("mine")
+    with pytest.raises(ccsrm.InputError):
+        prediction.write(user)
+    with pytest.raises(ccsrm.InputError) as e:
+        ccsrm.predict(experiment, params=tmp_path / "missing.yaml")
+    assert "missing.yaml" in str(e.value)
