@@ -188,13 +188,27 @@ nlohmann::json TrackedPointsJson(const std::vector<TrackedPoint>& points,
   return out;
 }
 
+namespace {
+
+// A free text (an input pattern's label) as one cell: its separators and
+// line breaks as spaces.
+std::string CsvCellText(std::string text) {
+  for (char& c : text) {
+    if (c == ',' || c == '\n' || c == '\r') c = ' ';
+  }
+  return text;
+}
+
+}  // namespace
+
 std::string PointsCsvText(const Experiment& x, const Eigen::MatrixXd& simulated,
                           const std::string& name, const std::string& kind) {
   std::ostringstream csv;
   csv << "# " << name << ": measured and " << kind
       << " tracked points [mm] at the measured frames, in the frame they were recorded in; "
          "residual = "
-      << kind << " - measured; empty where not measured\n";
+      << kind << " - measured; empty where not measured"
+      << (x.frame_labels.empty() ? "" : "; label: the input pattern of the frame") << "\n";
   csv << "time_s";
   for (const TrackedPoint& point : x.tracked_points) {
     for (const char* what : {"measured", kind.c_str(), "residual"}) {
@@ -202,6 +216,8 @@ std::string PointsCsvText(const Experiment& x, const Eigen::MatrixXd& simulated,
         csv << "," << what << "_" << point.name << "_" << axis << "_mm";
     }
   }
+  const bool labelled = !x.frame_labels.empty();
+  if (labelled) csv << ",label";
   csv << "\n";
   char value[64];
   const Eigen::Index first = 2 * x.joints;
@@ -225,6 +241,7 @@ std::string PointsCsvText(const Experiment& x, const Eigen::MatrixXd& simulated,
         }
       }
     }
+    if (labelled) csv << "," << CsvCellText(x.frame_labels[f]);
     csv << "\n";
   }
   return csv.str();

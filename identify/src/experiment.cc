@@ -162,10 +162,14 @@ std::size_t SetFrames(const datasets::ExperimentFile& file, const std::string& p
                     "has fewer than 2 frames at or after the first input sample (t = " +
                         std::to_string(e->start_time_s) + " s): nothing to simulate");
   }
+  std::size_t input = 0;
   for (std::size_t f = 0; f < frames; ++f) {
     const double t = file.mocap_time.at(first + f);
     e->frame_time_s.push_back(t);
     e->sample_time_s.push_back(t - e->start_time_s);
+    if (file.input_labels.empty()) continue;
+    while (input + 1 < file.input_labels.size() && file.input_time.at(input + 1) <= t) ++input;
+    e->frame_labels.push_back(file.input_labels[input]);
   }
   return first;
 }

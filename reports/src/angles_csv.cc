@@ -40,10 +40,12 @@ std::string ColumnName(const std::string& kind, std::size_t axis, std::size_t jo
 namespace {
 
 // The rows of a table whose header passed `check_header`: time_s first and
-// increasing, every cell a number or empty (NaN).
+// increasing, every cell a number or empty (NaN), but for a last column
+// named "label" (text, in `labels`; not in `header` or `rows`).
 struct Table {
   std::vector<std::string> header;
   std::vector<std::vector<double>> rows;
+  std::vector<std::string> labels;
 };
 
 template <typename CheckHeader>
@@ -54,16 +56,22 @@ Table ReadTable(const std::string& file, const std::string& named_by, CheckHeade
   int number = 0;
   Table table;
   if (NextRow(in, &line, &number)) table.header = SplitCells(line);
+  const bool labelled = !table.header.empty() && table.header.back() == "label";
+  if (labelled) table.header.pop_back();
   check_header(table.header, "line " + std::to_string(number));
   const std::vector<std::string>& header = table.header;
   std::vector<std::vector<double>>& rows = table.rows;
   while (NextRow(in, &line, &number)) {
     const std::string at = "line " + std::to_string(number);
-    const std::vector<std::string> cells = SplitCells(line);
-    if (cells.size() != header.size()) {
-      ThrowInputError(
-          file, at,
-          std::to_string(cells.size()) + " cells, expected " + std::to_string(header.size()));
+    std::vector<std::string> cells = SplitCells(line);
+    const std::size_t columns = header.size() + (labelled ? 1 : 0);
+    if (cells.size() != columns) {
+      ThrowInputError(file, at,
+                      std::to_string(cells.size()) + " cells, expected " + std::to_string(columns));
+    }
+    if (labelled) {
+      table.labels.push_back(cells.back());
+      cells.pop_back();
     }
     std::vector<double> row(cells.size(), std::numeric_limits<double>::quiet_NaN());
     for (std::size_t i = 0; i < cells.size(); ++i) {
@@ -171,6 +179,7 @@ PointsCsv ReadPointsCsv(const std::string& file, const std::vector<std::string>&
         }
       });
   const std::size_t frames = table.rows.size(), points = out.points.size();
+  out.labels = table.labels;
   out.series.assign(kinds.size(), datasets::Array({frames, points, 3}));
   for (std::size_t f = 0; f < frames; ++f) {
     out.time_s.push_back(table.rows[f][0]);

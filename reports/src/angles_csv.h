@@ -27,11 +27,13 @@ AnglesCsv ReadAnglesCsv(const std::string& file, const std::vector<std::string>&
 
 // <name>.points.csv of `ccsrm identify` and `ccsrm predict` for a recording
 // of tracked points: time_s, then per point p, for each kind (measured,
-// fitted or predicted, residual) and axis x, y, z, <kind>_<p>_<axis>_mm.
+// fitted or predicted, residual) and axis x, y, z, <kind>_<p>_<axis>_mm;
+// then, when the recording labels its input patterns, `label`.
 struct PointsCsv {
   std::vector<double> time_s;           // strictly increasing
   std::vector<std::string> points;      // names, in column order
   std::vector<datasets::Array> series;  // per kind, T × P × 3 [mm], NaN where empty
+  std::vector<std::string> labels;      // per frame; empty without the column
 };
 
 // Reads `file` with the columns of `kinds`; throws InputError as

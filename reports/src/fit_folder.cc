@@ -95,6 +95,7 @@ void ReadTrackedPoints(const JsonReader& in, const json& entry, const std::strin
                     "the points file fit.json names");
   e->time_s = std::move(points.time_s);
   e->points = std::move(points.points);
+  e->labels = std::move(points.labels);
   e->measured_mm = std::move(points.series[0]);
   e->fitted_mm = std::move(points.series[1]);
   e->residual_mm = std::move(points.series[2]);

@@ -86,6 +86,7 @@ struct FitExperiment {
   // [mm].
   std::string points_file;
   std::vector<std::string> points;
+  std::vector<std::string> labels;  // per frame, the input pattern's; empty: none
   datasets::Array measured_mm, fitted_mm, residual_mm;
   std::vector<double> point_start_rms_mm, point_rms_mm, point_rms_mean_removed_mm;
   // From run_file's stored configuration (ReadArmFacts); one group of every

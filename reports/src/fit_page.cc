@@ -231,6 +231,10 @@ Section ExperimentPointsSection(const FitExperiment& e, const std::string& stem,
       "Top left: the points' paths seen from above (x against y); then x, y and z against "
       "time. Dashed: measured; solid: the fitted model's.",
       ""});
+  internal::AddPatternFigures(
+      internal::TrackedPointsByPatternFigures("patterns_" + stem, e.labels, e.points, e.measured_mm,
+                                              e.fitted_mm),
+      "fitted", &section);
   return section;
 }
 

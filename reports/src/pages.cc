@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <map>
 
 #include "ccsrm/common/error.h"
 
@@ -273,6 +274,81 @@ Figure TrackedPointsFigure(const std::string& name, const std::vector<double>& t
     figure.panels.push_back(std::move(panel));
   }
   return figure;
+}
+
+std::vector<Figure> TrackedPointsByPatternFigures(const std::string& name,
+                                                  const std::vector<std::string>& labels,
+                                                  const std::vector<std::string>& points,
+                                                  const datasets::Array& measured,
+                                                  const datasets::Array& simulated) {
+  // The frames of each pattern, in the order the patterns first appear.
+  std::vector<std::string> patterns;
+  std::map<std::string, std::vector<std::size_t>> frames;
+  for (std::size_t f = 0; f < labels.size(); ++f) {
+    if (frames.count(labels[f]) == 0) patterns.push_back(labels[f]);
+    frames[labels[f]].push_back(f);
+  }
+  std::vector<Figure> figures;
+  for (std::size_t k = 0; k < patterns.size(); ++k) {
+    if (k % kPatternPanels == 0) {
+      Figure figure;
+      figure.name = name + "_" + std::to_string(figures.size() + 1);
+      figure.columns = 4;
+      figure.panel_width_px = 380;
+      figure.panel_height_px = 280;
+      figures.push_back(std::move(figure));
+    }
+    Panel panel;
+    panel.x = Axis{"x", "mm"};
+    panel.y = Axis{"y", "mm"};
+    panel.legend = LegendPlace::kNone;
+    double squared = 0.0;
+    std::size_t counted = 0;
+    for (std::size_t p = 0; p < points.size(); ++p) {
+      std::vector<double> xm, ym, xs, ys;
+      for (std::size_t f : frames[patterns[k]]) {
+        xm.push_back(measured.at(f, p, 0));
+        ym.push_back(measured.at(f, p, 1));
+        xs.push_back(simulated.at(f, p, 0));
+        ys.push_back(simulated.at(f, p, 1));
+        double d2 = 0.0;
+        for (std::size_t a = 0; a < 3; ++a) {
+          const double d = simulated.at(f, p, a) - measured.at(f, p, a);
+          d2 += d * d;
+        }
+        if (std::isfinite(d2)) {
+          squared += d2;
+          ++counted;
+        }
+      }
+      const std::string color = palette::Indexed(static_cast<int>(p) + 1);
+      Series m{"", std::move(xm), std::move(ym), color, SeriesStyle::kDashed};
+      m.line_width = 1.0;
+      panel.series.push_back(std::move(m));
+      panel.series.push_back(Series{"", std::move(xs), std::move(ys), color});
+    }
+    char rms[48];
+    std::snprintf(rms, sizeof(rms), " (%.1f mm)",
+                  counted > 0 ? std::sqrt(squared / static_cast<double>(counted)) : NAN);
+    panel.title = patterns[k] + rms;
+    figures.back().panels.push_back(std::move(panel));
+  }
+  return figures;
+}
+
+void AddPatternFigures(std::vector<Figure> figures, const std::string& simulated_word,
+                       Section* section) {
+  for (std::size_t k = 0; k < figures.size(); ++k) {
+    const std::string part = figures.size() > 1 ? " (" + std::to_string(k + 1) + " of " +
+                                                      std::to_string(figures.size()) + ")"
+                                                : "";
+    section->blocks.push_back(FigureBlock{
+        std::move(figures[k]), "Tracked points by input pattern" + part,
+        "Each pattern's frames (the recording's input labels) seen from above, titled with the "
+        "pattern's RMS error. Dashed: measured; solid: " +
+            simulated_word + ".",
+        ""});
+  }
 }
 
 Figure ResidualsFigure(const std::string& name, const std::vector<double>& time,

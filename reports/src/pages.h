@@ -60,6 +60,24 @@ Figure TrackedPointsFigure(const std::string& name, const std::vector<double>& t
                            const std::vector<std::string>& points, const datasets::Array& measured,
                            const datasets::Array& simulated, const std::string& simulated_word);
 
+// The same paths seen from above, one small panel per input pattern (the
+// frames of each label of `labels`, in the order the labels first appear;
+// a label that recurs later is the same pattern), titled with the label
+// and its RMS error (the points' Euclidean distance, simulated against
+// measured [mm]); at most kPatternPanels panels a figure, so a recording of
+// many patterns gives several figures, `name`_1, `name`_2, ...
+inline constexpr std::size_t kPatternPanels = 24;
+std::vector<Figure> TrackedPointsByPatternFigures(const std::string& name,
+                                                  const std::vector<std::string>& labels,
+                                                  const std::vector<std::string>& points,
+                                                  const datasets::Array& measured,
+                                                  const datasets::Array& simulated);
+
+// Appends TrackedPointsByPatternFigures' figures to `section` with their
+// titles and caption (`simulated_word`: "fitted", "predicted").
+void AddPatternFigures(std::vector<Figure> figures, const std::string& simulated_word,
+                       Section* section);
+
 // Residuals (simulated − measured, T × J × 2 [deg]) per segment, θx left
 // and θy right.
 Figure ResidualsFigure(const std::string& name, const std::vector<double>& time,

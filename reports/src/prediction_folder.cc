@@ -55,6 +55,7 @@ void ReadTrackedPoints(const JsonReader& in, const json& entry, const std::strin
                     "the points file pred.json names");
   r->time_s = std::move(points.time_s);
   r->points = std::move(points.points);
+  r->labels = std::move(points.labels);
   r->measured_mm = std::move(points.series[0]);
   r->predicted_mm = std::move(points.series[1]);
   r->residual_mm = std::move(points.series[2]);

@@ -56,6 +56,7 @@ struct PredictionRecording {
   // recording"; empty: recorded in W).
   std::string points_file;
   std::vector<std::string> points;
+  std::vector<std::string> labels;  // per frame, the input pattern's; empty: none
   datasets::Array measured_mm, predicted_mm, residual_mm;
   std::vector<double> point_rms_mm, point_rms_mean_removed_mm;
   std::string placement_from;

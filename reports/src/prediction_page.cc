@@ -172,6 +172,10 @@ Section PointsSection(const PredictionRecording& r, const std::string& stem, boo
       "Top left: the points' paths seen from above (x against y); then x, y and z against "
       "time. Dashed: measured; solid: predicted.",
       ""});
+  internal::AddPatternFigures(
+      internal::TrackedPointsByPatternFigures("patterns_" + stem, r.labels, r.points, r.measured_mm,
+                                              r.predicted_mm),
+      "predicted", &section);
   return section;
 }
 

@@ -73,6 +73,11 @@ datasets::ExperimentFile TipRecording(double noise_mm, unsigned seed) {
     const Eigen::Vector3d p_CT = CaptureRotation() * p_WT + kCaptureOffsetM;
     for (int a = 0; a < 3; ++a) file.mocap_markers.at(f, 0, a) = p_CT[a] + noise(rng);
   }
+  // A pose log's pattern labels: the first half of the inputs "out", the
+  // rest "back".
+  const std::size_t inputs = file.input_time.rows();
+  for (std::size_t i = 0; i < inputs; ++i)
+    file.input_labels.push_back(2 * i < inputs ? "out" : "back");
   return file;
 }
 
@@ -87,6 +92,10 @@ TEST(TrackedPoints, AMarkerOnItsOwnLoadsAsATrackedPointInTheCaptureFrame) {
   // No angle is measured: every residual is the tip's.
   EXPECT_FALSE(e.measured.leftCols(2 * e.joints).array().isFinite().any());
   EXPECT_TRUE(e.measured.rightCols(3).array().isFinite().all());
+  // Each frame carries the label of the input sample at or before it.
+  ASSERT_EQ(e.frame_labels.size(), e.frame_time_s.size());
+  EXPECT_EQ(e.frame_labels.front(), "out");
+  EXPECT_EQ(e.frame_labels.back(), "back");
 }
 
 TEST(TrackedPoints, AMarkerOnABodyTheArmLacksIsRefused) {
@@ -213,7 +222,8 @@ TEST(TrackedPoints, RecoverThePretensionAndThePlacementOfTheCaptureFrame) {
   std::printf("prediction of another recording: tip RMS %.3f mm\n", r.points.rms_mm[0]);
 
   // Both folders read back into their report pages: the points' section
-  // with its figure, and the tip's error in the summary.
+  // with its figure and one panel per input pattern (titled with the
+  // pattern and its error), and the tip's error in the summary.
   const std::filesystem::path predicted_folder =
       std::filesystem::temp_directory_path() / "ccsrm_tracked_points_pred";
   std::filesystem::remove_all(predicted_folder);
@@ -227,9 +237,17 @@ TEST(TrackedPoints, RecoverThePretensionAndThePlacementOfTheCaptureFrame) {
       if (section.id.rfind("points-", 0) != 0) continue;
       points = true;
       bool figure = false;
-      for (const reports::Block& block : section.blocks)
-        figure = figure || std::holds_alternative<reports::FigureBlock>(block);
+      std::vector<std::string> patterns;
+      for (const reports::Block& block : section.blocks) {
+        const auto* f = std::get_if<reports::FigureBlock>(&block);
+        figure = figure || f != nullptr;
+        if (f == nullptr || f->title != "Tracked points by input pattern") continue;
+        for (const reports::Panel& panel : f->figure.panels) patterns.push_back(panel.title);
+      }
       EXPECT_TRUE(figure) << page.kind;
+      ASSERT_EQ(patterns.size(), 2u) << page.kind;
+      EXPECT_THAT(patterns[0], ::testing::StartsWith("out (")) << page.kind;
+      EXPECT_THAT(patterns[1], ::testing::StartsWith("back (")) << page.kind;
     }
     EXPECT_TRUE(points) << page.kind;
     std::string summary;

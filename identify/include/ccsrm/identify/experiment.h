@@ -98,6 +98,9 @@ struct Experiment {
   // the same on the simulation's time base.
   std::vector<double> frame_time_s;
   std::vector<double> sample_time_s;
+  // Per frame, the label of the input pattern it belongs to (the last
+  // /input/labels entry at or before the frame); empty without labels.
+  std::vector<std::string> frame_labels;
   int joints = 0;
   // What was measured, row per frame: column 2 j + a the angle of joint j
   // (0-based) about axis a (0 θx, 1 θy) [rad], then column 2 J + 3 p + c
