@@ -82,7 +82,7 @@ void ListEffects(bool json, const std::string& config_path) {
               config_path.c_str(), arm.joints, arm.cables, arm.segments);
   for (const sim::EffectInfo& e : sim::Effects()) {
     std::printf("%s%s%s: %s\n", e.name.c_str(), e.measurement ? " (measurement)" : "",
-                e.library ? "" : " (not of the library: the loop's terms found in the data)",
+                e.library ? "" : " (not of the library: the loop never tries it)",
                 e.description.c_str());
     for (const std::string& name : sim::EffectParameterNames(e.name, arm)) {
       const sim::ParameterInfo& p = sim::FindParameter(name, "--list-effects", arm);

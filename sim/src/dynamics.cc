@@ -276,10 +276,14 @@ Eigen::VectorXd ArmDynamics::InitialState() const {
     y[o + 3] = 1.0;  // e = (1, 0, 0, 0): body axes along the world axes
   }
   // Uniform pre-strain: T_d0 = EA eps0 (eq. 13), so each element's
-  // unstretched length is its chord / sqrt(1 + 2 eps0) (Green strain).
-  const double eps0 = parameters_.T_d0 / ale_.axial_stiffness_n;
-  const double stretch = std::sqrt(1.0 + 2.0 * eps0);
+  // unstretched length is its chord / sqrt(1 + 2 eps0) (Green strain); an
+  // effect may change a segment's (segment_pretension).
   for (int c = 0; c < model_.num_cables(); ++c) {
+    double pretension = parameters_.T_d0;
+    for (const std::unique_ptr<Effect>& effect : effects_)
+      pretension += effect->DrivingPretensionChange(model_.cables()[c].segment + 1);
+    const double eps0 = pretension / ale_.axial_stiffness_n;
+    const double stretch = std::sqrt(1.0 + 2.0 * eps0);
     double s = 0.0;
     Vector3 previous;
     for (int k = 0; k < static_cast<int>(model_.cables()[c].nodes.size()); ++k) {

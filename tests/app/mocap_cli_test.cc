@@ -452,11 +452,14 @@ TEST(Generate, ListEffectsGivesEveryEffectWithUnitsBoundsAndRealisticMagnitude) 
   const Outcome o = RunCcsrm("generate --list-effects --json");
   ASSERT_EQ(o.status, 0) << o.err;
   const nlohmann::json j = nlohmann::json::parse(o.out);
-  // The seven of the library, and the loop's terms' carrier, marked.
-  ASSERT_EQ(j["effects"].size(), 8u);
+  // The seven of the library, then the loop's terms' carrier and the
+  // per-segment pre-tension, marked.
+  ASSERT_EQ(j["effects"].size(), 9u);
   EXPECT_EQ(j["effects"][0]["name"], "joint_friction");
   EXPECT_EQ(j["effects"][7]["name"], "joint_moment");
   EXPECT_FALSE(j["effects"][7]["library"].get<bool>());
+  EXPECT_EQ(j["effects"][8]["name"], "segment_pretension");
+  EXPECT_FALSE(j["effects"][8]["library"].get<bool>());
   EXPECT_TRUE(j["effects"][0]["library"].get<bool>());
   const nlohmann::json& p = j["effects"][0]["parameters"][0];
   EXPECT_EQ(p["name"], "joint_friction.coulomb_nm");
@@ -468,6 +471,7 @@ TEST(Generate, ListEffectsGivesEveryEffectWithUnitsBoundsAndRealisticMagnitude) 
   EXPECT_THAT(text.out, HasSubstr("mocap_offset (measurement)"));
   EXPECT_THAT(text.out, HasSubstr("table_tilt.lateral_rad"));
   EXPECT_THAT(text.out, HasSubstr("joint_moment (not of the library"));
+  EXPECT_THAT(text.out, HasSubstr("segment_pretension.segment2_n"));
 }
 
 // The second arm (configs/three-segment.yaml) with every segment given

@@ -113,8 +113,10 @@ TEST(Effects, SevenLibraryEffectsAndTheTermsCarrierEachWithNamedBoundedParameter
   EXPECT_EQ(names,
             (std::vector<std::string>{"joint_friction", "table_tilt", "actuator_delay", "backlash",
                                       "pretension_creep", "air_drag", "mocap_offset"}));
-  // The discovered terms' carrier is registered but not of the library.
+  // The discovered terms' carrier and the per-segment pre-tension are
+  // registered but not of the library.
   EXPECT_FALSE(FindEffect("joint_moment", "test").library);
+  EXPECT_FALSE(FindEffect("segment_pretension", "test").library);
   const ArmSize paper_arm{12, 6, 2};
   // One coefficient per segment, axis and term.
   EXPECT_EQ(EffectParameterNames("joint_moment", paper_arm).size(),
@@ -603,6 +605,29 @@ TEST(PretensionCreep, CreepLowersTensionOverTime) {
   const std::unique_ptr<internal::Effect> creep = internal::PretensionCreepEffect().make(p);
   EXPECT_EQ(creep->PretensionFactor(0.0), 1.0);
   EXPECT_NEAR(creep->PretensionFactor(1.0), 1.0 - 0.2 * (1.0 - std::exp(-1.0)), 1e-15);
+}
+
+TEST(SegmentPretension, EachSegmentsCablesStartAtTheirOwnPretension) {
+  // Case 1, inputs held, segment 2's cables 20 N above T_d0: a pre-strain
+  // of the straight arm, so with frictionless holes every element of a
+  // cable holds its segment's pre-tension from the start, and the arm
+  // stays straight (a segment's cables pull alike). 1 % of T_d0 as for
+  // the creep: the lumped length and the cable's dynamic lag.
+  PaperShort arm(1);
+  ArmParameters p = arm.config.parameters;
+  SetParameter("segment_pretension.segment2_n", 20.0, "test", &p);
+  const SimulationResult r =
+      Simulate(arm.model, p, Held(arm.model, 0.5), OptionsFor(arm.config, 0.5));
+  ASSERT_TRUE(r.summary.completed()) << r.summary.message;
+  for (std::size_t f : {std::size_t{0}, r.trajectory.size() - 1}) {
+    for (int c = 0; c < arm.model.num_cables(); ++c) {
+      const double expected = p.T_d0 + (arm.model.cables()[c].segment == 1 ? 20.0 : 0.0);
+      for (double tension : r.trajectory.frames[f].element_tension[c])
+        EXPECT_NEAR(tension, expected, 0.01 * p.T_d0) << "cable " << c + 1 << ", frame " << f;
+    }
+    for (const Eigen::Vector2d& angle : r.trajectory.frames[f].joint_angles)
+      EXPECT_LT(angle.cwiseAbs().maxCoeff(), 1e-6);
+  }
 }
 
 TEST(AirDrag, AirDragDissipatesEnergy) {

@@ -5,6 +5,7 @@
 // never asks which effect it is:
 //
 //   before the run      RealisedInputs     what the actuators do with the command
+//                       DrivingPretensionChange  a segment's driving cables' pre-tension
 //   every evaluation    PretensionFactor   the connecting cables' T_p(t) / T_p
 //                       CoupleDeflection   the deflection the couples' springs see
 //                       AddLoads           forces on links, moments on joints
@@ -87,6 +88,9 @@ class Effect {
   virtual bool deflects_couples() const { return false; }
   virtual bool adds_loads() const { return false; }
 
+  // What the driving cables of segment `segment` (1-based) hold at the
+  // start beyond T_d0 [N]: their pre-strain is (T_d0 + change) / EA.
+  virtual double DrivingPretensionChange(int /*segment*/) const { return 0.0; }
   // T_p(t) / T_p of the connecting cables.
   virtual double PretensionFactor(double /*t*/) const { return 1.0; }
   // The couples' deflection for relative rotation d [rad].
@@ -175,6 +179,7 @@ EffectDefinition BacklashEffect();
 EffectDefinition PretensionCreepEffect();
 EffectDefinition AirDragEffect();
 EffectDefinition MocapOffsetEffect();
+EffectDefinition SegmentPretensionEffect();
 // Not of the library: the discovered terms' carrier (joint_moment.cc).
 EffectDefinition JointMomentEffect();
 

@@ -109,6 +109,7 @@ const std::vector<EffectDefinition>& EffectDefinitions() {
     std::vector<EffectDefinition> list = {
         JointFrictionEffect(),   TableTiltEffect(), ActuatorDelayEffect(), BacklashEffect(),
         PretensionCreepEffect(), AirDragEffect(),   MocapOffsetEffect(),   JointMomentEffect(),
+        SegmentPretensionEffect(),
     };
     for (EffectDefinition& d : list) {
       for (ParameterInfo& p : d.parameters) Complete(d.name, &p);

@@ -19,6 +19,8 @@
 // a combination of JointMomentTerms() of the joint's own state with one
 // coefficient per segment, axis and term. EffectInfo::library is false for
 // it: the loop never tries it as an effect, only through its discovery step.
+// Nor `segment_pretension`, a calibration of the arm: each segment's driving
+// cables start at T_d0 plus their segment's "segment_pretension.segment<k>_n".
 //
 // An effect is switched on by a configuration's `effects:` section, by
 // ArmParameters::EnableEffect, or by setting any of its parameters
