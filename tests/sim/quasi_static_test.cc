@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -29,22 +30,48 @@ void UsePreslidingFriction(SolverConfig* solver) {
   solver->conduit_friction = ConduitFrictionModel::kPresliding;
 }
 
+// A small arm's settled residual and its solver, at rest: x the straight
+// arm's coordinates (InitialState) and zero multipliers.
+struct SettledArm {
+  explicit SettledArm(std::optional<double> mu_s = std::nullopt)
+      : config(PreslidingSmallArm(mu_s)),
+        model(config.arm),
+        inputs(test_support::PullAndHold(model, 0, 2e-3, 1.0, 2.0)),
+        dynamics(model, config.parameters, inputs, config.solver),
+        solver(model, &dynamics),
+        n(dynamics.num_coordinates()),
+        size(solver.size()),
+        x(Eigen::VectorXd::Zero(size)) {
+    x.head(n) = dynamics.InitialState().head(n);
+  }
+  static Config PreslidingSmallArm(std::optional<double> mu_s) {
+    Config c = test_support::SmallArm(5);
+    UsePreslidingFriction(&c.solver);
+    if (mu_s) c.parameters.mu_s = *mu_s;
+    return c;
+  }
+
+  Config config;
+  ArmModel model;
+  CableInputs inputs;
+  internal::ArmDynamics dynamics;
+  internal::SettledPoseSolver solver;
+  int n, size;
+  Eigen::VectorXd x;
+};
+
 TEST(SettledPoseSolver, ColouredJacobianIsTheDenseFiniteDifferenceOne) {
-  Config config = test_support::SmallArm(5);
-  UsePreslidingFriction(&config.solver);
-  config.parameters.mu_s = 0.25;  // static above kinetic
-  const ArmModel model(config.arm);
-  const CableInputs inputs = test_support::PullAndHold(model, 0, 2e-3, 1.0, 2.0);
-  internal::ArmDynamics dynamics(model, config.parameters, inputs, config.solver);
-  internal::SettledPoseSolver solver(model, &dynamics);
+  SettledArm arm(0.25);  // static above kinetic
+  const ArmModel& model = arm.model;
+  internal::ArmDynamics& dynamics = arm.dynamics;
+  internal::SettledPoseSolver& solver = arm.solver;
   // A pose off the straight one (every wrap angle away from zero) and off
   // its constraints, multipliers of a few newtons, friction carried from
   // the straight arm: nothing the Jacobian's pattern leaves out may move
   // the residual. The nodes move by 0.2 um, a strain of 4e-5 over an
   // element, below the pre-strain, so that no element goes slack.
-  const int n = dynamics.num_coordinates(), size = solver.size();
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(size);
-  x.head(n) = dynamics.InitialState().head(n);
+  const int n = arm.n, size = arm.size;
+  Eigen::VectorXd& x = arm.x;
   std::mt19937 random(7);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   for (int k = 0; k < n; ++k) x[k] += 2e-7 * unit(random);
@@ -87,15 +114,11 @@ TEST(SettledPoseSolver, ForwardDifferencesResolveTheToeOfACableAtTheVergeOfSlack
   // cable going slack would point nowhere (the robot's log, issue 46). The
   // Jacobian's material columns must match the residual's central
   // differences to a tenth of the weak stiffness.
-  Config config = test_support::SmallArm(5);
-  UsePreslidingFriction(&config.solver);
-  const ArmModel model(config.arm);
-  const CableInputs inputs = test_support::PullAndHold(model, 0, 1e-3, 1.0, 2.0);
-  internal::ArmDynamics dynamics(model, config.parameters, inputs, config.solver);
-  internal::SettledPoseSolver solver(model, &dynamics);
-  const int n = dynamics.num_coordinates(), size = solver.size();
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(size);
-  x.head(n) = dynamics.InitialState().head(n);
+  SettledArm arm;
+  const ArmModel& model = arm.model;
+  internal::ArmDynamics& dynamics = arm.dynamics;
+  const int n = arm.n, size = arm.size;
+  Eigen::VectorXd& x = arm.x;
   const int cable = 0, nodes = static_cast<int>(model.cables()[cable].nodes.size());
   double shortest = 1.0;
   for (int k = 1; k < nodes; ++k) {
@@ -104,9 +127,10 @@ TEST(SettledPoseSolver, ForwardDifferencesResolveTheToeOfACableAtTheVergeOfSlack
     shortest = std::min(shortest, x[b + 3] - x[a + 3]);
   }
   const internal::SettledFriction from = dynamics.InitialSettledFriction();
-  ASSERT_TRUE(solver.ComputeJacobian(0.0, from, x)) << solver.failure();
-  const Eigen::MatrixXd jacobian = Eigen::MatrixXd(solver.jacobian());
-  const double ea = config.arm.driving.youngs_modulus_pa * config.arm.driving.cross_section_m2;
+  ASSERT_TRUE(arm.solver.ComputeJacobian(0.0, from, x)) << arm.solver.failure();
+  const Eigen::MatrixXd jacobian = Eigen::MatrixXd(arm.solver.jacobian());
+  const DrivingCableConfig& driving = arm.config.arm.driving;
+  const double ea = driving.youngs_modulus_pa * driving.cross_section_m2;
   const double weak = internal::ArmDynamics::kSettledElementStiffness * ea / shortest;
   Eigen::VectorXd plus(size), minus(size);
   double worst = 0.0;
@@ -133,20 +157,15 @@ TEST(SettledPoseSolver, EquilibriumOfSlackCablesIsRegular) {
   // residual's weak stiffness every material coordinate of a hole node
   // would be a column of zeros (a singular Jacobian: no unique
   // equilibrium).
-  Config config = test_support::SmallArm(5);
-  UsePreslidingFriction(&config.solver);
-  const ArmModel model(config.arm);
-  const CableInputs inputs = test_support::PullAndHold(model, 0, 1e-3, 1.0, 2.0);
-  internal::ArmDynamics dynamics(model, config.parameters, inputs, config.solver);
-  internal::SettledPoseSolver solver(model, &dynamics);
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(solver.size());
-  x.head(dynamics.num_coordinates()) = dynamics.InitialState().head(dynamics.num_coordinates());
+  SettledArm arm;
+  const ArmModel& model = arm.model;
+  Eigen::VectorXd& x = arm.x;
   for (int c = 0; c < model.num_cables(); ++c) {
     for (std::size_t k = 0; k < model.cables()[c].nodes.size(); ++k)
       x[model.node_offset(c, static_cast<int>(k)) + 3] *= 1.01;
   }
-  EXPECT_TRUE(solver.ComputeJacobian(0.0, dynamics.InitialSettledFriction(), x))
-      << solver.failure();
+  EXPECT_TRUE(arm.solver.ComputeJacobian(0.0, arm.dynamics.InitialSettledFriction(), x))
+      << arm.solver.failure();
 }
 
 SimulationResult Replay(const ArmModel& model, const ArmParameters& parameters,
