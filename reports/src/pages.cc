@@ -321,11 +321,19 @@ std::vector<Figure> TrackedPointsByPatternFigures(const std::string& name,
           ++counted;
         }
       }
+      // A pattern of one or two poses (a hold) as markers: a line of one
+      // point draws nothing.
+      const bool few = xm.size() < 3;
       const std::string color = palette::Indexed(static_cast<int>(p) + 1);
-      Series m{"", std::move(xm), std::move(ym), color, SeriesStyle::kDashed};
+      Series m{"", std::move(xm), std::move(ym), color,
+               few ? SeriesStyle::kPoints : SeriesStyle::kDashed};
       m.line_width = 1.0;
+      m.point_size = 1.5;
       panel.series.push_back(std::move(m));
-      panel.series.push_back(Series{"", std::move(xs), std::move(ys), color});
+      Series f{"", std::move(xs), std::move(ys), color,
+               few ? SeriesStyle::kLinePoints : SeriesStyle::kLine};
+      f.point_size = 1.5;
+      panel.series.push_back(std::move(f));
     }
     char rms[48];
     std::snprintf(rms, sizeof(rms), " (%.1f mm)",
@@ -346,7 +354,8 @@ void AddPatternFigures(std::vector<Figure> figures, const std::string& simulated
         std::move(figures[k]), "Tracked points by input pattern" + part,
         "Each pattern's frames (the recording's input labels) seen from above, titled with the "
         "pattern's RMS error. Dashed: measured; solid: " +
-            simulated_word + ".",
+            simulated_word + " (a pattern of one or two poses: open markers measured, joined " +
+            "markers " + simulated_word + ").",
         ""});
   }
 }
