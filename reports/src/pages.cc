@@ -354,8 +354,8 @@ void AddPatternFigures(std::vector<Figure> figures, const std::string& simulated
         std::move(figures[k]), "Tracked points by input pattern" + part,
         "Each pattern's frames (the recording's input labels) seen from above, titled with the "
         "pattern's RMS error. Dashed: measured; solid: " +
-            simulated_word + " (a pattern of one or two poses: open markers measured, joined " +
-            "markers " + simulated_word + ").",
+            simulated_word + " (a pattern of one or two poses: markers measured, markers " +
+            "joined by a line " + simulated_word + ").",
         ""});
   }
 }
