@@ -16,7 +16,8 @@ constexpr double kBand = 1.96;  // two-sided 95 % of a normal
 // 1 Hz low-pass on 100 Hz frames correlates about 50 frames.
 constexpr int kMaxLag = 200;
 
-// One channel's series over its measured frames (NaN gaps skipped).
+// One channel's series over its measured frames (NaN gaps skipped); a
+// tracked point's in mm where a joint's are in deg, with no heading.
 struct Series {
   std::vector<double> time, residual_deg, angle_deg, rate_degps, heading_deg, input_rate;
   std::vector<double> hold_time;  // time from the middle of the hold, NaN outside holds
@@ -98,6 +99,11 @@ const std::vector<std::string>& ResidualSignalNames() {
       "rate_sign",  "rate",     "angle",      "heading",    "time",
       "input_rate", "constant", "hold_drift", "hysteresis", "lag"};
   return names;
+}
+
+std::string ChannelName(int joint, int axis, const std::string& point) {
+  if (!point.empty()) return "point " + point + " " + std::string(1, "xyz"[axis]);
+  return "joint " + std::to_string(joint) + (axis == 0 ? " θx" : " θy");
 }
 
 const SignalEvidence* ResidualDiagnostics::Pooled(const std::string& signal) const {
@@ -218,34 +224,44 @@ void DiagnoseLag(const Experiment& x, const Eigen::MatrixXd& sim, ExperimentDiag
   ed->lag_explained = at_zero > 0.0 ? 1.0 - best / at_zero : 0.0;
 }
 
-// Joint j's axis a where both the measured and the simulated angle are
-// finite: residual, angle, heading (the angles summed up to the joint) and
-// the frame's context.
-Series ChannelSeries(const Experiment& x, const Eigen::MatrixXd& sim, int j, int a,
+// Column `col` of the experiment where both the measured and the simulated
+// value are finite: the residual, the simulated value and the frame's
+// context; of a joint's angle in deg (the residual over the frame's relative
+// noise) with the heading (the angles of its axis summed up to the joint), of
+// a tracked point's coordinate in mm (its noise is the same at every frame)
+// with no heading.
+Series ChannelSeries(const Experiment& x, const Eigen::MatrixXd& sim, Eigen::Index col,
                      const FrameContext& context) {
-  const Eigen::Index col = 2 * j + a;
+  const bool point = x.IsPointColumn(col);
+  const int j = static_cast<int>(col / 2), a = static_cast<int>(col % 2);
   Series s;
   for (std::size_t f = 0; f < x.sample_time_s.size(); ++f) {
-    const double m = x.measured(static_cast<Eigen::Index>(f), col);
-    const double v = sim(static_cast<Eigen::Index>(f), col);
+    const Eigen::Index row = static_cast<Eigen::Index>(f);
+    const double m = x.measured(row, col);
+    const double v = sim(row, col);
     if (!std::isfinite(m) || !std::isfinite(v)) continue;
-    double heading = 0.0;
-    bool ok = true;
-    for (int k = 0; k <= j; ++k) {
-      const double hk = sim(static_cast<Eigen::Index>(f), 2 * k + a);
-      if (!std::isfinite(hk)) ok = false;
-      heading += hk;
-    }
     s.time.push_back(x.sample_time_s[f]);
-    // Simulated - measured, over the frame's relative noise: a recording's
-    // ends, where the low-pass leaves more noise, weigh what they know.
-    s.residual_deg.push_back((v - m) * kDeg * x.noise_deg[static_cast<std::size_t>(j)] /
-                             x.NoiseDeg(static_cast<Eigen::Index>(f), col));
-    s.angle_deg.push_back(v * kDeg);
-    s.heading_deg.push_back(ok ? heading * kDeg : v * kDeg);
     s.input_rate.push_back(context.input_rate[f]);
     s.hold_time.push_back(context.hold_time[f]);
     s.phase.push_back(context.phase_of[f]);
+    if (point) {
+      s.residual_deg.push_back((v - m) * 1e3);
+      s.angle_deg.push_back(v * 1e3);
+      continue;
+    }
+    double heading = 0.0;
+    bool ok = true;
+    for (int k = 0; k <= j; ++k) {
+      const double hk = sim(row, 2 * k + a);
+      if (!std::isfinite(hk)) ok = false;
+      heading += hk;
+    }
+    // Simulated - measured, over the frame's relative noise: a recording's
+    // ends, where the low-pass leaves more noise, weigh what they know.
+    s.residual_deg.push_back((v - m) * kDeg * x.noise_deg[static_cast<std::size_t>(j)] /
+                             x.NoiseDeg(row, col));
+    s.angle_deg.push_back(v * kDeg);
+    s.heading_deg.push_back(ok ? heading * kDeg : v * kDeg);
   }
   return s;
 }
@@ -360,18 +376,27 @@ void PhaseRms(const Series& s, std::size_t phases, ChannelDiagnostics* ch) {
 // Pooled sums per signal: Σ value·energy, Σ energy, Σ effective pairs.
 using EvidencePool = std::map<std::string, std::array<double, 3>>;
 
-// One channel of experiment `e`: its statistics and evidence, pooled and
-// cross-correlated. Returns the sum of squared residuals [deg^2] (0 for a
-// channel of fewer than 3 samples, which is listed without statistics).
-double DiagnoseChannel(const Experiment& x, std::size_t e, const Eigen::MatrixXd& sim, int j, int a,
-                       const FrameContext& context, const ExperimentDiagnostics& ed,
-                       EvidencePool* pool, ResidualDiagnostics* out) {
-  Series s = ChannelSeries(x, sim, j, a, context);
+// Column `col` of experiment `e`: its statistics and evidence, pooled and
+// cross-correlated. Returns the sum of squared residuals [deg^2, or mm^2 of
+// a tracked point] (0 for a channel of fewer than 3 samples, which is listed
+// without statistics).
+double DiagnoseChannel(const Experiment& x, std::size_t e, const Eigen::MatrixXd& sim,
+                       Eigen::Index col, const FrameContext& context,
+                       const ExperimentDiagnostics& ed, EvidencePool* pool,
+                       ResidualDiagnostics* out) {
+  Series s = ChannelSeries(x, sim, col, context);
   ChannelDiagnostics ch;
   ch.experiment = e;
-  ch.joint = j + 1;
-  ch.axis = a;
-  ch.noise_deg = x.noise_deg[static_cast<std::size_t>(j)];
+  if (x.IsPointColumn(col)) {
+    const Eigen::Index k = col - 2 * x.joints;
+    ch.point = x.tracked_points[static_cast<std::size_t>(k / 3)].name;
+    ch.axis = static_cast<int>(k % 3);
+    ch.noise_deg = x.point_noise_mm;
+  } else {
+    ch.joint = static_cast<int>(col / 2) + 1;
+    ch.axis = static_cast<int>(col % 2);
+    ch.noise_deg = x.noise_deg[static_cast<std::size_t>(col / 2)];
+  }
   ch.samples = s.residual_deg.size();
   const std::size_t n = ch.samples;
   if (n < 3) {
@@ -387,15 +412,21 @@ double DiagnoseChannel(const Experiment& x, std::size_t e, const Eigen::MatrixXd
     rate_sign[i] =
         std::abs(s.rate_degps[i]) > 0.05 * rate_top ? (s.rate_degps[i] > 0 ? 1.0 : -1.0) : 0.0;
   }
-  const std::map<std::string, const std::vector<double>*> signals = {
-      {"rate_sign", &rate_sign},   {"rate", &s.rate_degps}, {"angle", &s.angle_deg},
-      {"heading", &s.heading_deg}, {"time", &s.time},       {"input_rate", &s.input_rate}};
+  std::map<std::string, const std::vector<double>*> signals = {{"rate_sign", &rate_sign},
+                                                               {"rate", &s.rate_degps},
+                                                               {"angle", &s.angle_deg},
+                                                               {"time", &s.time},
+                                                               {"input_rate", &s.input_rate}};
+  if (!s.heading_deg.empty()) signals["heading"] = &s.heading_deg;
   for (const std::string& name : ResidualSignalNames()) {
     const auto series = signals.find(name);
-    const SignalEvidence ev =
-        series != signals.end()
-            ? Correlate(name, s.residual_deg, *series->second, ch.autocorrelation)
-            : StructureEvidence(name, s, ed, &ch);
+    SignalEvidence ev;
+    ev.signal = name;  // a tracked point has no heading: no evidence, never significant
+    if (series != signals.end()) {
+      ev = Correlate(name, s.residual_deg, *series->second, ch.autocorrelation);
+    } else if (name != "heading") {
+      ev = StructureEvidence(name, s, ed, &ch);
+    }
     ch.evidence.push_back(ev);
     auto& acc = (*pool)[name];
     acc[0] += ev.value * sq;
@@ -430,15 +461,17 @@ ResidualDiagnostics DiagnoseResidual(const std::vector<Experiment>& experiments,
     const FrameContext context = FrameContextOf(x, ed.phases);
     DiagnoseLag(x, simulated_rad[e], &ed);
     double exp_sq = 0.0, exp_n = 0.0;
-    for (int j = 0; j < x.joints; ++j) {
-      for (int a = 0; a < 2; ++a) {
-        const double sq = DiagnoseChannel(x, e, simulated_rad[e], j, a, context, ed, &pool, &out);
-        const ChannelDiagnostics& ch = out.channels.back();
-        if (ch.samples < 3) continue;
-        energy += sq;
-        exp_sq += sq;
-        exp_n += static_cast<double>(ch.samples);
-      }
+    // Every joint axis, then every tracked point's coordinates (an
+    // experiment of tracked points measures no angle: its joint axes have no
+    // sample and are left out).
+    for (Eigen::Index col = 0; col < x.measured.cols(); ++col) {
+      if (!x.tracked_points.empty() && !x.IsPointColumn(col)) continue;
+      const double sq = DiagnoseChannel(x, e, simulated_rad[e], col, context, ed, &pool, &out);
+      const ChannelDiagnostics& ch = out.channels.back();
+      if (ch.samples < 3) continue;
+      energy += sq;
+      exp_sq += sq;
+      exp_n += static_cast<double>(ch.samples);
     }
     ed.rms_deg = exp_n > 0 ? std::sqrt(exp_sq / exp_n) : 0.0;
     total_sq += exp_sq;
@@ -499,7 +532,8 @@ nlohmann::json ToJson(const ResidualDiagnostics& d) {
     }
     channels.push_back({{"experiment", d.experiments.at(c.experiment).name},
                         {"joint", c.joint},
-                        {"axis", c.axis == 0 ? "x" : "y"},
+                        {"point", c.point},
+                        {"axis", std::string(1, "xyz"[c.axis])},
                         {"samples", c.samples},
                         {"rms_deg", c.rms_deg},
                         {"mean_deg", c.mean_deg},

@@ -62,15 +62,6 @@ LoopJobResult RunLoopJob(const LoopJobOptions& job) {
                                     job.config_path, say);
   result.holdout = LoadExperiments(job.holdout, job.noise_deg, job.point_noise_mm, "held out",
                                    job.config_path, say);
-  // The loop's diagnostics and its effects' evidence read joint angles.
-  for (const std::vector<Experiment>* set : {&result.training, &result.holdout}) {
-    for (const Experiment& e : *set) {
-      if (e.tracked_points.empty()) continue;
-      ThrowInputError(e.path, "/mocap/rigid_bodies",
-                      "holds tracked points, not link poses: the loop's diagnostics read joint "
-                      "angles (fit and predict tracked points with identify and predict)");
-    }
-  }
   const auto backends = JobBackends({&result.training, &result.holdout}, job.runs, say);
   if (backends.empty()) {  // another rank of an MPI job: it served rank 0's runs
     result.served = true;

@@ -71,18 +71,19 @@ bool AcceptWinner(LoopState* s, RoundState* rs) {
   std::string winner_name = lr.winner;
   if (winner->kind == "discovered terms")
     winner_name = "terms found in the data (" + Join(winner->parameters) + ")";
-  lr.decision =
-      (declared_winner ? "corrected " : "added ") + winner_name +
-      (winner->indistinguishable.empty()
-           ? std::string()
-           : " (indistinguishable from " + Join(winner->indistinguishable) +
-                 ": the data see their combination)") +
-      ": ΔBIC " + Format("%.1f", winner->delta_bic) + ", training RMS " +
-      Format("%.4f", lr.rms_deg) + " -> " + Format("%.4f", winner->rms_deg) + " deg" +
-      (winner->holdout_rms_deg ? ", held-out " + Format("%.4f", *lr.holdout_rms_deg) + " -> " +
-                                     Format("%.4f", *winner->holdout_rms_deg) + " deg"
-                               : std::string()) +
-      ".";
+  lr.decision = (declared_winner ? "corrected " : "added ") + winner_name +
+                (winner->indistinguishable.empty()
+                     ? std::string()
+                     : " (indistinguishable from " + Join(winner->indistinguishable) +
+                           ": the data see their combination)") +
+                ": ΔBIC " + Format("%.1f", winner->delta_bic) + ", training RMS " +
+                Format("%.4f", lr.rms_deg) + " -> " + Format("%.4f", winner->rms_deg) + " " +
+                s->summary.unit +
+                (winner->holdout_rms_deg
+                     ? ", held-out " + Format("%.4f", *lr.holdout_rms_deg) + " -> " +
+                           Format("%.4f", *winner->holdout_rms_deg) + " " + s->summary.unit
+                     : std::string()) +
+                ".";
   if (!lr.tie.empty()) {
     lr.decision += " Tie (ΔBIC within " + Format("%g", options.tie_delta_bic) +
                    "): " + Join(lr.tie) + "; the one with the fewest parameters is kept.";
@@ -193,7 +194,7 @@ void BackwardStep(LoopState* s, int round, const std::string& winner_label, Loop
       continue;
     }
     b.refitted = true;
-    b.rms_deg_without = without.errors.rms_deg_overall;
+    b.rms_deg_without = LoopRms(training, without);
     b.delta_bic_keep =
         internal::DeltaBic(without.final_cost, current.final_cost,
                            std::min(neff, without.effective_samples), nres, b.parameters.size());
@@ -212,11 +213,11 @@ void BackwardStep(LoopState* s, int round, const std::string& winner_label, Loop
         ": after " + winner_label +
         (b.size_significant ? " it is not identifiable" : " its size is indistinguishable from 0") +
         " (" + keep + " <= " + Format("%g", options.min_delta_bic) + "; training RMS " +
-        Format("%.4f", current.errors.rms_deg_overall) + " -> " +
-        Format("%.4f", b.rms_deg_without) + " deg" +
+        Format("%.4f", LoopRms(training, current)) + " -> " + Format("%.4f", b.rms_deg_without) +
+        " " + s->summary.unit +
         (holdout.empty() ? std::string()
                          : ", held out " + Format("%.4f", current_holdout.rms_deg) + " -> " +
-                               Format("%.4f", h.rms_deg) + " deg") +
+                               Format("%.4f", h.rms_deg) + " " + s->summary.unit) +
         ")";
     progress(round, "backward", b.name, "  " + b.reason);
     lr->decision += " T" + b.reason.substr(1) + ".";  // "took back" -> "Took back"

@@ -93,7 +93,7 @@ void FindUnexplained(LoopState* s) {
   const std::vector<Experiment>& holdout = s->holdout;
   summary.final_fit = current;
   summary.after = current.errors;
-  summary.rms_after_deg = current.errors.rms_deg_overall;
+  summary.rms_after_deg = LoopRms(training, current);
   summary.holdout_final_rad = current_holdout.simulated;
   if (!holdout.empty()) {
     summary.holdout_rms_after_deg = current_holdout.rms_deg;
@@ -111,20 +111,22 @@ void FindUnexplained(LoopState* s) {
   }
   const ModelAdequacy adequacy = AssessModelAdequacy(
       recordings, simulated, options.unexplained_noise_ratio, kAboveNoiseSignificance);
-  const auto above_noise = [&](const std::string& name, int joint, int axis) {
+  const auto above_noise = [&](const std::string& name, const ChannelDiagnostics& ch) {
     return std::any_of(adequacy.above_noise.begin(), adequacy.above_noise.end(),
                        [&](const ChannelAboveNoise& c) {
-                         return c.recording == name && c.joint == joint && c.axis == axis;
+                         return c.recording == name && c.joint == ch.joint && c.axis == ch.axis &&
+                                c.point == ch.point;
                        });
   };
   // Where the residual remains.
   for (const ChannelDiagnostics& ch : summary.final_evidence.channels) {
     const ExperimentDiagnostics& ed = summary.final_evidence.experiments[ch.experiment];
-    if (!above_noise(ed.name, ch.joint, ch.axis)) continue;
+    if (!above_noise(ed.name, ch)) continue;
     UnexplainedChannel u;
     u.experiment = ed.name;
     u.joint = ch.joint;
     u.axis = ch.axis;
+    u.point = ch.point;
     u.rms_deg = ch.rms_deg;
     u.noise_deg = ch.noise_deg;
     for (std::size_t p = 0; p < ch.phase_rms_deg.size() && p < ed.phases.size(); ++p) {
@@ -177,18 +179,21 @@ LoopSummary Conclude(LoopState* s) {
     if (at != std::string::npos) conclusion << " " << last.substr(at);
   }
   if (declared_ok) {
+    const bool points = summary.unit == "mm";
+    const char* axis = points ? "point coordinate" : "joint axis";
+    const char* axes = points ? "point coordinates" : "joint axes";
     if (summary.unexplained.empty()) {
-      conclusion << " The residual is at the noise floor: no joint axis stands above its noise "
-                    "(beyond "
+      conclusion << " The residual is at the noise floor: no " << axis
+                 << " stands above its noise (beyond "
                  << Format("%g", options.unexplained_noise_ratio) << "x it and beyond chance).";
     } else {
       const UnexplainedChannel& u = summary.unexplained.front();
-      conclusion << " Unexplained residual remains in " << summary.unexplained.size()
-                 << " joint axes (beyond " << Format("%g", options.unexplained_noise_ratio)
-                 << "x their noise and beyond chance); the largest: " << u.experiment << " joint "
-                 << u.joint << (u.axis == 0 ? " θx " : " θy ") << Format("%.4f", u.rms_deg)
-                 << " deg against " << Format("%.4f", u.noise_deg) << ", worst in " << u.worst_phase
-                 << ".";
+      conclusion << " Unexplained residual remains in " << summary.unexplained.size() << " " << axes
+                 << " (beyond " << Format("%g", options.unexplained_noise_ratio)
+                 << "x their noise and beyond chance); the largest: " << u.experiment << " "
+                 << ChannelName(u.joint, u.axis, u.point) << " " << Format("%.4f", u.rms_deg) << " "
+                 << summary.unit << " against " << Format("%.4f", u.noise_deg) << ", worst in "
+                 << u.worst_phase << ".";
     }
   }
   summary.conclusion = conclusion.str();

@@ -240,6 +240,9 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
     if (p.free) params[p.name] = Estimate(p);
   }
   j["parameters"] = params;
+  // Every RMS figure below (the keys named _deg) is in this unit: mm over
+  // experiments of tracked points.
+  j["unit"] = s.unit;
   j["rms_before_deg"] = Number(s.rms_before_deg);
   j["rms_after_deg"] = Number(s.rms_after_deg);
   j["holdout_rms_before_deg"] = Optional(s.holdout_rms_before_deg);
@@ -251,6 +254,10 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
   double floor = 0.0;
   std::size_t count = 0;
   for (const Experiment& e : training) {
+    if (!e.tracked_points.empty()) {
+      floor += e.point_noise_mm * e.point_noise_mm, ++count;
+      continue;
+    }
     for (double v : e.noise_deg) floor += v * v, ++count;
   }
   j["noise_floor_deg"] =
@@ -259,7 +266,8 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
   for (const UnexplainedChannel& u : s.unexplained) {
     unexplained.push_back({{"experiment", u.experiment},
                            {"joint", u.joint},
-                           {"axis", u.axis == 0 ? "x" : "y"},
+                           {"point", u.point},
+                           {"axis", std::string(1, "xyz"[u.axis])},
                            {"rms_deg", Number(u.rms_deg)},
                            {"noise_deg", Number(u.noise_deg)},
                            {"worst_phase", u.worst_phase},
@@ -282,11 +290,12 @@ nlohmann::json ToJson(const LoopSummary& s, const std::vector<Experiment>& train
 
 std::string LoopSummary::FullReport() const {
   std::ostringstream out;
-  out << "Declared model: training RMS " << Cell("%.4f", rms_before_deg) << " deg";
+  out << "Declared model: training RMS " << Cell("%.4f", rms_before_deg) << " " << unit;
   if (holdout_rms_before_deg) out << ", held out " << Cell("%.4f", *holdout_rms_before_deg);
   out << "\n";
   for (const LoopRound& r : rounds) {
-    out << "\nRound " << r.index << " (training RMS " << Cell("%.4f", r.rms_deg) << " deg)\n";
+    out << "\nRound " << r.index << " (training RMS " << Cell("%.4f", r.rms_deg) << " " << unit
+        << ")\n";
     out << "  candidate                                  score     p        refit  dBIC     RMS    "
            "  "
            "held-out  accepted\n";
@@ -325,7 +334,7 @@ std::string LoopSummary::FullReport() const {
     out << "\nTerms found in the data (joint_moment):\n";
     for (const DiscoveredMoment& m : discovered_terms) out << "  " << m.Formula() << "\n";
   }
-  out << "\nRMS error [deg]      before    after\n";
+  out << "\nRMS error [" << unit << "]      before    after\n";
   out << "  training          " << Cell("%.4f", rms_before_deg) << "   "
       << Cell("%.4f", rms_after_deg) << "\n";
   if (holdout_rms_before_deg && holdout_rms_after_deg) {
@@ -336,8 +345,8 @@ std::string LoopSummary::FullReport() const {
     out << "\nUnexplained (RMS above the noise):\n";
     for (std::size_t k = 0; k < unexplained.size() && k < 12; ++k) {
       const UnexplainedChannel& u = unexplained[k];
-      out << "  " << u.experiment << " joint " << u.joint << (u.axis == 0 ? " θx " : " θy ")
-          << Cell("%.4f", u.rms_deg) << " deg (noise " << Cell("%.4f", u.noise_deg)
+      out << "  " << u.experiment << " " << ChannelName(u.joint, u.axis, u.point) << " "
+          << Cell("%.4f", u.rms_deg) << " " << unit << " (noise " << Cell("%.4f", u.noise_deg)
           << "), worst in " << u.worst_phase << "\n";
     }
     if (unexplained.size() > 12) out << "  ... and " << unexplained.size() - 12 << " more\n";
@@ -372,6 +381,19 @@ std::vector<std::string> WriteLoopDirectory(const LoopSummary& summary,
     fs::create_directory(tmp / "holdout");
     for (std::size_t e = 0; e < holdout.size(); ++e) {
       const Experiment& x = holdout[e];
+      const std::string name = x.name.empty() ? "holdout" + std::to_string(e + 1) : x.name;
+      if (!x.tracked_points.empty()) {
+        // The declared model's and the final model's points, each with the
+        // measured ones and its residual.
+        for (const auto& [kind, run] : {std::pair{"declared", &summary.holdout_declared_rad[e]},
+                                        std::pair{"final", &summary.holdout_final_rad[e]}}) {
+          const std::string file = name + "." + kind + ".points.csv";
+          WriteTextFileAtomically((tmp / "holdout" / file).string(),
+                                  internal::PointsCsvText(x, *run, x.name, kind));
+          written.push_back((fs::path(directory) / "holdout" / file).string());
+        }
+        continue;
+      }
       const auto degrees = [](const Eigen::MatrixXd& m) {
         return [&m](Eigen::Index f, Eigen::Index c) { return f < m.rows() ? m(f, c) * kDeg : NAN; };
       };
@@ -383,7 +405,6 @@ std::vector<std::string> WriteLoopDirectory(const LoopSummary& summary,
           {{"measured", degrees(x.measured)},
            {"declared", degrees(summary.holdout_declared_rad[e])},
            {"final", degrees(summary.holdout_final_rad[e])}});
-      const std::string name = x.name.empty() ? "holdout" + std::to_string(e + 1) : x.name;
       WriteTextFileAtomically((tmp / "holdout" / (name + ".angles.csv")).string(), csv);
       written.push_back((fs::path(directory) / "holdout" / (name + ".angles.csv")).string());
     }

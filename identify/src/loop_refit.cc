@@ -110,7 +110,7 @@ void RefitAndJudge(LoopState* s, RoundState* rs, CandidateResult* target) {
   IdentificationSummary refit = Refit(s, rs, cand);
   cand.refitted = true;
   cand.termination = TerminationName(refit.termination);
-  cand.rms_deg = refit.errors.rms_deg_overall;
+  cand.rms_deg = LoopRms(s->training, refit);
   if (refit.termination == IdentificationTermination::kFailed) {
     cand.reason = "refit failed: " + refit.message;
     return;
@@ -188,7 +188,7 @@ void RefitAndJudge(LoopState* s, RoundState* rs, CandidateResult* target) {
          Format("%g", options.min_delta_bic);
   if (!holdout.empty()) {
     why += "; held-out RMS " + Format("%.4f", current_holdout.rms_deg) + " -> " +
-           Format("%.4f", h.rms_deg) + " deg" +
+           Format("%.4f", h.rms_deg) + " " + s->summary.unit +
            (cand.holdout_improved ? " (a real gain)" : " (no gain beyond chance)");
   }
   why += cand.size_significant ? "; its size is distinguishable from 0"
@@ -201,8 +201,8 @@ void RefitAndJudge(LoopState* s, RoundState* rs, CandidateResult* target) {
   }
   cand.reason = why;
   progress(round, "refit", cand.name,
-           "  " + cand.name + ": RMS " + Format("%.4f", cand.rms_deg) + " deg, " + why +
-               (cand.accepted ? " -> passes" : " -> fails"));
+           "  " + cand.name + ": RMS " + Format("%.4f", cand.rms_deg) + " " + s->summary.unit +
+               ", " + why + (cand.accepted ? " -> passes" : " -> fails"));
   rs->refit_fits.emplace(cand.name, std::move(refit));
   rs->refit_holdouts.emplace(cand.name, std::move(h));
 }

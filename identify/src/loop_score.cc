@@ -148,7 +148,7 @@ bool GatherEvidence(LoopState* s, RoundState* rs) {
   LoopRound& lr = rs->lr;
   lr.index = round;
   lr.effects_on = effects_on;
-  lr.rms_deg = current.errors.rms_deg_overall;
+  lr.rms_deg = LoopRms(training, current);
   if (!holdout.empty()) lr.holdout_rms_deg = current_holdout.rms_deg;
   std::vector<Eigen::MatrixXd>& fitted = rs->fitted;
   for (const ExperimentFit& f : current.experiments) fitted.push_back(f.simulated);

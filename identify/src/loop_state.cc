@@ -42,7 +42,8 @@ double ScoreStep(const std::string& name, const sim::ArmSize& arm) {
 }
 
 // Weighted residual layout of FitProblem: experiment, frame, column, measured
-// entries only; (angles - measured) / noise.
+// entries only; (simulated - measured) / noise (Experiment::WeightedResidual:
+// an angle's in deg, a tracked point's in mm).
 Eigen::VectorXd Weighted(const std::vector<Experiment>& experiments,
                          const std::vector<const Eigen::MatrixXd*>& angles, bool difference_only,
                          const std::vector<const Eigen::MatrixXd*>& base) {
@@ -52,14 +53,45 @@ Eigen::VectorXd Weighted(const std::vector<Experiment>& experiments,
     for (Eigen::Index f = 0; f < x.measured.rows(); ++f) {
       for (Eigen::Index c = 0; c < x.measured.cols(); ++c) {
         if (!std::isfinite(x.measured(f, c))) continue;
-        const double reference = difference_only ? (*base[e])(f, c) : x.measured(f, c);
-        double v = ((*angles[e])(f, c) - reference) * kDeg / x.NoiseDeg(f, c);
+        double v = x.WeightedResidual(f, c, (*angles[e])(f, c));
+        if (difference_only) v -= x.WeightedResidual(f, c, (*base[e])(f, c));
         if (!std::isfinite(v)) v = 0.0;
         out.push_back(v);
       }
     }
   }
   return Eigen::Map<Eigen::VectorXd>(out.data(), static_cast<Eigen::Index>(out.size()));
+}
+
+double LoopRms(const std::vector<const Experiment*>& experiments,
+               const std::vector<const Eigen::MatrixXd*>& simulated) {
+  if (experiments.empty()) return 0.0;
+  if (experiments.front()->tracked_points.empty()) {
+    return AngleErrors(experiments, simulated).rms_deg_overall;
+  }
+  double sq = 0.0, frames = 0.0;
+  for (std::size_t e = 0; e < experiments.size(); ++e) {
+    const TrackedPointErrors p = PointErrors(*experiments[e], *simulated[e]);
+    for (std::size_t k = 0; k < p.rms_mm.size(); ++k) {
+      if (p.frames[k] == 0) continue;
+      sq += p.rms_mm[k] * p.rms_mm[k] * static_cast<double>(p.frames[k]);
+      frames += static_cast<double>(p.frames[k]);
+    }
+  }
+  return frames > 0.0 ? std::sqrt(sq / frames) : std::numeric_limits<double>::quiet_NaN();
+}
+
+double LoopRms(const std::vector<Experiment>& experiments, const IdentificationSummary& fit) {
+  if (experiments.empty() || experiments.front().tracked_points.empty()) {
+    return fit.errors.rms_deg_overall;
+  }
+  std::vector<const Experiment*> xs;
+  std::vector<const Eigen::MatrixXd*> simulated;
+  for (std::size_t e = 0; e < experiments.size() && e < fit.experiments.size(); ++e) {
+    xs.push_back(&experiments[e]);
+    simulated.push_back(&fit.experiments[e].simulated);
+  }
+  return LoopRms(xs, simulated);
 }
 
 // How much of r a least-squares fit of columns A removes: ||r||² - min ||r + A x||².
@@ -132,7 +164,7 @@ HoldoutResult LoopState::RunHoldout(const std::map<std::string, double>& values)
     angles.push_back(&h.simulated[e]);
   }
   h.errors = AngleErrors(xs, angles);
-  h.rms_deg = h.errors.rms_deg_overall;
+  h.rms_deg = LoopRms(xs, angles);
   const Eigen::VectorXd r = Weighted(holdout, angles, false);
   h.mean_square = r.size() > 0 ? r.squaredNorm() / static_cast<double>(r.size()) : 0.0;
   const ResidualDiagnostics d = DiagnoseResidual(holdout, h.simulated);
@@ -167,6 +199,19 @@ void StartLoop(LoopState* s) {
       ThrowInputError(h.path, "joints", "the held-out arm differs from the training experiments'");
     }
   }
+  // One kind of measurement: the residual's figures are in one unit.
+  const bool points = !training.front().tracked_points.empty();
+  for (const std::vector<Experiment>* set : {&training, &holdout}) {
+    for (const Experiment& x : *set) {
+      if (x.tracked_points.empty() == !points) continue;
+      ThrowInputError(x.path, "/mocap",
+                      std::string(points ? "holds joint angles" : "holds tracked points") +
+                          " where " + training.front().path + " holds " +
+                          (points ? "tracked points" : "joint angles") +
+                          ": the loop judges one kind of measurement at a time");
+    }
+  }
+  s->summary.unit = points ? "mm" : "deg";
   // The arm of the experiments: how many per-joint parameters a candidate has.
   s->arm = training.front().config.parameters.arm;
   const sim::ArmSize& arm = s->arm;
@@ -176,7 +221,9 @@ void StartLoop(LoopState* s) {
   candidates = options.candidates;
   if (candidates.empty()) {
     for (const sim::EffectInfo& e : sim::Effects()) {
-      if (e.library && !training.front().config.parameters.EffectOn(e.name)) {
+      // A measurement effect acts on recorded joint angles: none of tracked points.
+      if (e.library && !(points && e.measurement) &&
+          !training.front().config.parameters.EffectOn(e.name)) {
         candidates.push_back(e.name);
       }
     }
@@ -206,6 +253,11 @@ void StartLoop(LoopState* s) {
     e.name = c;
     e.parameters = SizeParameters(c, arm);
     e.measurement = sim::FindEffect(c, "--candidates").measurement;
+    if (points && e.measurement) {
+      ThrowInputError("--candidates", c,
+                      "a measurement effect acts on recorded joint angles; " +
+                          training.front().path + " holds tracked points");
+    }
     e.fingerprint = sim::FindEffect(c, "loop").fingerprint;
     specs.push_back(std::move(e));
   }
@@ -237,17 +289,18 @@ void FitDeclaredModel(LoopState* s) {
   s->current_holdout = s->RunHoldout(ValuesOf(s->current, s->fixed));
   summary.holdout_declared_rad = s->current_holdout.simulated;
   summary.before = summary.declared.errors;
-  summary.rms_before_deg = summary.declared.errors.rms_deg_overall;
+  summary.rms_before_deg = LoopRms(s->training, summary.declared);
   if (!holdout.empty()) {
     summary.holdout_rms_before_deg = s->current_holdout.rms_deg;
     summary.holdout_before = s->current_holdout.errors;
   }
+  const std::string unit = " " + summary.unit;
   s->Progress(
       0, "declared fit", "",
-      "declared model: RMS " + Format("%.4f", summary.rms_before_deg) + " deg (" +
+      "declared model: RMS " + Format("%.4f", summary.rms_before_deg) + unit + " (" +
           TerminationName(summary.declared.termination) + ")" +
           (holdout.empty() ? std::string()
-                           : ", held out " + Format("%.4f", s->current_holdout.rms_deg) + " deg"));
+                           : ", held out " + Format("%.4f", s->current_holdout.rms_deg) + unit));
   s->declared_ok = summary.declared.termination != IdentificationTermination::kFailed &&
                    summary.declared.jacobian.size() > 0;
 }

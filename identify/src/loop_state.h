@@ -38,7 +38,7 @@ inline constexpr const char* kTermsEffect = "joint_moment";
 // The held-out experiments at a fit's values.
 struct HoldoutResult {
   std::vector<Eigen::MatrixXd> simulated;
-  double rms_deg = 0.0;
+  double rms_deg = 0.0;  // LoopRms: mm over tracked points
   double mean_square = 0.0;  // weighted, per sample
   double effective_samples = 0.0;
   ChannelErrors errors;
@@ -51,6 +51,14 @@ struct HoldoutResult {
 Eigen::VectorXd Weighted(const std::vector<Experiment>& experiments,
                          const std::vector<const Eigen::MatrixXd*>& angles, bool difference_only,
                          const std::vector<const Eigen::MatrixXd*>& base = {});
+
+// The loop's RMS error of simulated runs (laid out as Experiment::measured):
+// of the angles [deg] over every measured joint axis (AngleErrors), or of
+// experiments of tracked points the points' Euclidean RMS error [mm] over
+// every point and frame measured; and of a fit's final runs.
+double LoopRms(const std::vector<const Experiment*>& experiments,
+               const std::vector<const Eigen::MatrixXd*>& simulated);
+double LoopRms(const std::vector<Experiment>& experiments, const IdentificationSummary& fit);
 
 // How much of r a least-squares fit of columns A removes: ||r||² - min ||r + A x||².
 double Reduction(const Eigen::VectorXd& r, const Eigen::MatrixXd& a, Eigen::VectorXd* x);

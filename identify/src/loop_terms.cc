@@ -105,7 +105,9 @@ CandidateResult DiscoverTerms(LoopState* state, RoundState* rs) {
     cand.term_path.push_back({support.parameters, support.delta_chi2_eff, support.delta_bic});
   }
   if (selection.chosen < 0) {
-    cand.reason = "no term moves the angles beyond what the fit's own parameters do";
+    cand.reason = std::string("no term moves the ") +
+                  (state->summary.unit == "mm" ? "tracked points" : "angles") +
+                  " beyond what the fit's own parameters do";
     return cand;
   }
   const internal::TermSupport& chosen = selection.path[static_cast<std::size_t>(selection.chosen)];
@@ -170,10 +172,11 @@ void SeekTerms(LoopState* s, RoundState* rs) {
     // (the loop sample of issue 44 sought terms for 108 runs at 0.0282 deg
     // against 0.0329 deg of noise).
     const bool at_noise = ms_current <= 1.0 && !widespread;
+    const std::string channels = s->summary.unit == "mm" ? " point coordinates" : " joint axes";
     if (at_noise) {
       lr.discovery = "no terms sought: the residual is at the noise (weighted mean square " +
                      Format("%.3g", ms_current) + ", 1 = the noise) on all but " +
-                     std::to_string(above) + " joint axes.";
+                     std::to_string(above) + channels + ".";
     } else if (ms_current > unexplained_ms || correlated || widespread) {
       CandidateResult cand = DiscoverTerms(s, rs);
       if (cand.significant) RefitAndJudge(s, rs, &cand);
@@ -181,8 +184,8 @@ void SeekTerms(LoopState* s, RoundState* rs) {
     } else {
       lr.discovery = "no terms sought: the residual is within " +
                      Format("%g", options.unexplained_noise_ratio) +
-                     "x the noise overall and on all but " + std::to_string(above) +
-                     " joint axes, and follows none of the effects' signals.";
+                     "x the noise overall and on all but " + std::to_string(above) + channels +
+                     ", and follows none of the effects' signals.";
     }
   }
 }

@@ -25,10 +25,21 @@ std::vector<LoopSignal> ReadPooled(const JsonReader& in, const json& object,
   return out;
 }
 
-int ReadAxis(const JsonReader& in, const json& object, const std::string& at) {
+// A channel's axis: x or y of a joint, x, y or z of a tracked point.
+int ReadAxis(const JsonReader& in, const json& object, const std::string& at, bool point) {
   const std::string axis = in.Text(object, at, "axis");
-  if (axis != "x" && axis != "y") in.Fail(at + ".axis", "is '" + axis + "', expected x or y");
-  return axis == "x" ? 0 : 1;
+  const std::string allowed = point ? "xyz" : "xy";
+  const std::size_t k = axis.size() == 1 ? allowed.find(axis[0]) : std::string::npos;
+  if (k == std::string::npos) {
+    in.Fail(at + ".axis", "is '" + axis + "', expected " + (point ? "x, y or z" : "x or y"));
+  }
+  return static_cast<int>(k);
+}
+
+// A channel's tracked point ('point', absent in files written before it):
+// empty for a joint's axis.
+std::string ReadPoint(const JsonReader& in, const json& object, const std::string& at) {
+  return object.contains("point") ? in.Text(object, at, "point") : std::string();
 }
 
 // A diagnostics object (`object`, at `key`). Its numbers are written as
@@ -75,7 +86,8 @@ LoopDiagnostics ReadDiagnostics(const JsonReader& in, const json& object, const 
     LoopDiagnostics::Channel x;
     x.experiment = in.Text(ch, at, "experiment");
     x.joint = static_cast<int>(in.NumberAt(ch, at, "joint"));
-    x.axis = ReadAxis(in, ch, at);
+    x.point = ReadPoint(in, ch, at);
+    x.axis = ReadAxis(in, ch, at, !x.point.empty());
     x.samples = in.NumberAt(ch, at, "samples", true);
     x.rms_deg = in.NumberAt(ch, at, "rms_deg", true);
     x.mean_deg = in.NumberAt(ch, at, "mean_deg", true);
@@ -231,6 +243,37 @@ std::optional<FitFolder> ReadModelFolder(const fs::path& folder, const std::stri
   return ReadFitFolder(folder.string());
 }
 
+// A held-out experiment's points of a loop over tracked points: the
+// declared and the final model's residuals, from their two files.
+void ReadHoldoutPoints(const std::string& folder, const std::string& stem, LoopHoldout* h,
+                       std::vector<std::string>* problems) {
+  std::error_code ec;
+  std::vector<PointsCsv> read;
+  for (const char* kind : {"declared", "final"}) {
+    const fs::path csv = fs::path(folder) / "holdout" / (stem + "." + kind + ".points.csv");
+    if (!fs::exists(csv, ec)) {
+      problems->push_back("The loop folder holds no holdout/" + stem + "." + kind +
+                          ".points.csv: the residuals of held-out experiment " + h->name +
+                          " are not shown.");
+      return;
+    }
+    read.push_back(ReadPointsCsv(csv.string(), {"measured", kind, "residual"},
+                                 "the held-out points of experiment " + h->name));
+  }
+  if (read[0].time_s != read[1].time_s || read[0].points != read[1].points) {
+    problems->push_back("holdout/" + stem +
+                        ".declared.points.csv and .final.points.csv hold "
+                        "other frames or points: the residuals of held-out experiment " +
+                        h->name + " are not shown.");
+    return;
+  }
+  h->file = (fs::path(folder) / "holdout" / (stem + ".declared.points.csv")).string();
+  h->time_s = std::move(read[0].time_s);
+  h->points = std::move(read[0].points);
+  h->declared_residual_mm = std::move(read[0].series[2]);
+  h->final_residual_mm = std::move(read[1].series[2]);
+}
+
 }  // namespace
 
 bool LooksLikeLoopFolder(const std::string& folder) {
@@ -315,6 +358,12 @@ LoopFolder ReadLoopFolder(const std::string& folder) {
     }
   }
   loop.parameters = ReadEstimates(in, root, "", "parameters");
+  if (root.contains("unit")) {
+    loop.unit = in.Text(root, "", "unit");
+    if (loop.unit != "deg" && loop.unit != "mm") {
+      in.Fail("unit", "is '" + loop.unit + "', expected deg or mm");
+    }
+  }
   loop.rms_before_deg = in.NumberAt(root, "", "rms_before_deg", true);
   loop.rms_after_deg = in.NumberAt(root, "", "rms_after_deg", true);
   loop.holdout_rms_before_deg = in.NumberAt(root, "", "holdout_rms_before_deg", true);
@@ -328,9 +377,10 @@ LoopFolder ReadLoopFolder(const std::string& folder) {
   for (std::size_t u = 0; u < unexplained.size(); ++u) {
     const std::string at = JsonReader::Index("unexplained", u);
     const json& entry = unexplained[u];
+    const std::string point = ReadPoint(in, entry, at);
     loop.unexplained.push_back(
         {in.Text(entry, at, "experiment"), static_cast<int>(in.NumberAt(entry, at, "joint")),
-         ReadAxis(in, entry, at), in.NumberAt(entry, at, "rms_deg", true),
+         ReadAxis(in, entry, at, !point.empty()), point, in.NumberAt(entry, at, "rms_deg", true),
          in.NumberAt(entry, at, "noise_deg", true), in.Text(entry, at, "worst_phase"),
          in.NumberAt(entry, at, "worst_phase_rms_deg", true)});
   }
@@ -354,6 +404,11 @@ LoopFolder ReadLoopFolder(const std::string& folder) {
     h.path = d.path;
     // ccsrm loop names an unnamed experiment by its place among the held-out.
     const std::string stem = d.name.empty() ? "holdout" + std::to_string(k) : d.name;
+    if (loop.unit == "mm") {
+      ReadHoldoutPoints(folder, stem, &h, &loop.problems);
+      if (!h.file.empty()) loop.holdout.push_back(std::move(h));
+      continue;
+    }
     const fs::path csv = fs::path(folder) / "holdout" / (stem + ".angles.csv");
     if (!fs::exists(csv, ec)) {
       loop.problems.push_back("The loop folder holds no holdout/" + stem +

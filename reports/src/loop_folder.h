@@ -48,10 +48,12 @@ struct LoopDiagnostics {
     std::vector<Phase> phases;
   };
   std::vector<Experiment> experiments;
+  // A joint's axis, or a tracked point's coordinate (its figures in mm).
   struct Channel {
     std::string experiment;
-    int joint = 0;
-    int axis = 0;  // 0 θx, 1 θy
+    int joint = 0;      // 0 for a tracked point's coordinate
+    int axis = 0;       // 0 θx, 1 θy; of a tracked point 0 x, 1 y, 2 z
+    std::string point;  // the tracked point's name
     double samples = kUnknown;
     double rms_deg = kUnknown, mean_deg = kUnknown, noise_deg = kUnknown;
     double lags_outside_band = kUnknown;
@@ -122,8 +124,9 @@ struct LoopErrors {
 
 struct LoopUnexplained {
   std::string experiment;
-  int joint = 0;
-  int axis = 0;
+  int joint = 0;      // 0 for a tracked point's coordinate
+  int axis = 0;       // as LoopDiagnostics::Channel's
+  std::string point;  // the tracked point's name
   double rms_deg = kUnknown, noise_deg = kUnknown;
   std::string worst_phase;
   double worst_phase_rms_deg = kUnknown;
@@ -134,12 +137,16 @@ struct LoopFitRun {  // declared_fit, final_fit
   double iterations = 0;
 };
 
-// A held-out experiment's angles (holdout/<name>.angles.csv).
+// A held-out experiment's angles (holdout/<name>.angles.csv), or of a loop
+// over tracked points its points (holdout/<name>.declared.points.csv and
+// <name>.final.points.csv).
 struct LoopHoldout {
   std::string name, path;
-  std::string file;  // as read; empty when the folder holds none (problems says so)
+  std::string file;  // as read (the declared points' file); empty when the folder holds none
   std::vector<double> time_s;
-  datasets::Array measured_deg, declared_deg, final_deg;  // T × J × 2
+  datasets::Array measured_deg, declared_deg, final_deg;    // T × J × 2
+  std::vector<std::string> points;                          // names; empty: angles
+  datasets::Array declared_residual_mm, final_residual_mm;  // T × P × 3
 };
 
 // A declared value the loop corrected (loop.json 'declared_corrections',
@@ -178,6 +185,9 @@ struct LoopFolder {
   std::vector<LoopDeclaredCorrection> declared_corrections;
   std::vector<LoopDiscoveredMoment> discovered_terms;
   std::vector<LoopEstimate> parameters;  // the final model's free parameters
+  // The unit of every RMS figure (the fields named _deg): loop.json 'unit',
+  // "mm" for a loop over tracked points; "deg" in files written before it.
+  std::string unit = "deg";
   double rms_before_deg = kUnknown, rms_after_deg = kUnknown;
   double holdout_rms_before_deg = kUnknown, holdout_rms_after_deg = kUnknown;
   LoopErrors before, after;

@@ -9,7 +9,9 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <string>
+#include <tuple>
 
 #include "ccsrm/common/error.h"
 #include "ccsrm/common/version.h"
@@ -40,7 +42,7 @@ using internal::Show;
 using internal::UnitSuffix;
 
 // Number formats, one per quantity, as `ccsrm loop` prints them.
-const NumberFormat kRms = NumberFormat::Fixed(4);             // deg
+const NumberFormat kRms = NumberFormat::Fixed(4);             // deg, or mm of tracked points
 const NumberFormat kScore = NumberFormat::Fixed(1);           // score, ΔBIC
 const NumberFormat kP = NumberFormat::Significant(2);         // p-value
 const NumberFormat kValue = NumberFormat::Significant(4);     // parameters
@@ -49,6 +51,31 @@ const NumberFormat kSignal = NumberFormat::Significant(3);    // correlations an
 const NumberFormat kCount = NumberFormat::Integer();
 
 const char* YesNo(bool b) { return b ? "yes" : "no"; }
+
+// A loop over tracked points (loop.json 'unit' mm): its channels are the
+// points' coordinates, not joint axes.
+bool OverPoints(const LoopFolder& loop) { return loop.unit == "mm"; }
+
+// The column naming a channel's joint, or of a loop over tracked points its
+// point; and its cell.
+Column ChannelColumn(const LoopFolder& loop) {
+  return OverPoints(loop) ? Column{"point", "point", "", kCount}
+                          : Column{"joint", "joint", "", kCount};
+}
+Cell ChannelCell(int joint, const std::string& point) {
+  return point.empty() ? Cell::Number(joint) : Cell::Text(point);
+}
+
+// A channel's axis: θx, θy of a joint; x, y, z of a tracked point.
+std::string ChannelAxis(const std::string& point, int axis) {
+  return point.empty() ? AxisName(axis) : std::string(1, "xyz"[axis]);
+}
+
+// The channels' word: "joint axis" or "point coordinate", plural with an s.
+std::string ChannelWord(const LoopFolder& loop, bool plural) {
+  return OverPoints(loop) ? (plural ? "point coordinates" : "point coordinate")
+                          : (plural ? "joint axes" : "joint axis");
+}
 
 std::string Names(const std::vector<std::string>& names, const std::string& none) {
   return names.empty() ? none : ListNames(names);
@@ -59,9 +86,15 @@ std::string Names(const std::vector<std::string>& names, const std::string& none
 Table LoopTable(const LoopFolder& loop) {
   Table table = internal::KeyValueTable(
       "loop", "Loop",
-      "From loop.json. RMS errors over every measured frame, joint and axis of the training "
-      "(or held-out) experiments; the noise floor is the RMS of the training experiments' "
-      "per-joint measurement noise: an RMS error near it leaves nothing to explain.");
+      OverPoints(loop)
+          ? "From loop.json. RMS errors: the tracked points' Euclidean distance from the measured "
+            "ones over every measured frame of the training (or held-out) experiments; the noise "
+            "floor is the training experiments' noise of a point's coordinate: an RMS error near "
+            "√3 times it leaves nothing to explain."
+          : "From loop.json. RMS errors over every measured frame, joint and axis of the training "
+            "(or held-out) experiments; the noise floor is the RMS of the training experiments' "
+            "per-joint measurement noise: an RMS error near it leaves nothing to explain.");
+  const std::string& unit = loop.unit;
   AddText(&table, "declared free parameters", Names(loop.declared_free, "none"));
   AddText(&table, "effects added", Names(loop.added_effects, "none"));
   std::vector<std::string> taken_back;
@@ -72,11 +105,11 @@ Table LoopTable(const LoopFolder& loop) {
   }
   if (!taken_back.empty()) AddText(&table, "taken back (backward step)", ListNames(taken_back));
   AddValue(&table, "rounds", static_cast<double>(loop.rounds.size()), "", kCount);
-  AddValue(&table, "training RMS before", loop.rms_before_deg, "deg", kRms);
-  AddValue(&table, "training RMS after", loop.rms_after_deg, "deg", kRms);
-  AddValue(&table, "held-out RMS before", loop.holdout_rms_before_deg, "deg", kRms);
-  AddValue(&table, "held-out RMS after", loop.holdout_rms_after_deg, "deg", kRms);
-  AddValue(&table, "noise floor", loop.noise_floor_deg, "deg", kRms);
+  AddValue(&table, "training RMS before", loop.rms_before_deg, unit, kRms);
+  AddValue(&table, "training RMS after", loop.rms_after_deg, unit, kRms);
+  AddValue(&table, "held-out RMS before", loop.holdout_rms_before_deg, unit, kRms);
+  AddValue(&table, "held-out RMS after", loop.holdout_rms_after_deg, unit, kRms);
+  AddValue(&table, "noise floor", loop.noise_floor_deg, unit, kRms);
   AddText(&table, "declared fit", loop.declared_fit.termination);
   AddValue(&table, "declared fit iterations", loop.declared_fit.iterations, "", kCount);
   AddText(&table, "final fit", loop.final_fit.termination);
@@ -192,13 +225,15 @@ Paragraph AnswerParagraph(const LoopFolder& loop) {
     if (!loop.discovered_terms.empty()) found.push_back("terms found in the data (table below)");
     text = "Answer: added " + ListNames(found) + ".";
   }
-  text += " Training RMS error " + Show(loop.rms_before_deg, kRms) + " deg declared, " +
-          Show(loop.rms_after_deg, kRms) + " deg final";
+  const std::string unit = " " + loop.unit;
+  text += " Training RMS error " + Show(loop.rms_before_deg, kRms) + unit + " declared, " +
+          Show(loop.rms_after_deg, kRms) + unit + " final";
   if (std::isfinite(loop.holdout_rms_before_deg) && std::isfinite(loop.holdout_rms_after_deg)) {
-    text += "; held out " + Show(loop.holdout_rms_before_deg, kRms) + " deg declared, " +
-            Show(loop.holdout_rms_after_deg, kRms) + " deg final";
+    text += "; held out " + Show(loop.holdout_rms_before_deg, kRms) + unit + " declared, " +
+            Show(loop.holdout_rms_after_deg, kRms) + unit + " final";
   }
-  text += "; the noise floor is " + Show(loop.noise_floor_deg, kRms) + " deg.";
+  text += "; the noise floor is " + Show(loop.noise_floor_deg, kRms) + unit +
+          (OverPoints(loop) ? " per coordinate." : ".");
   bool misfit = false;
   if (loop.final_model && loop.final_model->adequacy_known) {
     std::string verdict = loop.final_model->verdict;
@@ -225,13 +260,15 @@ Section SummarySection(const LoopFolder& loop) {
   if (!holdout.empty()) text += ", held out " + ListNames(holdout);
   text += ", and tried the candidate effects in " +
           Plural(static_cast<double>(loop.rounds.size()), "round") + ". The training RMS error " +
-          "went from " + Show(loop.rms_before_deg, kRms) + " deg with the declared model to " +
-          Show(loop.rms_after_deg, kRms) + " deg with the final one";
+          (OverPoints(loop) ? "of the tracked points " : "") + "went from " +
+          Show(loop.rms_before_deg, kRms) + " " + loop.unit + " with the declared model to " +
+          Show(loop.rms_after_deg, kRms) + " " + loop.unit + " with the final one";
   if (std::isfinite(loop.holdout_rms_before_deg) && std::isfinite(loop.holdout_rms_after_deg)) {
     text += ", the held-out error from " + Show(loop.holdout_rms_before_deg, kRms) + " to " +
-            Show(loop.holdout_rms_after_deg, kRms) + " deg";
+            Show(loop.holdout_rms_after_deg, kRms) + " " + loop.unit;
   }
-  text += "; the measurement noise floor is " + Show(loop.noise_floor_deg, kRms) + " deg.";
+  text += "; the measurement noise floor is " + Show(loop.noise_floor_deg, kRms) + " " + loop.unit +
+          (OverPoints(loop) ? " per coordinate." : ".");
   section.blocks.push_back(Paragraph{text, false});
   section.blocks.push_back(Paragraph{"Conclusion: " + loop.conclusion, false});
   if (loop.declared_fit.termination == "failed") {
@@ -322,6 +359,40 @@ Figure ErrorFigure(const LoopFolder& loop) {
   return figure;
 }
 
+// Per training experiment and tracked point, from declared/ and final/:
+// the RMS error and the same with the mean offset removed (the publishing
+// project's metric on the recorded robot).
+Table PointErrorTable(const LoopFolder& loop) {
+  Table table;
+  table.id = "errors_per_point";
+  table.title = "RMS error per tracked point";
+  table.caption =
+      "declared/ and final/ fit.json 'tracked_points' of the training experiments: the Euclidean "
+      "RMS distance of the fitted point from the measured one, and the same after removing the "
+      "mean offset.";
+  table.columns = {{"experiment", "experiment", "", kRms},
+                   {"point", "point", "", kRms},
+                   {"before_mm", "declared model", "mm", kRms},
+                   {"after_mm", "final model", "mm", kRms},
+                   {"before_mean_removed_mm", "declared, mean removed", "mm", kRms},
+                   {"after_mean_removed_mm", "final, mean removed", "mm", kRms}};
+  if (!loop.declared || !loop.final_model) return table;
+  for (const internal::FitExperiment& before : loop.declared->experiments) {
+    for (const internal::FitExperiment& after : loop.final_model->experiments) {
+      if (after.name != before.name || after.points != before.points) continue;
+      for (std::size_t p = 0; p < before.points.size(); ++p) {
+        const auto at = [p](const std::vector<double>& v) {
+          return p < v.size() ? Cell::Number(v[p]) : Cell::Missing();
+        };
+        table.AddRow({Cell::Text(before.name), Cell::Text(before.points[p]),
+                      at(before.point_rms_mm), at(after.point_rms_mm),
+                      at(before.point_rms_mean_removed_mm), at(after.point_rms_mean_removed_mm)});
+      }
+    }
+  }
+  return table;
+}
+
 Section ErrorSection(const LoopFolder& loop) {
   Section section{"errors", "Error before and after", {}};
   const bool held = loop.holdout_before && loop.holdout_after;
@@ -330,15 +401,21 @@ Section ErrorSection(const LoopFolder& loop) {
   overall.title = "RMS error";
   overall.caption =
       "loop.json 'rms_before_deg', 'rms_after_deg' and their held-out twins: the declared "
-      "model's fit (before) against the final model's (after).";
+      "model's fit (before) against the final model's (after)" +
+      std::string(OverPoints(loop) ? ", in mm (loop.json 'unit')." : ".");
   overall.columns = {{"data", "data", "", kRms},
-                     {"before_deg", "declared model", "deg", kRms},
-                     {"after_deg", "final model", "deg", kRms}};
+                     {"before_" + loop.unit, "declared model", loop.unit, kRms},
+                     {"after_" + loop.unit, "final model", loop.unit, kRms}};
   overall.AddRow({Cell::Text("training"), Cell::Number(loop.rms_before_deg),
                   Cell::Number(loop.rms_after_deg)});
   if (std::isfinite(loop.holdout_rms_before_deg) || std::isfinite(loop.holdout_rms_after_deg)) {
     overall.AddRow({Cell::Text("held out"), Cell::Number(loop.holdout_rms_before_deg),
                     Cell::Number(loop.holdout_rms_after_deg)});
+  }
+  if (OverPoints(loop)) {
+    section.blocks.push_back(std::move(overall));
+    section.blocks.push_back(PointErrorTable(loop));
+    return section;
   }
   Table per_joint;
   per_joint.id = "errors_per_joint";
@@ -391,44 +468,89 @@ Section ErrorSection(const LoopFolder& loop) {
 // the final model right, on the same y range so the two can be compared.
 // `before` and `after` are T × J × 2 residuals [deg] at `time_before` and
 // `time_after`.
-Figure ResidualFigure(const std::string& name, const std::vector<JointGroup>& segments, int c,
-                      const std::vector<double>& time_before, const datasets::Array& before,
-                      const std::vector<double>& time_after, const datasets::Array& after) {
+Figure PairedResidualFigure(const std::string& name) {
   Figure figure;
   figure.name = name;
   figure.columns = 2;
   figure.panel_width_px = 640;
   figure.panel_height_px = 280;
+  return figure;
+}
+
+// One row of a residual figure, `title`: the series of components 0..n-1 of
+// index `which` (a joint's axis, a point's coordinate), from `before` (the
+// declared model, left) and `after` (the final model, right), on the same y
+// range. `component(k)` gives series k's index and axis into the arrays, its
+// label and its colour index.
+void AddResidualRow(
+    const std::string& title, const Axis& y, std::size_t n,
+    const std::function<std::tuple<std::size_t, std::size_t, std::string, int>(std::size_t)>&
+        component,
+    const std::vector<double>& time_before, const datasets::Array& before,
+    const std::vector<double>& time_after, const datasets::Array& after, Figure* figure) {
+  double top = 0.0;
+  const std::pair<const std::vector<double>*, const datasets::Array*> sides[] = {
+      {&time_before, &before}, {&time_after, &after}};
+  std::vector<Panel> pair;
+  for (int s = 0; s < 2; ++s) {
+    Panel panel;
+    panel.title = title + ": " + (s == 0 ? "declared model" : "final model");
+    panel.x = internal::TimeAxis();
+    panel.y = y;
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto [index, axis, label, colour] = component(k);
+      Series series{label, *sides[s].first, internal::ComponentOf(*sides[s].second, index, axis),
+                    palette::Indexed(colour)};
+      series.line_width = 1.2;
+      for (double v : series.y) {
+        if (std::isfinite(v)) top = std::max(top, std::abs(v));
+      }
+      panel.series.push_back(std::move(series));
+    }
+    pair.push_back(std::move(panel));
+  }
+  if (top > 0.0) {
+    for (Panel& panel : pair) {
+      panel.y.min = -1.05 * top;
+      panel.y.max = 1.05 * top;
+    }
+  }
+  for (Panel& panel : pair) figure->panels.push_back(std::move(panel));
+}
+
+Figure ResidualFigure(const std::string& name, const std::vector<JointGroup>& segments, int c,
+                      const std::vector<double>& time_before, const datasets::Array& before,
+                      const std::vector<double>& time_after, const datasets::Array& after) {
+  Figure figure = PairedResidualFigure(name);
   const std::size_t axis = static_cast<std::size_t>(c);
   for (const JointGroup& group : segments) {
-    double top = 0.0;
-    const std::pair<const std::vector<double>*, const datasets::Array*> sides[] = {
-        {&time_before, &before}, {&time_after, &after}};
-    std::vector<Panel> pair;
-    for (int s = 0; s < 2; ++s) {
-      Panel panel;
-      panel.title = group.title + ": " + (s == 0 ? "declared model" : "final model");
-      panel.x = internal::TimeAxis();
-      panel.y = Axis{std::string("residual ") + AxisName(c), "deg"};
-      for (int k = 1; k <= group.joints; ++k) {
-        const std::size_t j = static_cast<std::size_t>(group.first_joint + k - 2);
-        Series series{"joint " + std::to_string(j + 1), *sides[s].first,
-                      internal::ComponentOf(*sides[s].second, j, axis), palette::Indexed(k)};
-        series.line_width = 1.2;
-        for (double v : series.y) {
-          if (std::isfinite(v)) top = std::max(top, std::abs(v));
-        }
-        panel.series.push_back(std::move(series));
-      }
-      pair.push_back(std::move(panel));
-    }
-    if (top > 0.0) {
-      for (Panel& panel : pair) {
-        panel.y.min = -1.05 * top;
-        panel.y.max = 1.05 * top;
-      }
-    }
-    for (Panel& panel : pair) figure.panels.push_back(std::move(panel));
+    AddResidualRow(
+        group.title, Axis{std::string("residual ") + AxisName(c), "deg"},
+        static_cast<std::size_t>(group.joints),
+        [&](std::size_t k) {
+          const std::size_t j = static_cast<std::size_t>(group.first_joint - 1) + k;
+          return std::tuple{j, axis, "joint " + std::to_string(j + 1), static_cast<int>(k) + 1};
+        },
+        time_before, before, time_after, after, &figure);
+  }
+  return figure;
+}
+
+// Residuals of tracked points (T × P × 3 [mm]), one row per coordinate x,
+// y, z: the declared model left and the final model right, each point in
+// its colour.
+Figure PointResidualFigure(const std::string& name, const std::vector<std::string>& points,
+                           const std::vector<double>& time_before, const datasets::Array& before,
+                           const std::vector<double>& time_after, const datasets::Array& after) {
+  Figure figure = PairedResidualFigure(name);
+  for (std::size_t a = 0; a < 3; ++a) {
+    const std::string axis(1, "xyz"[a]);
+    AddResidualRow(
+        "Coordinate " + axis, Axis{"residual " + axis, "mm"}, points.size(),
+        [&](std::size_t p) {
+          return std::tuple{p, a, points[p], static_cast<int>(p) + 1};
+        },
+        time_before, before, time_after, after, &figure);
   }
   return figure;
 }
@@ -458,10 +580,15 @@ Section TrainingResidualSection(const LoopFolder& loop) {
     return section;
   }
   section.blocks.push_back(Paragraph{
-      "Residual (fitted − measured) of every joint over time, from declared/ and final/ "
-      "<experiment>.angles.csv: left with the declared model's fitted parameters, right with "
-      "the final model's. A residual that follows the motion rather than scattering around 0 is "
-      "what a model misses.",
+      OverPoints(loop)
+          ? "Residual (fitted − measured) of every tracked point over time, from declared/ and "
+            "final/ <experiment>.points.csv: left with the declared model's fitted parameters, "
+            "right with the final model's. A residual that follows the motion rather than "
+            "scattering around 0 is what a model misses."
+          : "Residual (fitted − measured) of every joint over time, from declared/ and final/ "
+            "<experiment>.angles.csv: left with the declared model's fitted parameters, right "
+            "with the final model's. A residual that follows the motion rather than scattering "
+            "around 0 is what a model misses.",
       false});
   const bool several = loop.declared->experiments.size() > 1;
   for (std::size_t e = 0; e < loop.declared->experiments.size(); ++e) {
@@ -469,6 +596,27 @@ Section TrainingResidualSection(const LoopFolder& loop) {
     const internal::FitExperiment* after = nullptr;
     for (const internal::FitExperiment& x : loop.final_model->experiments) {
       if (x.name == before.name) after = &x;
+    }
+    if (!before.points.empty()) {
+      if (after == nullptr || after->points != before.points) {
+        section.blocks.push_back(
+            Paragraph{"final/ has no experiment " + before.name +
+                          " with the tracked points of declared/: its residuals are not shown.",
+                      true});
+        continue;
+      }
+      const std::string stem =
+          FigureStem(several ? before.name + "_" + std::to_string(e + 1) : before.name);
+      section.blocks.push_back(FigureBlock{
+          PointResidualFigure("residual_points_" + stem, before.points, before.time_s,
+                              before.residual_mm, after->time_s, after->residual_mm),
+          "Tracked points' residual: " + before.name,
+          "Experiment " + before.name +
+              ": fitted minus measured position of each tracked point, one row per coordinate "
+              "(in the frame the points were recorded in); the declared model left, the final "
+              "model right, on the same scale.",
+          ""});
+      continue;
     }
     if (after == nullptr || after->residual_deg.shape[1] != before.residual_deg.shape[1]) {
       section.blocks.push_back(
@@ -504,14 +652,30 @@ Section TrainingResidualSection(const LoopFolder& loop) {
 Section HoldoutResidualSection(const LoopFolder& loop) {
   Section section{"holdout", "Residuals before and after (held out)", {}};
   section.blocks.push_back(Paragraph{
-      "Residual (simulated − measured) of the held-out experiments, from holdout/"
-      "<experiment>.angles.csv: left the declared model's run, right the final model's. Neither "
-      "fit saw these data.",
+      OverPoints(loop)
+          ? "Residual (simulated − measured) of the held-out experiments' tracked points, from "
+            "holdout/<experiment>.declared.points.csv and .final.points.csv: left the declared "
+            "model's run, right the final model's. Neither fit saw these data."
+          : "Residual (simulated − measured) of the held-out experiments, from holdout/"
+            "<experiment>.angles.csv: left the declared model's run, right the final model's. "
+            "Neither fit saw these data.",
       false});
   const std::vector<JointGroup>* known = SegmentsOf(loop);
   const bool several = loop.holdout.size() > 1;
   for (std::size_t e = 0; e < loop.holdout.size(); ++e) {
     const internal::LoopHoldout& h = loop.holdout[e];
+    if (!h.points.empty()) {
+      const std::string stem = FigureStem(several ? h.name + "_" + std::to_string(e + 1) : h.name);
+      section.blocks.push_back(FigureBlock{
+          PointResidualFigure("holdout_residual_points_" + stem, h.points, h.time_s,
+                              h.declared_residual_mm, h.time_s, h.final_residual_mm),
+          "Tracked points' residual: " + h.name + " (held out)",
+          "Held-out experiment " + h.name + " (" + h.path +
+              "): simulated minus measured position of each tracked point, one row per "
+              "coordinate; the declared model left, the final model right, on the same scale.",
+          ""});
+      continue;
+    }
     const std::size_t joints = h.measured_deg.shape[1];
     std::vector<JointGroup> segments;
     int covered = 0;
@@ -605,9 +769,10 @@ Table SignalTable(const std::string& id, const std::string& title, const LoopDia
   table.title = title;
   table.caption =
       source +
-      ": each signal's correlation with the residual pooled over every joint and axis (for "
-      "constant, hysteresis and lag the normalised statistic of diagnostics.h), and the 95 % "
-      "band of no relation from the effective number of independent samples.";
+      ": each signal's correlation with the residual pooled over every channel (joint axis or "
+      "tracked point coordinate; for constant, hysteresis and lag the normalised statistic of "
+      "diagnostics.h), and the 95 % band of no relation from the effective number of "
+      "independent samples.";
   table.columns = {{"signal", "signal", "", kSignal},
                    {"value", "value", "", kSignal},
                    {"band", "95 % band", "", kSignal},
@@ -619,8 +784,8 @@ Table SignalTable(const std::string& id, const std::string& title, const LoopDia
   return table;
 }
 
-Table ExperimentLagTable(const std::string& id, const LoopDiagnostics& d,
-                         const std::string& source) {
+Table ExperimentLagTable(const std::string& id, const LoopDiagnostics& d, const std::string& source,
+                         const std::string& unit) {
   Table table;
   table.id = id;
   table.title = "Residual per experiment";
@@ -629,7 +794,7 @@ Table ExperimentLagTable(const std::string& id, const LoopDiagnostics& d,
                   "measured one (positive: the arm moves later than simulated) and the share of "
                   "the residual's mean square that shift removes.";
   table.columns = {{"experiment", "experiment", "", kRms},
-                   {"rms_deg", "RMS", "deg", kRms},
+                   {"rms_deg", "RMS", unit, kRms},
                    {"lag_s", "lag", "s", NumberFormat::Fixed(3)},
                    {"lag_explained", "explained by the lag", "", kSignal}};
   for (const LoopDiagnostics::Experiment& e : d.experiments) {
@@ -639,7 +804,7 @@ Table ExperimentLagTable(const std::string& id, const LoopDiagnostics& d,
   return table;
 }
 
-Table CandidateTable(const std::string& id, const LoopRound& round) {
+Table CandidateTable(const std::string& id, const LoopRound& round, const std::string& unit) {
   Table table;
   table.id = id;
   table.title = "Candidates";
@@ -655,8 +820,8 @@ Table CandidateTable(const std::string& id, const LoopRound& round) {
                    {"significant", "significant", "", kScore},
                    {"refitted", "refitted", "", kScore},
                    {"delta_bic", "ΔBIC", "", kScore},
-                   {"rms_deg", "RMS", "deg", kRms},
-                   {"holdout_rms_deg", "held-out RMS", "deg", kRms},
+                   {"rms_deg", "RMS", unit, kRms},
+                   {"holdout_rms_deg", "held-out RMS", unit, kRms},
                    {"holdout_improved", "held-out gain", "", kScore},
                    {"size_significant", "size ≠ 0", "", kScore},
                    {"accepted", "accepted", "", kScore},
@@ -678,7 +843,7 @@ Table CandidateTable(const std::string& id, const LoopRound& round) {
 
 // The backward step of a round (issue 28): each earlier addition checked
 // in the fit after the round's winner, and whether it was taken back.
-Table BackwardTable(const std::string& id, const LoopRound& round) {
+Table BackwardTable(const std::string& id, const LoopRound& round, const std::string& unit) {
   Table table;
   table.id = id;
   table.title = "Backward step";
@@ -694,8 +859,8 @@ Table BackwardTable(const std::string& id, const LoopRound& round) {
                    {"delta_chi2_zeroed", "Δχ² at 0", "", kScore},
                    {"refitted", "refitted without", "", kScore},
                    {"delta_bic_keep", "ΔBIC of keeping", "", kScore},
-                   {"rms_deg_without", "RMS without", "deg", kRms},
-                   {"holdout_rms_deg_without", "held-out RMS without", "deg", kRms},
+                   {"rms_deg_without", "RMS without", unit, kRms},
+                   {"holdout_rms_deg_without", "held-out RMS without", unit, kRms},
                    {"taken_back", "taken back", "", kScore},
                    {"reason", "reason", "", kScore, true}};
   for (const internal::LoopBackwardCheck& b : round.backward) {
@@ -771,28 +936,28 @@ Table EvidenceTable(const std::string& id, const LoopRound& round) {
   return table;
 }
 
-Section RoundSection(const LoopRound& round) {
+Section RoundSection(const LoopRound& round, const std::string& unit) {
   const std::string k = std::to_string(round.index);
   Section section{"round-" + k, "Round " + k, {}};
   std::string text = "Round " + k + " started from the model with " +
                      (round.effects_on.empty() ? std::string("no effect added (the declared model)")
                                                : ListNames(round.effects_on) + " on") +
-                     ": training RMS " + Show(round.rms_deg, kRms) + " deg";
+                     ": training RMS " + Show(round.rms_deg, kRms) + " " + unit;
   if (std::isfinite(round.holdout_rms_deg)) {
-    text += ", held out " + Show(round.holdout_rms_deg, kRms) + " deg";
+    text += ", held out " + Show(round.holdout_rms_deg, kRms) + " " + unit;
   }
   text += ". " + Plural(static_cast<double>(round.candidates.size()), "candidate") +
           " scored. Decision: " + round.decision;
   section.blocks.push_back(Paragraph{text, false});
-  section.blocks.push_back(CandidateTable("round_" + k + "_candidates", round));
+  section.blocks.push_back(CandidateTable("round_" + k + "_candidates", round, unit));
   if (!round.backward.empty()) {
-    section.blocks.push_back(BackwardTable("round_" + k + "_backward", round));
+    section.blocks.push_back(BackwardTable("round_" + k + "_backward", round, unit));
   }
   section.blocks.push_back(EstimateTable("round_" + k + "_estimates", round));
   section.blocks.push_back(CrossCorrelationBlock(
       "cross_correlation_round_" + k, round.evidence, "Residual against the signals, round " + k,
       "Cross-correlation of the residual of the round's starting model (simulated − measured) "
-      "with each signal of the simulated motion, pooled over every joint and axis, against the "
+      "with each signal of the simulated motion, pooled over every channel, against the "
       "shift of the signal (loop.json 'cross_correlation' at 'lags_s'). Dashed: the 95 % band "
       "of no relation at lag 0; red: the signal's pooled correlation lies outside it."));
   section.blocks.push_back(SignalTable("round_" + k + "_signals", "Signals in the residual",
@@ -800,7 +965,8 @@ Section RoundSection(const LoopRound& round) {
                                        "loop.json 'evidence.pooled' of round " + k));
   section.blocks.push_back(EvidenceTable("round_" + k + "_evidence", round));
   section.blocks.push_back(ExperimentLagTable("round_" + k + "_experiments", round.evidence,
-                                              "loop.json 'evidence.experiments' of round " + k));
+                                              "loop.json 'evidence.experiments' of round " + k,
+                                              unit));
   return section;
 }
 
@@ -854,23 +1020,26 @@ Section ParameterSection(const LoopFolder& loop) {
 Table UnexplainedTable(const LoopFolder& loop) {
   Table table;
   table.id = "unexplained";
-  table.title = "Joint axes the final model does not explain";
+  table.title = OverPoints(loop) ? "Point coordinates the final model does not explain"
+                                 : "Joint axes the final model does not explain";
   table.caption =
-      "loop.json 'unexplained': every experiment, joint and axis whose residual stands above its "
+      "loop.json 'unexplained': every experiment and channel whose residual stands above its "
       "measurement noise by the rule of the final model's verdict (RMS beyond the loop's ratio, "
       "LoopOptions::unexplained_noise_ratio, 1.5 by default, and beyond chance), largest ratio "
       "first, with the phase of the protocol where it is largest. RMS and noise here weigh each "
       "frame by its noise (a recording's ends count less); the fit's tables give them raw.";
+  const std::string& unit = loop.unit;
   table.columns = {{"experiment", "experiment", "", kRms},
-                   {"joint", "joint", "", kCount},
+                   ChannelColumn(loop),
                    {"axis", "axis", "", kRms},
-                   {"rms_deg", "RMS", "deg", kRms},
-                   {"noise_deg", "noise", "deg", kRms},
+                   {"rms_deg", "RMS", unit, kRms},
+                   {"noise_deg", "noise", unit, kRms},
                    {"worst_phase", "worst phase", "", kRms},
-                   {"worst_phase_rms_deg", "RMS in it", "deg", kRms}};
+                   {"worst_phase_rms_deg", "RMS in it", unit, kRms}};
   for (const internal::LoopUnexplained& u : loop.unexplained) {
-    table.AddRow({Cell::Text(u.experiment), Cell::Number(u.joint), Cell::Text(AxisName(u.axis)),
-                  Cell::Number(u.rms_deg), Cell::Number(u.noise_deg), Cell::Text(u.worst_phase),
+    table.AddRow({Cell::Text(u.experiment), ChannelCell(u.joint, u.point),
+                  Cell::Text(ChannelAxis(u.point, u.axis)), Cell::Number(u.rms_deg),
+                  Cell::Number(u.noise_deg), Cell::Text(u.worst_phase),
                   Cell::Number(u.worst_phase_rms_deg)});
   }
   return table;
@@ -878,33 +1047,38 @@ Table UnexplainedTable(const LoopFolder& loop) {
 
 // The final residual per experiment, joint and axis: how far above the
 // noise, how white, drift and hysteresis.
-Table ChannelTable(const LoopDiagnostics& d) {
+Table ChannelTable(const LoopFolder& loop) {
+  const LoopDiagnostics& d = loop.final_evidence;
+  const std::string& unit = loop.unit;
   Table table;
   table.id = "final_channels";
-  table.title = "Final residual per joint and axis";
+  table.title = OverPoints(loop) ? "Final residual per tracked point and coordinate"
+                                 : "Final residual per joint and axis";
   table.caption =
       "loop.json 'final_evidence.channels' (residual simulated − measured of the final model): "
       "RMS, mean and the experiment's noise; the share of autocorrelation lags outside the "
       "white-noise band (about 0.05 for white noise) and the autocorrelation time [frames]; the "
-      "mean slope during holds and the loop area against the angle.";
+      "mean slope during holds and the loop area against the angle (of a tracked point: its "
+      "coordinate).";
   table.columns = {{"experiment", "experiment", "", kRms},
-                   {"joint", "joint", "", kCount},
+                   ChannelColumn(loop),
                    {"axis", "axis", "", kRms},
                    {"samples", "samples", "", kCount},
-                   {"rms_deg", "RMS", "deg", kRms},
-                   {"mean_deg", "mean", "deg", kRms},
-                   {"noise_deg", "noise", "deg", kRms},
+                   {"rms_deg", "RMS", unit, kRms},
+                   {"mean_deg", "mean", unit, kRms},
+                   {"noise_deg", "noise", unit, kRms},
                    {"lags_outside_band", "lags outside band", "", NumberFormat::Fixed(2)},
                    {"autocorrelation_time", "autocorrelation time", "", NumberFormat::Fixed(1)},
                    {"effective_samples", "effective samples", "", kCount},
-                   {"hold_drift_degps", "hold drift", "deg/s", NumberFormat::Significant(3)},
-                   {"hysteresis_deg2", "hysteresis", "deg²", NumberFormat::Significant(3)}};
+                   {"hold_drift_degps", "hold drift", unit + "/s", NumberFormat::Significant(3)},
+                   {"hysteresis_deg2", "hysteresis", unit + "²", NumberFormat::Significant(3)}};
   for (const LoopDiagnostics::Channel& c : d.channels) {
-    table.AddRow({Cell::Text(c.experiment), Cell::Number(c.joint), Cell::Text(AxisName(c.axis)),
-                  Cell::Number(c.samples), Cell::Number(c.rms_deg), Cell::Number(c.mean_deg),
-                  Cell::Number(c.noise_deg), Cell::Number(c.lags_outside_band),
-                  Cell::Number(c.autocorrelation_time), Cell::Number(c.effective_samples),
-                  Cell::Number(c.hold_drift_degps), Cell::Number(c.hysteresis_deg2)});
+    table.AddRow({Cell::Text(c.experiment), ChannelCell(c.joint, c.point),
+                  Cell::Text(ChannelAxis(c.point, c.axis)), Cell::Number(c.samples),
+                  Cell::Number(c.rms_deg), Cell::Number(c.mean_deg), Cell::Number(c.noise_deg),
+                  Cell::Number(c.lags_outside_band), Cell::Number(c.autocorrelation_time),
+                  Cell::Number(c.effective_samples), Cell::Number(c.hold_drift_degps),
+                  Cell::Number(c.hysteresis_deg2)});
   }
   return table;
 }
@@ -935,11 +1109,12 @@ Section UnexplainedSection(const LoopFolder& loop) {
   const std::size_t n = loop.unexplained.size();
   section.blocks.push_back(Paragraph{
       "Conclusion: " + loop.conclusion + " " +
-          (n == 0 ? std::string("No joint axis keeps a residual above its noise threshold.")
-                  : Show(static_cast<double>(n), kCount) +
-                        (n == 1 ? " joint axis keeps" : " joint axes keep") +
-                        " a residual above its noise threshold (table below); the signals the "
-                        "residual still follows point to what the effect library lacks."),
+          (n == 0
+               ? "No " + ChannelWord(loop, false) + " keeps a residual above its noise threshold."
+               : Show(static_cast<double>(n), kCount) + " " + ChannelWord(loop, n != 1) +
+                     (n == 1 ? " keeps" : " keep") +
+                     " a residual above its noise threshold (table below); the signals the "
+                     "residual still follows point to what the effect library lacks."),
       false});
   section.blocks.push_back(UnexplainedTable(loop));
   section.blocks.push_back(PhaseTable(loop.final_evidence));
@@ -951,8 +1126,8 @@ Section UnexplainedSection(const LoopFolder& loop) {
   section.blocks.push_back(SignalTable("final_signals", "Signals in the final residual",
                                        loop.final_evidence, "loop.json 'final_evidence.pooled'"));
   section.blocks.push_back(ExperimentLagTable("final_experiments", loop.final_evidence,
-                                              "loop.json 'final_evidence.experiments'"));
-  section.blocks.push_back(ChannelTable(loop.final_evidence));
+                                              "loop.json 'final_evidence.experiments'", loop.unit));
+  section.blocks.push_back(ChannelTable(loop));
   return section;
 }
 
@@ -973,7 +1148,9 @@ Document BuildLoopDocument(const std::string& folder, const ReportOptions& optio
   document.sections.push_back(ErrorSection(loop));
   document.sections.push_back(TrainingResidualSection(loop));
   if (!loop.holdout.empty()) document.sections.push_back(HoldoutResidualSection(loop));
-  for (const LoopRound& round : loop.rounds) document.sections.push_back(RoundSection(round));
+  for (const LoopRound& round : loop.rounds) {
+    document.sections.push_back(RoundSection(round, loop.unit));
+  }
   document.sections.push_back(ParameterSection(loop));
   document.sections.push_back(UnexplainedSection(loop));
   return document;

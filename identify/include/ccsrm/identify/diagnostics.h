@@ -11,9 +11,10 @@
 // are taken from the simulated motion:
 //   rate_sign   sign of the joint rate (0 while the joint is still)
 //   rate        joint rate
-//   angle       joint angle
+//   angle       joint angle (a tracked point's coordinate)
 //   heading     the heading of the joint's distal link: the sum of the
-//               angles of this axis from joint 1 to the joint
+//               angles of this axis from joint 1 to the joint (none for a
+//               tracked point)
 //   time        time since the start of the experiment
 //   input_rate  rate of the input cable that moves most
 //   constant    the residual's mean (value: mean / RMS)
@@ -55,10 +56,15 @@ struct SignalEvidence {
   bool significant() const { return std::abs(value) > band; }
 };
 
+// A channel: a joint's axis, or a tracked point's coordinate in the capture
+// frame (an experiment of tracked points, issue 46). A tracked point's
+// channel is in mm where a joint's is in deg (every field named _deg below,
+// as in ChannelAboveNoise), and has no heading.
 struct ChannelDiagnostics {
   std::size_t experiment = 0;
-  int joint = 0;  // 1-based
-  int axis = 0;   // 0 θx, 1 θy
+  int joint = 0;      // 1-based; 0 for a tracked point's coordinate
+  int axis = 0;       // 0 θx, 1 θy; of a tracked point 0 x, 1 y, 2 z
+  std::string point;  // the tracked point's name (Experiment::tracked_points)
   std::size_t samples = 0;
   double rms_deg = 0.0;
   double mean_deg = 0.0;
@@ -76,6 +82,9 @@ struct ChannelDiagnostics {
   double hysteresis_deg2 = 0.0;          // ∮ r dθ [deg²]
   std::vector<double> phase_rms_deg;     // per phase of the experiment
 };
+
+// "joint 3 θx", or of a tracked point's coordinate "point tip x".
+std::string ChannelName(int joint, int axis, const std::string& point);
 
 struct ExperimentDiagnostics {
   std::string name;
@@ -106,7 +115,10 @@ struct ResidualDiagnostics {
 
 // Diagnoses the residual of simulated angles [rad] (one matrix per
 // experiment, laid out as Experiment::measured and passed through
-// Experiment::AsMeasured) against the experiments' measured angles.
+// Experiment::AsMeasured) against the experiments' measured angles, or of
+// the simulated tracked points [m] against the measured ones. The RMS
+// figures of an experiment and of the whole are over its channels, deg or
+// mm: the loop never mixes experiments of angles and of tracked points.
 ResidualDiagnostics DiagnoseResidual(const std::vector<Experiment>& experiments,
                                      const std::vector<Eigen::MatrixXd>& simulated_rad);
 

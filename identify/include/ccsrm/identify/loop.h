@@ -94,6 +94,13 @@
 // and the partial-explanation rule included. Reported as a formula per
 // segment's joints and axis (LoopSummary::discovered_terms).
 //
+// Experiments of tracked points (issue 46) go through the same rounds: the
+// residual, the scores and the refits are the fit's (each run placed in the
+// capture frame by its best rigid motion), the evidence is per point
+// coordinate, and every RMS figure is the points' Euclidean RMS error in mm
+// (LoopSummary::unit). Measurement effects act on recorded joint angles:
+// they are no candidates there. The loop takes one kind at a time.
+//
 // At the end, every (experiment, joint, axis) whose residual stands above its
 // noise by the verdict's rule (adequacy.h: RMS beyond unexplained_noise_ratio,
 // 1.5, times its noise and beyond chance) is reported as unexplained, with
@@ -279,10 +286,14 @@ struct DiscoveredMoment {
   std::string Formula() const;
 };
 
+// A channel (ChannelDiagnostics) whose residual stays above its noise: a
+// joint's axis, or a tracked point's coordinate (its fields in deg then in
+// mm).
 struct UnexplainedChannel {
   std::string experiment;
-  int joint = 0;
-  int axis = 0;
+  int joint = 0;      // 0 for a tracked point's coordinate
+  int axis = 0;       // 0 θx, 1 θy; of a tracked point 0 x, 1 y, 2 z
+  std::string point;  // the tracked point's name
   double rms_deg = 0.0;
   double noise_deg = 0.0;
   std::string worst_phase;
@@ -308,6 +319,10 @@ struct DeclaredCorrection {
 
 struct LoopSummary {
   LoopOptions options;  // what the loop ran with (its thresholds go to loop.json)
+  // The unit of every RMS figure of the loop (the fields named _deg, and
+  // their diagnostics): "deg" over joint angles, "mm" over experiments of
+  // tracked points (issue 46; LoopRms: the points' Euclidean RMS error).
+  std::string unit = "deg";
   std::vector<LoopRound> rounds;
   // Effects (and joint_moment, the discovered terms) in the final model, in
   // order; an addition the backward step took back is not among them.
@@ -353,7 +368,8 @@ nlohmann::json ToJson(const LoopSummary& summary, const std::vector<Experiment>&
 // was corrected (LoopSummary::calibrated); declared/ and final/ (fit folders of
 // the declared and the final model, WriteFitDirectory); holdout/ with, per
 // held-out experiment, <name>.angles.csv (time, measured, declared, final
-// θx and θy of every joint, deg). Returns the paths written.
+// θx and θy of every joint, deg; of tracked points <name>.declared.points.csv
+// and <name>.final.points.csv, mm). Returns the paths written.
 std::vector<std::string> WriteLoopDirectory(const LoopSummary& summary,
                                             const std::vector<Experiment>& training,
                                             const std::vector<Experiment>& holdout,
