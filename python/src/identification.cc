@@ -333,6 +333,9 @@ void AddLoop(py::module_& m) {
       "and the final fit, with loop.json.")
       .def_property_readonly("added_effects", [](const Loop& l) { return l.summary.added_effects; })
       .def_property_readonly("conclusion", [](const Loop& l) { return l.summary.conclusion; })
+      .def_property_readonly(
+          "unit", [](const Loop& l) { return l.summary.unit; },
+          "The unit of every RMS figure: 'deg', or 'mm' for recordings of tracked points.")
       .def_property_readonly("rms_before_deg",
                              [](const Loop& l) { return l.summary.rms_before_deg; })
       .def_property_readonly("rms_after_deg", [](const Loop& l) { return l.summary.rms_after_deg; })
