@@ -607,6 +607,29 @@ TEST(PretensionCreep, CreepLowersTensionOverTime) {
   EXPECT_NEAR(creep->PretensionFactor(1.0), 1.0 - 0.2 * (1.0 - std::exp(-1.0)), 1e-15);
 }
 
+TEST(PretensionCreep, EachSegmentsCablesLoseTheirOwnPretension) {
+  // As above, with segment 2's cables 20 N above T_d0: each cable loses the
+  // same fraction of its own pre-tension, T_d0 + its segment's change
+  // (a creep computed from T_d0 alone would leave segment 2's cables 4 N
+  // too taut at t → ∞).
+  PaperShort arm(1);
+  ArmParameters p = arm.config.parameters;
+  SetParameter("segment_pretension.segment2_n", 20.0, "test", &p);
+  SetParameter("pretension_creep.driving_fraction", 0.2, "test", &p);
+  SetParameter("pretension_creep.time_constant_s", 1.0, "test", &p);
+  const SimulationResult r =
+      Simulate(arm.model, p, Held(arm.model, 3.0), OptionsFor(arm.config, 3.0));
+  ASSERT_TRUE(r.summary.completed()) << r.summary.message;
+  const std::size_t f = 300;
+  const double t = r.trajectory.time[f];
+  for (int c = 0; c < arm.model.num_cables(); ++c) {
+    const double own = p.T_d0 + (arm.model.cables()[c].segment == 1 ? 20.0 : 0.0);
+    const double expected = own * (1.0 - 0.2 * (1.0 - std::exp(-t)));
+    EXPECT_NEAR(r.trajectory.frames[f].element_tension[c][0], expected, 0.01 * own)
+        << "cable " << c + 1 << " at " << t << " s";
+  }
+}
+
 TEST(SegmentPretension, EachSegmentsCablesStartAtTheirOwnPretension) {
   // Case 1, inputs held, segment 2's cables 20 N above T_d0: a pre-strain
   // of the straight arm, so with frictionless holes every element of a

@@ -4,7 +4,9 @@
 //   T(t) = T0 (1 − f (1 − e^(−t/τ)))
 //
 // with f `pretension_creep.connecting_fraction` for the connecting cables'
-// T_p, `pretension_creep.driving_fraction` for the driving cables' T_d0 and
+// T_p, `pretension_creep.driving_fraction` for the driving cables' T_d0 (a
+// cable's own pre-tension with segment_pretension on: T_d0 plus its
+// segment's change; none lost by a cable that starts slack) and
 // τ `pretension_creep.time_constant_s`, t from the start of the run.
 // Connecting cables: T_p enters the large-S couples (capstan stiffness and
 // conduit friction, eqs. 46-53) through PretensionFactor. Driving cables:
@@ -16,6 +18,8 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "ccsrm/sim/kinematics.h"
 #include "effect.h"
@@ -29,7 +33,13 @@ class PretensionCreep final : public Effect {
       : connecting_(GetParameter(p, "pretension_creep.connecting_fraction")),
         driving_(GetParameter(p, "pretension_creep.driving_fraction")),
         tau_s_(GetParameter(p, "pretension_creep.time_constant_s")),
-        t_d0_(p.T_d0) {}
+        t_d0_(p.T_d0) {
+    if (!p.EffectOn("segment_pretension")) return;
+    for (int k = 1; k <= p.arm.segments; ++k) {
+      segment_change_n_.push_back(
+          GetParameter(p, "segment_pretension.segment" + std::to_string(k) + "_n"));
+    }
+  }
 
   bool scales_pretension() const override { return connecting_ > 0.0; }
 
@@ -50,7 +60,8 @@ class PretensionCreep final : public Effect {
     Eigen::VectorXd time(n);
     Eigen::MatrixXd realised(n, commanded.num_cables());
     for (int c = 0; c < commanded.num_cables(); ++c) {
-      const double paid_out_full = driving_ * t_d0_ * CablePathLength(model, c, straight) / ea;
+      const double paid_out_full = driving_ * Pretension(model.cables()[c].segment) *
+                                   CablePathLength(model, c, straight) / ea;
       for (int k = 0; k < n; ++k) {
         const double t = start + step * k;
         double u, rate, accel;
@@ -66,7 +77,14 @@ class PretensionCreep final : public Effect {
   // 1 − e^(−t/τ), the relaxed fraction of f at time t.
   double Relaxed(double t) const { return -std::expm1(-std::max(0.0, t) / tau_s_); }
 
+  // The pre-tension of a driving cable of `segment` (0-based) [N], at least 0.
+  double Pretension(int segment) const {
+    const std::size_t k = static_cast<std::size_t>(segment);
+    return std::max(0.0, t_d0_ + (k < segment_change_n_.size() ? segment_change_n_[k] : 0.0));
+  }
+
   double connecting_, driving_, tau_s_, t_d0_;
+  std::vector<double> segment_change_n_;  // segment_pretension's, when on
 };
 
 }  // namespace
