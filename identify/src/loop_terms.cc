@@ -10,6 +10,39 @@
 
 namespace ccsrm::identify::internal {
 
+namespace {
+
+// The largest |angle| of `axis` over joints first_joint .. first_joint +
+// links - 1 in the current fit: over the measured frames of recorded angles
+// (`fitted`, laid out as measured), over the fitted runs' frames for an
+// experiment of tracked points, which measures no angle.
+double LargestAngle(const std::vector<Experiment>& training, const IdentificationSummary& current,
+                    const std::vector<Eigen::MatrixXd>& fitted, int first_joint, int links,
+                    int axis) {
+  double largest = 0.0;
+  for (std::size_t e = 0; e < training.size() && e < fitted.size(); ++e) {
+    const Eigen::MatrixXd& a = fitted[e];
+    for (int j = first_joint; j < first_joint + links; ++j) {
+      if (!training[e].tracked_points.empty()) {
+        for (const sim::TrajectoryFrame& frame : current.experiments[e].run.trajectory.frames) {
+          const std::size_t k = static_cast<std::size_t>(j - 1);
+          if (k < frame.joint_angles.size() && std::isfinite(frame.joint_angles[k][axis]))
+            largest = std::max(largest, std::abs(frame.joint_angles[k][axis]));
+        }
+        continue;
+      }
+      const Eigen::Index c = 2 * (j - 1) + axis;
+      if (c >= a.cols()) continue;
+      for (Eigen::Index f = 0; f < a.rows(); ++f) {
+        if (std::isfinite(a(f, c))) largest = std::max(largest, std::abs(a(f, c)));
+      }
+    }
+  }
+  return largest;
+}
+
+}  // namespace
+
 // The discovered terms' candidate of a round (issue 28): one column per
 // term, segment and axis (a simulation per training experiment, a secant
 // from 0 to the term's realistic coefficient), sparse regression on them
@@ -42,16 +75,7 @@ CandidateResult DiscoverTerms(LoopState* state, RoundState* rs) {
       // 0 moves nothing to first order: no column, no simulation. The
       // input rate goes with them: inputs that command a bending of an
       // axis move it.
-      double largest = 0.0;
-      for (const Eigen::MatrixXd& a : fitted) {
-        for (int j = first_joint; j < first_joint + links; ++j) {
-          const Eigen::Index c = 2 * (j - 1) + axis;
-          if (c >= a.cols()) continue;
-          for (Eigen::Index f = 0; f < a.rows(); ++f) {
-            if (std::isfinite(a(f, c))) largest = std::max(largest, std::abs(a(f, c)));
-          }
-        }
-      }
+      const double largest = LargestAngle(training, current, fitted, first_joint, links, axis);
       for (const sim::JointMomentTerm& term : sim::JointMomentTerms()) {
         const bool of_state = term.name != "const" && term.name != "time";
         if (of_state && !(largest > 1e-6)) continue;

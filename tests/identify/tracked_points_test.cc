@@ -17,6 +17,7 @@
 #include "ccsrm/identify/experiment.h"
 #include "ccsrm/identify/identification.h"
 #include "ccsrm/identify/job.h"
+#include "ccsrm/identify/loop.h"
 #include "ccsrm/identify/prediction.h"
 #include "ccsrm/mocap/pose_log.h"
 #include "ccsrm/reports/report.h"
@@ -189,6 +190,45 @@ TEST(TrackedPoints, TheLoopFindsALaggingActuatorInTheTipsPath) {
       s.conclusion.c_str(), s.rms_before_deg, s.rms_after_deg, *s.holdout_rms_before_deg,
       *s.holdout_rms_after_deg, delay_s, dead->value, lag->value,
       static_cast<long long>(s.simulations));
+}
+
+// Terms found in a tip's path: an arm whose segment-1 joints carry a cubic
+// spring about x (the loop's validation of terms, docs/loop.md) recorded
+// as a tip. A tip recording measures no angle, so the terms' columns in the
+// joints' angles must come from the fitted runs: the discovery tries them
+// (the regression's first support holds every term) and finds a moment in
+// the angle of segment 1 about x.
+TEST(TrackedPoints, TheLoopFindsTermsInTheAnglesOfATipsArm) {
+  constexpr double kNoiseMm = 0.2;
+  sim::ArmParameters truth = Truth();
+  sim::SetParameter("joint_moment.segment1_x_angle3", -200.0, "test", &truth);
+  ExperimentLoadOptions load;
+  load.point_noise_mm = kNoiseMm;
+  const Experiment e = MakeExperiment(TipRecording(kNoiseMm, 5, truth), "tip5.h5", load);
+  LoopOptions options;
+  options.fit.free_parameters = {"T_p"};
+  options.fit.threads = 2;
+  options.candidates = {"terms"};
+  options.max_rounds = 1;
+  const LoopSummary s = CloseLoop({e}, {}, options);
+  ASSERT_EQ(s.rounds.size(), 1u);
+  const CandidateResult* terms = nullptr;
+  for (const CandidateResult& c : s.rounds[0].candidates) {
+    if (c.kind == "discovered terms") terms = &c;
+  }
+  ASSERT_NE(terms, nullptr) << s.rounds[0].discovery;
+  ASSERT_FALSE(terms->term_path.empty());
+  const std::vector<std::string>& all = terms->term_path.front().parameters;
+  EXPECT_THAT(all, ::testing::Contains("joint_moment.segment1_x_angle3"));
+  bool in_angle = false;
+  for (const std::string& name : terms->parameters) {
+    in_angle = in_angle || name.rfind("joint_moment.segment1_x_angle", 0) == 0;
+  }
+  std::string chosen;
+  for (const std::string& name : terms->parameters) chosen += name + " ";
+  EXPECT_TRUE(in_angle) << chosen;
+  std::printf("terms in a tip's path: %s chose %s(%s)\n", s.conclusion.c_str(), chosen.c_str(),
+              terms->reason.c_str());
 }
 
 TEST(TrackedPoints, TheLoopRefusesAMeasurementEffectAndAMixOfKinds) {
