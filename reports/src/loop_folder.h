@@ -5,7 +5,8 @@
 // before and after, what remains unexplained), the fit folders declared/
 // and final/ of the declared and the final model (ReadFitFolder), and per
 // held-out experiment holdout/<name>.angles.csv (measured, declared and
-// final angles). The numbers are kept as written.
+// final angles; of tracked points <name>.declared.points.csv and
+// <name>.final.points.csv). The numbers are kept as written.
 #include <array>
 #include <optional>
 #include <string>
