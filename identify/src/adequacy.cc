@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "ccsrm/identify/diagnostics.h"
 #include "statistics.h"
 #include "text.h"
 
@@ -18,12 +19,11 @@ double Ratio(const ChannelAboveNoise& c) { return c.rms_deg / c.noise_deg; }
 }  // namespace
 
 std::string Describe(const ChannelAboveNoise& c) {
+  const std::string name = ChannelName(c.joint, c.axis, c.point);
   if (!c.point.empty()) {
-    return Format("point %s %c, %.3f mm RMS against %.3f mm of noise", c.point.c_str(),
-                  "xyz"[c.axis], c.rms_deg, c.noise_deg);
+    return name + Format(", %.3f mm RMS against %.3f mm of noise", c.rms_deg, c.noise_deg);
   }
-  return Format("joint %d %s, %.4f deg RMS against %.4f deg of noise", c.joint,
-                c.axis == 0 ? "θx" : "θy", c.rms_deg, c.noise_deg);
+  return name + Format(", %.4f deg RMS against %.4f deg of noise", c.rms_deg, c.noise_deg);
 }
 
 namespace {
