@@ -19,8 +19,13 @@ int PositionOf(const int* begin, const int* end, int row) {
 // the panel factorisation and the updates. The count % 4 leading columns in
 // one pass that also sets y, then four columns at a time, so that each pass
 // over y does up to four multiply-adds per load and store; the i loops are
-// contiguous and vectorise.
-void Combination(const double* a, int stride, const double* w, int count, int length, double* y) {
+// contiguous and vectorise. Built twice, the AVX2 clone chosen at load
+// time where the processor has it: 4-wide instead of SSE2's 2-wide, 3 %
+// of a fast-reversals run. AVX2 without FMA keeps every rounding the
+// default clone's (the angles bit-identical on either path).
+__attribute__((target_clones("avx2", "default"))) void Combination(const double* a, int stride,
+                                                                   const double* w, int count,
+                                                                   int length, double* y) {
   auto column = [&](int k) { return a + static_cast<std::size_t>(k) * stride; };
   int k = count % 4;
   switch (k) {
