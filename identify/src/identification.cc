@@ -1022,19 +1022,8 @@ struct Uncertainty {
   Eigen::MatrixXd covariance_u;  // free × free, scaled space, times σ_res²
   std::vector<bool> identifiable;
   std::vector<double> derivative_step_disagreement;  // per free parameter; empty: not checked
+  std::vector<double> derivative_step;               // per free parameter, as the check chose
 };
-
-// Per column: ||a - b|| / max(||a||, ||b||); NaN where b is NaN (not checked).
-std::vector<double> ColumnDisagreement(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  std::vector<double> out;
-  for (Eigen::Index i = 0; i < a.cols(); ++i) {
-    const double scale = std::max(a.col(i).norm(), b.col(i).norm());
-    out.push_back(!b.col(i).allFinite() ? kNaN
-                  : scale > 0.0         ? (a.col(i) - b.col(i)).norm() / scale
-                                        : 0.0);
-  }
-  return out;
-}
 
 // The residual statistics, singular values, unidentifiable directions and
 // covariance at the final point `u` (values p_final) into *summary.
@@ -1066,14 +1055,21 @@ Uncertainty UncertaintyAt(FitProblem& problem, ceres::Problem& ceres_problem,
   Eigen::MatrixXd jacobian;
   std::string failure;
   if (problem.Jacobian(u->data(), &jacobian, &failure)) {
-    summary->jacobian = jacobian;
     summary->weighted_residuals = final_eval.residuals;
-    Eigen::MatrixXd finer;
-    std::string finer_failure;
+    Eigen::MatrixXd third;
+    std::string unused;
     if (options.check_derivative_steps &&
-        problem.JacobianAtStep(u->data(), options.relative_step / 3.0, &finer, &finer_failure)) {
-      out.derivative_step_disagreement = ColumnDisagreement(jacobian, finer);
+        problem.JacobianAtStep(u->data(), options.relative_step / 3.0, &third, &unused)) {
+      const internal::DerivativeSteps steps = internal::ChooseDerivativeSteps(
+          options.relative_step, third,
+          [&](Eigen::MatrixXd* ninth) {
+            return problem.JacobianAtStep(u->data(), options.relative_step / 9.0, ninth, &unused);
+          },
+          kDerivativeStepLimit, &jacobian);
+      out.derivative_step_disagreement = steps.disagreement;
+      out.derivative_step = steps.relative_step;
     }
+    summary->jacobian = jacobian;
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian, Eigen::ComputeThinV);
     const Eigen::VectorXd sv = svd.singularValues();
     const Eigen::MatrixXd v = svd.matrixV();
@@ -1177,6 +1173,7 @@ void TabulateParameters(const std::vector<FreeParameter>& free, const std::vecto
     }
     if (i < uncertainty.derivative_step_disagreement.size()) {
       est.derivative_step_disagreement = uncertainty.derivative_step_disagreement[i];
+      est.derivative_step = uncertainty.derivative_step[i];
     }
     summary->parameters.push_back(est);
   }

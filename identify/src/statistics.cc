@@ -71,4 +71,36 @@ Identifiability AssessIdentifiability(const Eigen::MatrixXd& v,
   return out;
 }
 
+std::vector<double> ColumnDisagreement(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  std::vector<double> out;
+  for (Eigen::Index i = 0; i < a.cols(); ++i) {
+    const double scale = std::max(a.col(i).norm(), b.col(i).norm());
+    out.push_back(!b.col(i).allFinite() ? std::numeric_limits<double>::quiet_NaN()
+                  : scale > 0.0         ? (a.col(i) - b.col(i)).norm() / scale
+                                        : 0.0);
+  }
+  return out;
+}
+
+DerivativeSteps ChooseDerivativeSteps(double relative_step, const Eigen::MatrixXd& at_third,
+                                      const std::function<bool(Eigen::MatrixXd*)>& at_ninth,
+                                      double limit, Eigen::MatrixXd* jacobian) {
+  DerivativeSteps out;
+  out.disagreement = ColumnDisagreement(*jacobian, at_third);
+  out.relative_step.assign(out.disagreement.size(), relative_step);
+  const bool rough = std::any_of(out.disagreement.begin(), out.disagreement.end(),
+                                 [limit](double d) { return d > limit; });
+  Eigen::MatrixXd ninth;
+  if (!rough || !at_ninth(&ninth)) return out;
+  const std::vector<double> finer = ColumnDisagreement(at_third, ninth);
+  for (std::size_t i = 0; i < out.disagreement.size(); ++i) {
+    if (!(out.disagreement[i] > limit && finer[i] <= limit)) continue;
+    const Eigen::Index c = static_cast<Eigen::Index>(i);
+    jacobian->col(c) = at_third.col(c);
+    out.disagreement[i] = finer[i];
+    out.relative_step[i] = relative_step / 3.0;
+  }
+  return out;
+}
+
 }  // namespace ccsrm::identify::internal

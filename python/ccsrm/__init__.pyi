@@ -221,6 +221,8 @@ class ParameterEstimate:
     ci95_lower: float
     ci95_upper: float
     at_bound: bool
+    derivative_step_disagreement: float
+    derivative_step: float
 
 class Fit:
     @property

@@ -243,6 +243,13 @@ void AddFitClasses(py::module_& m) {
       .def_readonly("ci95_lower", &ParameterEstimate::ci95_lower)
       .def_readonly("ci95_upper", &ParameterEstimate::ci95_upper)
       .def_readonly("at_bound", &ParameterEstimate::at_bound)
+      .def_readonly("derivative_step_disagreement",
+                    &ParameterEstimate::derivative_step_disagreement,
+                    "Its derivatives at derivative_step and a third of it differ by this "
+                    "(relative); above 0.05 the angles are not smooth in it. NaN: not checked.")
+      .def_readonly("derivative_step", &ParameterEstimate::derivative_step,
+                    "The relative finite-difference step of its derivative in the intervals: "
+                    "the fit's, or a third of it where the angles bend between the two.")
       .def("__repr__", [](const ParameterEstimate& p) {
         return "<ParameterEstimate " + p.name + " = " +
                py::repr(py::float_(p.value)).cast<std::string>() + " " + p.units + ">";

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "ccsrm/identify/adequacy.h"
@@ -148,3 +149,65 @@ TEST(ModelAdequacy, ANoiseKnownFromFewSamplesIsNotTakenForAMisfit) {
 
 }  // namespace
 }  // namespace ccsrm::identify
+
+namespace ccsrm::identify::internal {
+namespace {
+
+// Three columns of a Jacobian at relative steps r, r/3, r/9: the first a
+// clean derivative, the second one that bends between r/3 and r (its
+// central difference at r carries a curvature error the finer two do not),
+// the third one that jumps (every step gives another slope).
+TEST(ChooseDerivativeSteps, TakesTheFinerColumnOnlyWhereTheFinerStepsAgree) {
+  Eigen::MatrixXd at_r(2, 3), at_third(2, 3), at_ninth(2, 3);
+  at_r << 1.0, 1.10, 1.0, 2.0, 2.20, 0.0;
+  at_third << 1.0, 1.01, 1.5, 2.0, 2.02, 0.5;
+  at_ninth << 1.0, 1.00, 0.6, 2.0, 2.00, -0.4;
+  Eigen::MatrixXd jacobian = at_r;
+  int asked = 0;
+  const DerivativeSteps steps = ChooseDerivativeSteps(
+      0.01, at_third,
+      [&](Eigen::MatrixXd* ninth) {
+        ++asked;
+        *ninth = at_ninth;
+        return true;
+      },
+      0.05, &jacobian);
+  EXPECT_EQ(asked, 1);
+  EXPECT_DOUBLE_EQ(steps.relative_step[0], 0.01);
+  EXPECT_DOUBLE_EQ(steps.disagreement[0], 0.0);
+  // Bends: r against r/3 differ by 8.2 %, r/3 against r/9 by 1 %.
+  EXPECT_DOUBLE_EQ(steps.relative_step[1], 0.01 / 3.0);
+  EXPECT_NEAR(steps.disagreement[1], 0.01 / 1.01, 1e-12);
+  EXPECT_TRUE(jacobian.col(1).isApprox(at_third.col(1)));
+  // Jumps: kept at r, with r's disagreement, and its column the fit's.
+  EXPECT_DOUBLE_EQ(steps.relative_step[2], 0.01);
+  EXPECT_GT(steps.disagreement[2], 0.05);
+  EXPECT_TRUE(jacobian.col(2).isApprox(at_r.col(2)));
+  EXPECT_TRUE(jacobian.col(0).isApprox(at_r.col(0)));
+}
+
+TEST(ChooseDerivativeSteps, AsksForNoNinthWhereEveryColumnAgrees) {
+  Eigen::MatrixXd jacobian(1, 2), at_third(1, 2);
+  jacobian << 1.0, 2.0;
+  at_third << 1.01, 2.02;
+  const DerivativeSteps steps = ChooseDerivativeSteps(
+      0.01, at_third, [](Eigen::MatrixXd*) -> bool { throw std::logic_error("asked"); }, 0.05,
+      &jacobian);
+  EXPECT_NEAR(steps.disagreement[1], 0.02 / 2.02, 1e-12);
+  EXPECT_DOUBLE_EQ(steps.relative_step[1], 0.01);
+}
+
+// A ninth that could not be computed leaves every column at the fit's step.
+TEST(ChooseDerivativeSteps, KeepsTheFitsStepWithoutANinth) {
+  Eigen::MatrixXd jacobian(1, 1), at_third(1, 1);
+  jacobian << 1.1;
+  at_third << 1.0;
+  const DerivativeSteps steps = ChooseDerivativeSteps(
+      0.01, at_third, [](Eigen::MatrixXd*) { return false; }, 0.05, &jacobian);
+  EXPECT_NEAR(steps.disagreement[0], 0.1 / 1.1, 1e-12);
+  EXPECT_DOUBLE_EQ(steps.relative_step[0], 0.01);
+  EXPECT_DOUBLE_EQ(jacobian(0, 0), 1.1);
+}
+
+}  // namespace
+}  // namespace ccsrm::identify::internal

@@ -224,12 +224,16 @@ struct ParameterEstimate {
   double ci95_lower = std::numeric_limits<double>::quiet_NaN();
   double ci95_upper = std::numeric_limits<double>::quiet_NaN();
   bool at_bound = false;  // the estimate sits on a bound: its interval is not symmetric
-  // Free: ||J_r - J_r/3|| / max(||J_r||, ||J_r/3||) of its column of the
-  // weighted residuals' Jacobian at the final point, at the fit's relative
-  // step r and r/3 (IdentificationOptions::check_derivative_steps); above
-  // kDerivativeStepLimit the angles are not smooth in it there. NaN when not
-  // checked (or a measurement parameter, exact at any step).
+  // Free: ||J_s - J_s/3|| / max(||J_s||, ||J_s/3||) of its column of the
+  // weighted residuals' Jacobian at the final point, at the relative step s
+  // of derivative_step and s/3 (IdentificationOptions::check_derivative_steps);
+  // above kDerivativeStepLimit the angles are not smooth in it there. NaN
+  // when not checked (or a measurement parameter, exact at any step).
   double derivative_step_disagreement = std::numeric_limits<double>::quiet_NaN();
+  // The relative step of its column in the singular values and intervals:
+  // the fit's r, or r/3 where r and r/3 disagree and r/3 and r/9 agree (a
+  // derivative that bends between r/3 and r). NaN when not checked.
+  double derivative_step = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Derivatives at two steps that differ by more than this are not a
