@@ -212,6 +212,16 @@ class FitProblem {
     return DifferenceJacobian(u, true, relative_step, jacobian, &runs, failure);
   }
 
+  // What Jacobian(u) returns from now on: the final point's, whose columns
+  // the derivative check may have taken at a finer step (Ceres' covariance
+  // asks for it through the cost function).
+  void SetJacobianAt(const double* u, const Eigen::MatrixXd& jacobian) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    jacobian_u_.assign(u, u + free_.size());
+    jacobian_second_order_ = second_order_;
+    jacobian_ = jacobian;
+  }
+
   // From now on every Jacobian is second order (the final point's).
   void UseSecondOrder() {
     const std::lock_guard<std::mutex> lock(mutex_);
@@ -1068,6 +1078,7 @@ Uncertainty UncertaintyAt(FitProblem& problem, ceres::Problem& ceres_problem,
           kDerivativeStepLimit, &jacobian);
       out.derivative_step_disagreement = steps.disagreement;
       out.derivative_step = steps.relative_step;
+      problem.SetJacobianAt(u->data(), jacobian);
     }
     summary->jacobian = jacobian;
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(jacobian, Eigen::ComputeThinV);
