@@ -113,11 +113,23 @@ Section SummarySection(const PredictionFolder& p) {
     for (const std::string& problem : r.problems)
       section.blocks.push_back(Paragraph{problem, true});
   }
+  // Angle rows only where some recording measured angles; a tracked point
+  // gets its own rows in mm.
+  const bool angles = std::any_of(p.recordings.begin(), p.recordings.end(),
+                                  [](const PredictionRecording& r) { return r.points.empty(); });
+  const bool points = std::any_of(p.recordings.begin(), p.recordings.end(),
+                                  [](const PredictionRecording& r) { return !r.points.empty(); });
   Table table = internal::KeyValueTable(
       "prediction", "Prediction",
-      "From pred.json. RMS and largest error: predicted − measured over every measured frame, "
-      "joint and axis. Weighted RMS: the RMS of (predicted − measured) / noise, the residual "
-      "identification minimises; about 1 when the errors are as large as the measurement noise.");
+      std::string("From pred.json. ") +
+          (angles ? "RMS and largest error: predicted − measured over every measured frame, "
+                    "joint and axis. "
+                  : "") +
+          (points ? "Tracked points: each point's Euclidean RMS error over its frames, and "
+                    "the same with its mean offset removed. "
+                  : "") +
+          "Weighted RMS: the RMS of (predicted − measured) / noise, the residual identification "
+          "minimises; about 1 when the errors are as large as the measurement noise.");
   AddText(&table, "model", p.model_source);
   AddText(&table, "model kind", p.model_kind);
   AddText(&table, "fitted parameters", p.free.empty() ? "–" : ListNames(p.free));
@@ -125,10 +137,20 @@ Section SummarySection(const PredictionFolder& p) {
   if (!p.effects_files.empty()) AddText(&table, "effects from", ListNames(p.effects_files));
   AddValue(&table, "recordings", static_cast<double>(p.recordings.size()), "",
            NumberFormat::Integer());
-  AddValue(&table, "RMS error", p.errors.rms_deg, "deg", kRms);
-  AddValue(&table, "largest error", p.errors.max_abs_deg, "deg", kRms);
+  if (angles) {
+    AddValue(&table, "RMS error", p.errors.rms_deg, "deg", kRms);
+    AddValue(&table, "largest error", p.errors.max_abs_deg, "deg", kRms);
+  }
+  for (const PredictionRecording& r : p.recordings) {
+    for (std::size_t k = 0; k < r.points.size() && k < r.point_rms_mm.size(); ++k) {
+      const std::string name = (p.recordings.size() > 1 ? r.name + " " : "") + r.points[k];
+      AddValue(&table, name + " RMS error", r.point_rms_mm[k], "mm", kMm);
+      AddValue(&table, name + " RMS error, mean offset removed", r.point_rms_mean_removed_mm[k],
+               "mm", kMm);
+    }
+  }
   AddValue(&table, "weighted RMS", p.errors.weighted_rms, "", kRatio);
-  AddValue(&table, "fit percent", p.errors.fit_percent, "%", kPercent);
+  if (angles) AddValue(&table, "fit percent", p.errors.fit_percent, "%", kPercent);
   AddValue(&table, "channels above the noise", static_cast<double>(p.above_noise.size()), "",
            NumberFormat::Integer());
   AddValue(&table, "simulations", p.simulations, "", NumberFormat::Integer());

@@ -389,6 +389,17 @@ TEST(TrackedPoints, RecoverThePretensionAndThePlacementOfTheCaptureFrame) {
     }
     EXPECT_THAT(summary, HasSubstr("mm with the mean offset removed")) << page.kind;
   }
+  // The prediction's table gives the tip's errors in mm, and no angle rows
+  // (a tip recording measures no angle).
+  std::vector<std::string> rows;
+  for (const reports::Block& block : pages[1].sections[0].blocks) {
+    const auto* t = std::get_if<reports::Table>(&block);
+    if (t == nullptr || t->id != "prediction") continue;
+    for (const std::vector<reports::Cell>& row : t->rows) rows.push_back(row[0].text);
+  }
+  EXPECT_THAT(rows, ::testing::Contains("tip RMS error, mean offset removed"));
+  EXPECT_THAT(rows, ::testing::Not(::testing::Contains("RMS error")));
+  EXPECT_THAT(rows, ::testing::Not(::testing::Contains("fit percent")));
   std::printf(
       "T_p %.4f N (truth %.1f), std error %.3g N; placement off by %.4f deg and %.4f mm; tip "
       "RMS %.3f -> %.3f mm (noise %.3f expected), path radius %.1f mm; %lld runs\n",
