@@ -95,8 +95,9 @@ TEST(RealFriction, AFastRecordingWithStaticAboveKineticIsFittedToTheTruth) {
 
 // At three times the fit's default step the same recording's angles bend
 // between r and r/3 in the holes' static coefficient (3.0 % between r/3
-// and r/9 against more than 5 % between r and r/3, measured through
-// `ccsrm identify --relative-step 0.03`): the check takes that column at
+// and r/9 against more than 5 % between r and r/3, measured by `ccsrm
+// identify --relative-step 0.03` one iteration from the truth with mu and
+// T_p free as well): the check takes that column at
 // r/3, and the intervals follow it. Their standard errors are those of the
 // Jacobian the summary reports, column for column: Ceres' covariance reads
 // the same Jacobian the check chose, not the fit's first one.
