@@ -310,7 +310,10 @@ Figure ErrorFigure(const PredictionFolder& p) {
 }
 
 Section ErrorSection(const PredictionFolder& p) {
-  Section section{"errors", "Errors per joint", {}};
+  // Recordings of tracked points only: no joint was measured, and what is
+  // left of the section is the channels above the noise.
+  const bool angles = std::isfinite(p.errors.rms_deg);
+  Section section{"errors", angles ? "Errors per joint" : "Channels above the noise", {}};
   Table table;
   table.id = "errors_per_joint";
   table.title = "Prediction error per joint and axis";
@@ -334,8 +337,6 @@ Section ErrorSection(const PredictionFolder& p) {
                    {"fit_y_percent", "fit θy", "%", kPercent},
                    {"samples_x", "samples θx", "", NumberFormat::Integer()},
                    {"samples_y", "samples θy", "", NumberFormat::Integer()}};
-  // Recordings of tracked points only: no joint was measured.
-  const bool angles = std::isfinite(p.errors.rms_deg);
   for (const auto& j :
        angles ? p.errors.per_joint : std::vector<internal::PredictionErrors::Joint>{}) {
     table.AddRow({Cell::Number(j.joint), Cell::Number(j.rms_deg[0]), Cell::Number(j.max_abs_deg[0]),

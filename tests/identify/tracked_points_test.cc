@@ -400,6 +400,10 @@ TEST(TrackedPoints, RecoverThePretensionAndThePlacementOfTheCaptureFrame) {
   EXPECT_THAT(rows, ::testing::Contains("tip RMS error, mean offset removed"));
   EXPECT_THAT(rows, ::testing::Not(::testing::Contains("RMS error")));
   EXPECT_THAT(rows, ::testing::Not(::testing::Contains("fit percent")));
+  std::vector<std::string> titles;
+  for (const reports::Section& section : pages[1].sections) titles.push_back(section.title);
+  EXPECT_THAT(titles, ::testing::Contains("Channels above the noise"));
+  EXPECT_THAT(titles, ::testing::Not(::testing::Contains("Errors per joint")));
   std::printf(
       "T_p %.4f N (truth %.1f), std error %.3g N; placement off by %.4f deg and %.4f mm; tip "
       "RMS %.3f -> %.3f mm (noise %.3f expected), path radius %.1f mm; %lld runs\n",
