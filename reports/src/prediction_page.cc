@@ -43,6 +43,17 @@ std::string ChannelName(const internal::PredictionChannel& c) {
 
 // ----------------------------------------------------------------- summary
 
+// Whether some recording measured joint angles, and whether some measured
+// tracked points (a prediction may hold either or both).
+bool HasAngles(const PredictionFolder& p) {
+  return std::any_of(p.recordings.begin(), p.recordings.end(),
+                     [](const PredictionRecording& r) { return r.points.empty(); });
+}
+bool HasPoints(const PredictionFolder& p) {
+  return std::any_of(p.recordings.begin(), p.recordings.end(),
+                     [](const PredictionRecording& r) { return !r.points.empty(); });
+}
+
 Section SummarySection(const PredictionFolder& p) {
   Section section{"summary", "Summary", {}};
   // The answer first: whether the model explains these recordings.
@@ -115,10 +126,8 @@ Section SummarySection(const PredictionFolder& p) {
   }
   // Angle rows only where some recording measured angles; a tracked point
   // gets its own rows in mm.
-  const bool angles = std::any_of(p.recordings.begin(), p.recordings.end(),
-                                  [](const PredictionRecording& r) { return r.points.empty(); });
-  const bool points = std::any_of(p.recordings.begin(), p.recordings.end(),
-                                  [](const PredictionRecording& r) { return !r.points.empty(); });
+  const bool angles = HasAngles(p);
+  const bool points = HasPoints(p);
   Table table = internal::KeyValueTable(
       "prediction", "Prediction",
       std::string("From pred.json. ") +
@@ -312,7 +321,7 @@ Figure ErrorFigure(const PredictionFolder& p) {
 Section ErrorSection(const PredictionFolder& p) {
   // Recordings of tracked points only: no joint was measured, and what is
   // left of the section is the channels above the noise.
-  const bool angles = std::isfinite(p.errors.rms_deg);
+  const bool angles = HasAngles(p);
   Section section{"errors", angles ? "Errors per joint" : "Channels above the noise", {}};
   Table table;
   table.id = "errors_per_joint";
